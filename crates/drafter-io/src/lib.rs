@@ -1,0 +1,107 @@
+//! Importers into the drafter [`Scene`]: glTF 2.0 (.gltf, .glb), OBJ, STL (binary and ASCII), OFF and
+//! PLY (ASCII and binary little-endian).
+//!
+//! The format is chosen by content first (glb magic, `ply`, `OFF`, a binary STL whose size matches
+//! its triangle count, JSON) and by extension second. Every importer returns either a scene plus
+//! diagnostics for what it recovered from, or an [`ImportError`] naming the file and the place.
+//!
+//! Invariants: no panic on any input; no allocation is sized by a count read from the file unless
+//! the file's length can back it; a glTF's external URIs resolve only inside the file's folder.
+
+mod error;
+mod gltf_import;
+mod obj;
+mod off;
+mod ply;
+mod raw;
+mod stl;
+
+use std::path::Path;
+
+use drafter_core::{Diagnostic, Diagnostics, Scene, SourceFormat};
+
+pub use error::{ImportError, ParseError, Place};
+pub use raw::RawMesh;
+
+/// A successfully imported file.
+#[derive(Debug)]
+pub struct Imported {
+    pub scene: Scene,
+    /// Problems recovered from, aggregated by kind.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Reads `path`, choosing the format by content and extension.
+pub fn import(path: &Path) -> Result<Imported, ImportError> {
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
+}
+
+/// Imports `bytes` that were read from `path`. The path names the file in errors, resolves a glTF's
+/// external buffers and OBJ material libraries, and breaks ties in format detection.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, ImportError> {
+    let format = detect_format(path, bytes)?;
+    let mut diagnostics = Diagnostics::new();
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let scene = match format {
+        SourceFormat::Gltf | SourceFormat::Glb => gltf_import::import(path, bytes, &mut diagnostics)?,
+        SourceFormat::Obj => obj::import(path, bytes, &mut diagnostics)?,
+        SourceFormat::Stl => raw_scene(path, stl::read(bytes), format, &name, &mut diagnostics)?,
+        SourceFormat::Off => raw_scene(path, off::read(bytes), format, &name, &mut diagnostics)?,
+        SourceFormat::Ply => raw_scene(path, ply::read(bytes), format, &name, &mut diagnostics)?,
+    };
+    Ok(Imported { scene, diagnostics: diagnostics.into_vec() })
+}
+
+fn raw_scene(
+    path: &Path,
+    raw: Result<RawMesh, ParseError>,
+    format: SourceFormat,
+    name: &str,
+    diagnostics: &mut Diagnostics,
+) -> Result<Scene, ImportError> {
+    raw.and_then(|raw| raw::single_mesh_scene(raw, format, name, diagnostics)).map_err(|e| e.in_path(path))
+}
+
+/// Decides the format of `bytes`, content first.
+pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<SourceFormat, ImportError> {
+    let unsupported = |reason: &str| ImportError::UnsupportedFormat { path: path.to_path_buf(), reason: reason.to_owned() };
+    if bytes.is_empty() {
+        return Err(ParseError::in_file("empty file").in_path(path));
+    }
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    if bytes.starts_with(b"glTF") {
+        return Ok(SourceFormat::Glb);
+    }
+    if bytes.starts_with(b"ply") {
+        return Ok(SourceFormat::Ply);
+    }
+    if stl::is_binary(bytes) {
+        return Ok(SourceFormat::Stl);
+    }
+    let text_start = trim_ascii_start(bytes);
+    if text_start.starts_with(b"OFF") || text_start.starts_with(b"COFF") || text_start.starts_with(b"NOFF") {
+        return Ok(SourceFormat::Off);
+    }
+    if text_start.starts_with(b"{") {
+        return Ok(SourceFormat::Gltf);
+    }
+    if text_start.starts_with(b"solid") {
+        return Ok(SourceFormat::Stl);
+    }
+    match extension.as_str() {
+        "gltf" => Ok(SourceFormat::Gltf),
+        "glb" => Ok(SourceFormat::Glb),
+        "obj" => Ok(SourceFormat::Obj),
+        "stl" => Ok(SourceFormat::Stl),
+        "off" => Ok(SourceFormat::Off),
+        "ply" => Ok(SourceFormat::Ply),
+        "" => Err(unsupported("no extension and no known signature")),
+        other => Err(unsupported(&format!("extension .{other} and no known signature"))),
+    }
+}
+
+fn trim_ascii_start(bytes: &[u8]) -> &[u8] {
+    let skip = bytes.iter().take_while(|b| b.is_ascii_whitespace()).count();
+    &bytes[skip..]
+}

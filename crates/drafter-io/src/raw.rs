@@ -1,0 +1,70 @@
+//! The common output of the single-mesh readers (STL, OFF, PLY) before it becomes a [`Scene`].
+
+use drafter_core::{DiagnosticKind, Diagnostics, Mesh, Scene, SourceFormat, TriangleGroup};
+use glam::{DMat4, Vec3};
+
+use crate::error::ParseError;
+
+/// One mesh as read from a file: positions and triangles exactly as stored (polygons already
+/// fan-triangulated), not yet checked for NaN.
+///
+/// Invariant (enforced by each reader, which reports the place of the offence): every index is
+/// `< positions.len()`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RawMesh {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-vertex normals if the file has them (PLY nx/ny/nz), one per position.
+    pub normals: Option<Vec<[f32; 3]>>,
+}
+
+/// Turns a reader's output into a one-instance scene: drops faces using non-finite positions (with a
+/// diagnostic) and fails if nothing drawable is left.
+pub(crate) fn single_mesh_scene(
+    raw: RawMesh,
+    format: SourceFormat,
+    name: &str,
+    diagnostics: &mut Diagnostics,
+) -> Result<Scene, ParseError> {
+    let mut mesh = Mesh { name: name.to_owned(), ..Mesh::default() };
+    mesh.positions = raw.positions.iter().map(|&p| Vec3::from(p)).collect();
+    let finite: Vec<bool> = mesh.positions.iter().map(|p| p.is_finite()).collect();
+    let bad_vertices = finite.iter().filter(|&&f| !f).count();
+    if let Some(first) = finite.iter().position(|&f| !f) {
+        diagnostics.push(DiagnosticKind::NonFinitePosition, bad_vertices, || format!("vertex {first} is NaN or infinite"));
+        // Keep the array dense; the bad vertices are unreferenced after the faces go.
+        for (p, &ok) in mesh.positions.iter_mut().zip(&finite) {
+            if !ok {
+                *p = Vec3::ZERO;
+            }
+        }
+    }
+    let total = raw.triangles.len();
+    mesh.triangles = raw.triangles.into_iter().filter(|t| t.iter().all(|&v| finite[v as usize])).collect();
+    let dropped = total - mesh.triangles.len();
+    diagnostics.push(DiagnosticKind::DroppedFace, dropped, || format!("{dropped} faces used non-finite vertices"));
+    if let Some(normals) = raw.normals {
+        if normals.len() == mesh.positions.len() && normals.iter().all(|n| n.iter().all(|c| c.is_finite())) {
+            mesh.normals = Some(normals.into_iter().map(Vec3::from).collect());
+        } else {
+            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || "vertex normals are not finite; ignored".into());
+        }
+    }
+    if mesh.triangles.is_empty() {
+        return Err(ParseError::in_file(if total == 0 {
+            "no triangles".to_owned()
+        } else {
+            "no triangle with finite vertex positions".to_owned()
+        }));
+    }
+    mesh.groups = vec![TriangleGroup { start: 0, count: mesh.triangles.len() as u32, material: None }];
+    let mut scene = Scene::new(format);
+    scene.meshes.push(mesh);
+    scene.instances.push(drafter_core::Instance {
+        name: name.to_owned(),
+        mesh: drafter_core::MeshId(0),
+        node: None,
+        world_from_object: DMat4::IDENTITY,
+    });
+    Ok(scene)
+}
