@@ -1,1 +1,39 @@
-fn main() {}
+//! `drafter`: bake technical 3D models into illustration-ready glTF, inspect them, render them.
+//!
+//! Exit codes: 0 success, 2 bad input (one line on stderr naming the file and the place), 1 internal
+//! error (a bug: please report it).
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cmd;
+mod exit;
+
+#[derive(Debug, Parser)]
+#[command(name = "drafter", version, about = "Bake CAD assemblies and meshes into assets for technical illustration")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print what a file contains: parts, meshes, triangle counts, bounds and welded topology.
+    Inspect(cmd::inspect::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = std::panic::catch_unwind(|| match cli.command {
+        Command::Inspect(args) => cmd::inspect::run(args),
+    });
+    match result {
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Err(err)) => exit::report(&err),
+        Err(_) => {
+            eprintln!("drafter: internal error (a panic, reported above); this is a bug");
+            ExitCode::from(exit::INTERNAL)
+        }
+    }
+}

@@ -30,12 +30,21 @@ use crate::Mesh;
 /// Marks an edge slot of a face that collapsed to a point after welding.
 pub const EDGE_NONE: u32 = u32::MAX;
 
+/// Default grid of [`Weld::Snap`], as a fraction of the bounding diagonal.
+pub const DEFAULT_SNAP_FRACTION: f64 = 1e-9;
+
 /// How positions are merged before connectivity is derived.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Weld {
     /// Merge vertices whose coordinates are bit-identical (after mapping -0.0 to 0.0).
-    #[default]
     Exact,
+    /// Merge vertices whose coordinates round to the same point of a grid with this spacing, as a
+    /// fraction of the bounding diagonal (default [`DEFAULT_SNAP_FRACTION`]). This is "identical
+    /// positions" up to float noise: CAD exporters write `2.4e-18` where a neighbouring facet has
+    /// `0.0`, and trimesh's `merge_vertices` welds those by rounding too. At 1e-9 the grid is
+    /// finer than f32 resolution for every coordinate above 1/60 of the diagonal, so distinct
+    /// vertices of a real model never merge. Same cost as `Exact`.
+    Snap(f64),
     /// Merge vertices closer than this fraction of the mesh's bounding diagonal (e.g. `1e-6`).
     /// Clustering is greedy in vertex order: a vertex joins the first earlier cluster
     /// representative within the distance, so the result is deterministic.
@@ -80,6 +89,7 @@ impl Topology {
     pub fn from_triangles(positions: &[Vec3], triangles: &[[u32; 3]], weld: Weld) -> Topology {
         let welded_of_vertex = match weld {
             Weld::Exact => weld_exact(positions),
+            Weld::Snap(fraction) => weld_snap(positions, fraction),
             Weld::Relative(fraction) => weld_tolerance(positions, fraction),
         };
         let welded_count = welded_of_vertex.iter().map(|&w| w as usize + 1).max().unwrap_or(0);
@@ -165,6 +175,30 @@ impl Topology {
         (0..self.edges.len()).filter(|&e| self.edge_valence(e) >= 3).count()
     }
 
+    /// Boundary and non-manifold edge counts in the *incidence* convention of trimesh and MeshLab:
+    /// every face corner contributes its edge, collapsed faces included, so a face `(a, a, b)` adds a
+    /// self-edge `{a, a}` (seen once: boundary) and two more uses of `{a, b}`. [`Topology::edges`]
+    /// leaves collapsed faces out, which is what the geometry stages want; this count is what
+    /// other tools report for the same file.
+    pub fn incidence_edge_counts(&self) -> (usize, usize) {
+        let mut extra: std::collections::BTreeMap<[u32; 2], u32> = Default::default();
+        for &[a, b, c] in &self.faces {
+            if a == b || b == c || c == a {
+                for (u, w) in [(a, b), (b, c), (c, a)] {
+                    *extra.entry([u.min(w), u.max(w)]).or_default() += 1;
+                }
+            }
+        }
+        let (mut boundary, mut nonmanifold) = (self.boundary_edge_count(), self.nonmanifold_edge_count());
+        for (edge, added) in extra {
+            let before = self.edges.binary_search(&edge).map_or(0, |e| self.edge_valence(e));
+            let after = before + added;
+            boundary = boundary + usize::from(after == 1) - usize::from(before == 1);
+            nonmanifold = nonmanifold + usize::from(after >= 3) - usize::from(before >= 3);
+        }
+        (boundary, nonmanifold)
+    }
+
     pub fn degenerate_triangle_count(&self) -> usize {
         self.face_degenerate.iter().filter(|&&d| d).count()
     }
@@ -181,9 +215,36 @@ fn weld_key(p: Vec3) -> [u32; 3] {
     p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
+impl Default for Weld {
+    fn default() -> Self {
+        Weld::Snap(DEFAULT_SNAP_FRACTION)
+    }
+}
+
 fn weld_exact(positions: &[Vec3]) -> Vec<u32> {
-    let n = positions.len();
-    let mut order: Vec<([u32; 3], u32)> = positions.par_iter().enumerate().map(|(i, &p)| (weld_key(p), i as u32)).collect();
+    let keys: Vec<[u32; 3]> = positions.par_iter().map(|&p| weld_key(p)).collect();
+    weld_by_keys(&keys)
+}
+
+fn weld_snap(positions: &[Vec3], fraction: f64) -> Vec<u32> {
+    let (lo, hi) = positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+        (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+    });
+    let cell = if positions.is_empty() { 0.0 } else { (hi - lo).length() * fraction.abs() };
+    if !(cell > 0.0) || !cell.is_finite() {
+        return weld_exact(positions);
+    }
+    // Rounding the coordinate itself (not relative to the box) keeps 0.0 at a cell centre, so noise
+    // around zero welds.
+    let keys: Vec<[i64; 3]> =
+        positions.par_iter().map(|p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64)).collect();
+    weld_by_keys(&keys)
+}
+
+/// Welds vertices with equal keys; ids in order of first occurrence.
+fn weld_by_keys<K: Ord + Copy + Send + Sync>(keys: &[K]) -> Vec<u32> {
+    let n = keys.len();
+    let mut order: Vec<(K, u32)> = keys.par_iter().enumerate().map(|(i, &k)| (k, i as u32)).collect();
     // Unique (key, index) pairs: the unstable sort is deterministic.
     order.par_sort_unstable();
     let mut representative = vec![0u32; n];
@@ -219,6 +280,8 @@ fn number_clusters(representative: &[u32]) -> Vec<u32> {
 }
 
 fn weld_tolerance(positions: &[Vec3], fraction: f64) -> Vec<u32> {
+    // Greedy clustering over a hash grid: a vertex joins the lowest-numbered earlier representative
+    // within the distance. Slower than the sort-based welds; for explicit tolerances only.
     let mut bounds_min = DVec3::splat(f64::INFINITY);
     let mut bounds_max = DVec3::splat(f64::NEG_INFINITY);
     for p in positions {
@@ -456,6 +519,24 @@ mod tests {
         assert_eq!(topo.welded_of_vertex, vec![0, 0, 1, 2]);
         let exact = Topology::from_triangles(&p, &[], Weld::Exact);
         assert_eq!(exact.welded_positions.len(), 4);
+    }
+
+    #[test]
+    fn snap_weld_merges_float_noise_only() {
+        let p = vec![Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.5, 2.4e-18, 0.0), Vec3::new(0.5, 1e-4, 0.0), Vec3::ONE];
+        let topo = Topology::from_triangles(&p, &[], Weld::default());
+        assert_eq!(topo.welded_of_vertex, vec![0, 0, 1, 2]);
+    }
+
+    #[test]
+    fn incidence_counts_include_collapsed_faces() {
+        // Two triangles sharing {0,1}, plus a collapsed face (0,0,1): {0,1} becomes non-manifold and
+        // the self-edge {0,0} a boundary, as trimesh counts them.
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NEG_Y];
+        let t = vec![[0, 1, 2], [1, 0, 3], [0, 0, 1]];
+        let topo = Topology::from_triangles(&p, &t, Weld::Exact);
+        assert_eq!((topo.boundary_edge_count(), topo.nonmanifold_edge_count()), (4, 0));
+        assert_eq!(topo.incidence_edge_counts(), (5, 1));
     }
 
     #[test]

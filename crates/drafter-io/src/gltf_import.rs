@@ -1,9 +1,621 @@
-use std::path::Path;
+//! glTF 2.0 importer (.gltf with external or data-URI buffers, and .glb).
+//!
+//! The JSON is parsed and validated by the `gltf` crate; buffers and accessors are resolved here by
+//! hand, because the crate's `import` follows any URI (absolute paths, `..`) and its accessor reader
+//! assumes float positions, while we must (a) confine URIs to the file's folder, (b) read
+//! KHR_mesh_quantization's integer positions and normals, and (c) check every accessor against its
+//! buffer view and buffer, naming the accessor when it does not fit.
+//!
+//! Scene model: every glTF mesh becomes one [`Mesh`] (its primitives concatenated, one
+//! [`TriangleGroup`] per primitive, so `MeshId` = glTF mesh index); every node of the default scene
+//! (else the first) that has a mesh becomes an [`Instance`] with its world transform composed in f64.
+//! Strips and fans are turned into triangle lists with the spec's winding rule; points and lines are
+//! skipped with a diagnostic. Mirrored instances keep the mesh as stored: [`Instance::flips_winding`]
+//! tells consumers to flip it in the world.
 
-use drafter_core::{Diagnostics, Scene};
+use std::path::{Component, Path, PathBuf};
+
+use base64::Engine as _;
+use drafter_core::{
+    DiagnosticKind, Diagnostics, Instance, Material, MaterialId, Mesh, MeshId, Node, NodeId, Scene, SourceFormat,
+    TriangleGroup,
+};
+use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::json::validation::Validate as _;
+use gltf::mesh::Mode;
 
 use crate::error::{ImportError, ParseError};
+use crate::raw::drop_nonfinite_faces;
 
-pub(crate) fn import(path: &Path, _bytes: &[u8], _diagnostics: &mut Diagnostics) -> Result<Scene, ImportError> {
-    Err(ParseError::in_file("glTF importer not written yet").in_path(path))
+/// Required extensions we can honour: quantized attributes are decoded here; the others change only
+/// appearance or textures, which the bake does not decode.
+const ACCEPTED_REQUIRED_EXTENSIONS: &[&str] =
+    &["KHR_mesh_quantization", "KHR_texture_transform", "KHR_texture_basisu", "EXT_texture_webp", "KHR_lights_punctual"];
+
+pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -> Result<Scene, ImportError> {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(e).in_path(path))?;
+    let format = if bytes.starts_with(b"glTF") { SourceFormat::Glb } else { SourceFormat::Gltf };
+    let doc = &gltf.document;
+    check_required_extensions(doc.as_json()).map_err(|e| e.in_path(path))?;
+    validate(doc.as_json()).map_err(|e| e.in_path(path))?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let buffers = load_buffers(doc, gltf.blob.as_deref(), folder).map_err(|e| e.in_path(path))?;
+    build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))
+}
+
+fn gltf_error(e: gltf::Error) -> ParseError {
+    match e {
+        gltf::Error::Deserialize(e) => {
+            ParseError::at_line(e.line(), format!("invalid glTF JSON: {}", strip_position(&e.to_string())))
+        }
+        gltf::Error::Binary(e) => ParseError::in_file(format!("invalid GLB container: {e}")),
+        gltf::Error::Validation(errors) => validation_error(&errors),
+        other => ParseError::in_file(other.to_string()),
+    }
+}
+
+/// serde_json appends " at line L column C"; the place is reported separately.
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_owned(),
+        None => message.to_owned(),
+    }
+}
+
+/// Turns gltf-json's `meshes[0].primitives[1].attributes["POSITION"]` into a JSON pointer.
+fn json_pointer(path: &str) -> String {
+    let mut out = String::new();
+    for part in path.split('.') {
+        let mut rest = part;
+        if let Some(i) = rest.find('[') {
+            out.push('/');
+            out.push_str(&rest[..i]);
+            rest = &rest[i..];
+            while let Some(end) = rest.find(']') {
+                out.push('/');
+                out.push_str(rest[1..end].trim_matches('"'));
+                rest = &rest[end + 1..];
+            }
+        } else {
+            out.push('/');
+            out.push_str(rest);
+        }
+    }
+    out
+}
+
+fn validation_error(errors: &[(gltf::json::Path, gltf::json::validation::Error)]) -> ParseError {
+    let Some((path, error)) = errors.first() else {
+        return ParseError::in_file("invalid glTF");
+    };
+    let more = if errors.len() > 1 { format!(" (and {} more problems)", errors.len() - 1) } else { String::new() };
+    ParseError::at_json(json_pointer(path.as_str()), format!("invalid glTF: {error}{more}"))
+}
+
+fn check_required_extensions(root: &gltf::json::Root) -> Result<(), ParseError> {
+    for (i, name) in root.extensions_required.iter().enumerate() {
+        let accepted = ACCEPTED_REQUIRED_EXTENSIONS.contains(&name.as_str()) || name.starts_with("KHR_materials_");
+        if !accepted {
+            return Err(ParseError::at_json(
+                format!("/extensionsRequired/{i}"),
+                format!("requires extension {name}, which drafter cannot decode (decompress or convert the file first)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        // Required extensions were checked above against what we really support.
+        let is_required_extension = path.as_str().starts_with("extensionsRequired");
+        if !(is_required_extension && error == gltf::json::validation::Error::Unsupported) {
+            errors.push((path, error));
+        }
+    });
+    if errors.is_empty() { Ok(()) } else { Err(validation_error(&errors)) }
+}
+
+fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Result<Vec<Vec<u8>>, ParseError> {
+    let mut out = Vec::with_capacity(doc.buffers().len());
+    for buffer in doc.buffers() {
+        let pointer = format!("/buffers/{}", buffer.index());
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => match blob {
+                Some(bin) if buffer.index() == 0 => bin.to_vec(),
+                _ => return Err(ParseError::at_json(pointer, "buffer has no uri and there is no GLB BIN chunk")),
+            },
+            gltf::buffer::Source::Uri(uri) => load_uri(uri, folder).map_err(|m| ParseError::at_json(&pointer, m))?,
+        };
+        if data.len() < buffer.length() {
+            return Err(ParseError::at_json(
+                pointer,
+                format!("byteLength is {} but only {} bytes are available", buffer.length(), data.len()),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn load_uri(uri: &str, folder: &Path) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, payload)) = rest.split_once(";base64,") else {
+            return Err("data URI is not base64".into());
+        };
+        return base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64 in data URI: {e}"));
+    }
+    let relative = resolve_relative_uri(uri)?;
+    let full = folder.join(&relative);
+    std::fs::read(&full).map_err(|e| format!("cannot read buffer file {}: {e}", relative.display()))
+}
+
+/// Accepts only a relative reference that stays inside the glTF's folder: no scheme (other than the
+/// `data:` handled before), no absolute path or drive, no `..`.
+fn resolve_relative_uri(uri: &str) -> Result<PathBuf, String> {
+    let decoded = percent_decode(uri).ok_or_else(|| format!("URI {uri:?} has a bad percent escape"))?;
+    if let Some(colon) = decoded.find(':') {
+        let before = &decoded[..colon];
+        if !before.contains('/') {
+            return Err(format!("URI {uri:?} has a scheme; only relative paths and data: URIs are allowed"));
+        }
+    }
+    if decoded.starts_with('/') || decoded.starts_with('\\') {
+        return Err(format!("URI {uri:?} is an absolute path; only paths inside the file's folder are allowed"));
+    }
+    let normalised = decoded.replace('\\', "/");
+    let path = PathBuf::from(&normalised);
+    for component in path.components() {
+        match component {
+            Component::Normal(_) | Component::CurDir => {}
+            _ => return Err(format!("URI {uri:?} leaves the file's folder; only paths inside it are allowed")),
+        }
+    }
+    Ok(path)
+}
+
+fn percent_decode(s: &str) -> Option<String> {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Reads accessor `accessor` as `N`-component float vectors, de-quantising integer types
+/// (normalised or not, KHR_mesh_quantization) and applying sparse substitution.
+fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<[f32; N]>, ParseError> {
+    let pointer = format!("/accessors/{}", accessor.index());
+    let expected = match N {
+        1 => Dimensions::Scalar,
+        2 => Dimensions::Vec2,
+        3 => Dimensions::Vec3,
+        _ => Dimensions::Vec4,
+    };
+    if accessor.dimensions() != expected {
+        return Err(ParseError::at_json(pointer, format!("expected type {expected:?}, found {:?}", accessor.dimensions())));
+    }
+    let count = accessor.count();
+    let component = accessor.data_type().size();
+    let element = component * N;
+    let normalized = accessor.normalized();
+    let data_type = accessor.data_type();
+    let mut out = match accessor.view() {
+        Some(view) => {
+            let bytes = view_bytes(&view, buffers)?;
+            let stride = view.stride().unwrap_or(element).max(element);
+            let start = accessor.offset();
+            let needed = if count == 0 { Some(0) } else { (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(element)) };
+            match needed {
+                Some(n) if n <= bytes.len() => {}
+                _ => {
+                    return Err(ParseError::at_json(
+                        pointer,
+                        format!(
+                            "{count} elements of {element} bytes (stride {stride}, offset {start}) do not fit in bufferView {} of {} bytes",
+                            view.index(),
+                            bytes.len()
+                        ),
+                    ));
+                }
+            }
+            let mut values = Vec::with_capacity(count);
+            for i in 0..count {
+                let at = start + i * stride;
+                let mut v = [0.0f32; N];
+                for (c, slot) in v.iter_mut().enumerate() {
+                    *slot = decode_component(&bytes[at + c * component..], data_type, normalized);
+                }
+                values.push(v);
+            }
+            values
+        }
+        None => {
+            // No buffer view: zeros (then sparse). Guard the size: a count with no data behind it
+            // must still be bounded by something real, so require sparse data to exist.
+            if accessor.sparse().is_none() {
+                return Err(ParseError::at_json(pointer, "accessor has neither bufferView nor sparse data"));
+            }
+            if count > 1 << 26 {
+                return Err(ParseError::at_json(pointer, format!("sparse accessor count {count} is implausibly large")));
+            }
+            vec![[0.0f32; N]; count]
+        }
+    };
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        let indices_view = sparse.indices().view();
+        let index_bytes = view_bytes(&indices_view, buffers)?;
+        let index_type = sparse.indices().index_type();
+        let index_size = match index_type {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        let index_start = sparse.indices().offset();
+        let values_view = sparse.values().view();
+        let value_bytes = view_bytes(&values_view, buffers)?;
+        let value_start = sparse.values().offset();
+        let fits = |start: usize, size: usize, len: usize| n.checked_mul(size).and_then(|x| x.checked_add(start)).is_some_and(|end| end <= len);
+        if !fits(index_start, index_size, index_bytes.len()) || !fits(value_start, element, value_bytes.len()) {
+            return Err(ParseError::at_json(format!("{pointer}/sparse"), format!("{n} sparse entries do not fit in their buffer views")));
+        }
+        for k in 0..n {
+            let at = index_start + k * index_size;
+            let target = match index_size {
+                1 => index_bytes[at] as usize,
+                2 => u16::from_le_bytes([index_bytes[at], index_bytes[at + 1]]) as usize,
+                _ => u32::from_le_bytes([index_bytes[at], index_bytes[at + 1], index_bytes[at + 2], index_bytes[at + 3]]) as usize,
+            };
+            let Some(slot) = out.get_mut(target) else {
+                return Err(ParseError::at_json(format!("{pointer}/sparse"), format!("sparse index {target} is out of range ({count} elements)")));
+            };
+            let at = value_start + k * element;
+            for (c, value) in slot.iter_mut().enumerate() {
+                *value = decode_component(&value_bytes[at + c * component..], data_type, normalized);
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], ParseError> {
+    let buffer = &buffers[view.buffer().index()];
+    let declared = view.buffer().length().min(buffer.len());
+    let start = view.offset();
+    match start.checked_add(view.length()) {
+        Some(end) if end <= declared => Ok(&buffer[start..end]),
+        _ => Err(ParseError::at_json(
+            format!("/bufferViews/{}", view.index()),
+            format!("bytes {start}..{} lie outside buffer {} of {declared} bytes", start.saturating_add(view.length()), view.buffer().index()),
+        )),
+    }
+}
+
+/// Decodes one component at the start of `b` (the caller guarantees the bytes exist). Normalised
+/// integers follow the glTF spec's `max(c / MAX, -1)` rule.
+#[inline]
+fn decode_component(b: &[u8], data_type: DataType, normalized: bool) -> f32 {
+    match data_type {
+        DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        DataType::I8 => {
+            let v = b[0] as i8 as f32;
+            if normalized { (v / 127.0).max(-1.0) } else { v }
+        }
+        DataType::U8 => {
+            let v = b[0] as f32;
+            if normalized { v / 255.0 } else { v }
+        }
+        DataType::I16 => {
+            let v = i16::from_le_bytes([b[0], b[1]]) as f32;
+            if normalized { (v / 32767.0).max(-1.0) } else { v }
+        }
+        DataType::U16 => {
+            let v = u16::from_le_bytes([b[0], b[1]]) as f32;
+            if normalized { v / 65535.0 } else { v }
+        }
+        DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    }
+}
+
+fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: usize) -> Result<Vec<u32>, ParseError> {
+    let pointer = format!("/accessors/{}", accessor.index());
+    if accessor.dimensions() != Dimensions::Scalar {
+        return Err(ParseError::at_json(pointer, "index accessor is not SCALAR"));
+    }
+    let size = match accessor.data_type() {
+        DataType::U8 => 1,
+        DataType::U16 => 2,
+        DataType::U32 => 4,
+        other => return Err(ParseError::at_json(pointer, format!("index component type {other:?} is not unsigned"))),
+    };
+    if accessor.sparse().is_some() || accessor.view().is_none() {
+        // Sparse or view-less indices are legal but meaningless for geometry; read generically.
+        let values = read_vectors::<1>(accessor, buffers)?;
+        return values.into_iter().enumerate().map(|(i, [v])| check_index(v as u32, i, vertex_count, &pointer)).collect();
+    }
+    let Some(view) = accessor.view() else { return Ok(Vec::new()) };
+    let bytes = view_bytes(&view, buffers)?;
+    let count = accessor.count();
+    let stride = view.stride().unwrap_or(size).max(size);
+    let start = accessor.offset();
+    let needed = if count == 0 { Some(0) } else { (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(size)) };
+    if !needed.is_some_and(|n| n <= bytes.len()) {
+        return Err(ParseError::at_json(
+            pointer,
+            format!("{count} indices (offset {start}) do not fit in bufferView {} of {} bytes", view.index(), bytes.len()),
+        ));
+    }
+    let mut out = Vec::with_capacity(count);
+    for i in 0..count {
+        let at = start + i * stride;
+        let v = match size {
+            1 => bytes[at] as u32,
+            2 => u16::from_le_bytes([bytes[at], bytes[at + 1]]) as u32,
+            _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
+        };
+        out.push(check_index(v, i, vertex_count, &pointer)?);
+    }
+    Ok(out)
+}
+
+fn check_index(v: u32, i: usize, vertex_count: usize, pointer: &str) -> Result<u32, ParseError> {
+    if (v as usize) < vertex_count {
+        Ok(v)
+    } else {
+        Err(ParseError::at_json(pointer, format!("index {v} at element {i} is out of range ({vertex_count} vertices)")))
+    }
+}
+
+/// Triangles of a primitive in list form (glTF 2.0 spec §3.7.2.1 for strips and fans).
+fn assemble_triangles(mode: Mode, indices: &[u32]) -> (Vec<[u32; 3]>, usize) {
+    let n = indices.len();
+    match mode {
+        Mode::Triangles => {
+            let tris = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            (tris, n % 3)
+        }
+        Mode::TriangleStrip => {
+            let tris = (0..n.saturating_sub(2))
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [indices[i], indices[i + 1], indices[i + 2]]
+                    } else {
+                        [indices[i + 1], indices[i], indices[i + 2]]
+                    }
+                })
+                .collect();
+            (tris, 0)
+        }
+        Mode::TriangleFan => {
+            let tris = (1..n.saturating_sub(1)).map(|i| [indices[i], indices[i + 1], indices[0]]).collect();
+            (tris, 0)
+        }
+        _ => (Vec::new(), 0),
+    }
+}
+
+fn build_scene(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    format: SourceFormat,
+    diagnostics: &mut Diagnostics,
+) -> Result<Scene, ParseError> {
+    let mut scene = Scene::new(format);
+    scene.materials = doc
+        .materials()
+        .map(|m| {
+            let pbr = m.pbr_metallic_roughness();
+            Material {
+                name: m.name().unwrap_or_default().to_owned(),
+                base_color: pbr.base_color_factor(),
+                metallic: pbr.metallic_factor(),
+                roughness: pbr.roughness_factor(),
+            }
+        })
+        .collect();
+    for mesh in doc.meshes() {
+        scene.meshes.push(import_mesh(&mesh, buffers, diagnostics)?);
+    }
+    if doc.skins().len() > 0 || doc.animations().len() > 0 {
+        diagnostics.push(DiagnosticKind::Ignored, doc.skins().len() + doc.animations().len(), || {
+            "skins and animations are ignored; meshes are taken in their bind/rest pose".into()
+        });
+    }
+
+    // Nodes, with parents derived from the children lists (first parent wins).
+    let node_count = doc.nodes().len();
+    scene.nodes = doc
+        .nodes()
+        .map(|n| Node {
+            name: n.name().unwrap_or_default().to_owned(),
+            parent: None,
+            children: n.children().map(|c| NodeId::from(c.index())).collect(),
+            parent_from_local: local_transform(&n),
+            mesh: n.mesh().map(|m| MeshId::from(m.index())),
+        })
+        .collect();
+    for i in 0..node_count {
+        for c in scene.nodes[i].children.clone() {
+            if scene.nodes[c.index()].parent.is_none() && c.index() != i {
+                scene.nodes[c.index()].parent = Some(NodeId::from(i));
+            }
+        }
+    }
+    let roots: Vec<NodeId> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().map(|n| NodeId::from(n.index())).collect(),
+        None => {
+            diagnostics.push(DiagnosticKind::Other, 1, || "no scene: every parentless node is taken as a root".into());
+            (0..node_count).filter(|&i| scene.nodes[i].parent.is_none()).map(NodeId::from).collect()
+        }
+    };
+    scene.roots = roots.clone();
+
+    // Depth-first walk; a node reached twice (cycle or shared child) is reported and skipped.
+    let mut visited = vec![false; node_count];
+    let mut stack: Vec<(NodeId, DMat4)> = roots.iter().rev().map(|&r| (r, DMat4::IDENTITY)).collect();
+    while let Some((id, parent_world)) = stack.pop() {
+        if std::mem::replace(&mut visited[id.index()], true) {
+            diagnostics.push(DiagnosticKind::NodeCycle, 1, || format!("node {id} is reached more than once; repeat skipped"));
+            continue;
+        }
+        let node = &scene.nodes[id.index()];
+        let world = parent_world * node.parent_from_local;
+        if !world.is_finite() {
+            diagnostics.push(DiagnosticKind::BadTransform, 1, || format!("node {id} has a non-finite transform; subtree skipped"));
+            continue;
+        }
+        if let Some(mesh) = node.mesh {
+            let name = if node.name.is_empty() {
+                let mesh_name = &scene.meshes[mesh.index()].name;
+                if mesh_name.is_empty() { format!("node {id}") } else { mesh_name.clone() }
+            } else {
+                node.name.clone()
+            };
+            scene.instances.push(Instance { name, mesh, node: Some(id), world_from_object: world });
+        }
+        for &child in node.children.iter().rev() {
+            stack.push((child, world));
+        }
+    }
+    Ok(scene)
+}
+
+fn local_transform(node: &gltf::Node) -> DMat4 {
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))),
+        gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+            let rotation = DQuat::from_array(rotation.map(f64::from));
+            let rotation = if rotation.length_squared() > 0.0 { rotation.normalize() } else { DQuat::IDENTITY };
+            DMat4::from_scale_rotation_translation(
+                DVec3::from_array(scale.map(f64::from)),
+                rotation,
+                DVec3::from_array(translation.map(f64::from)),
+            )
+        }
+    }
+}
+
+fn import_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], diagnostics: &mut Diagnostics) -> Result<Mesh, ParseError> {
+    let mut out = Mesh { name: mesh.name().unwrap_or_default().to_owned(), ..Mesh::default() };
+    let mut normals: Vec<Vec3> = Vec::new();
+    let mut uvs: Vec<Vec2> = Vec::new();
+    let mut all_have_normals = true;
+    let mut all_have_uvs = true;
+    for primitive in mesh.primitives() {
+        let place = || format!("/meshes/{}/primitives/{}", mesh.index(), primitive.index());
+        let mode = primitive.mode();
+        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            diagnostics.push(DiagnosticKind::SkippedPrimitive, 1, || format!("{}: mode {mode:?} is not triangles; skipped", place()));
+            continue;
+        }
+        let Some(position_accessor) = primitive.get(&gltf::Semantic::Positions) else {
+            diagnostics.push(DiagnosticKind::SkippedPrimitive, 1, || format!("{}: no POSITION; skipped", place()));
+            continue;
+        };
+        let positions = read_vectors::<3>(&position_accessor, buffers)?;
+        let vertex_count = positions.len();
+        let indices = match primitive.indices() {
+            Some(a) => read_indices(&a, buffers, vertex_count)?,
+            None => (0..vertex_count as u32).collect(),
+        };
+        let (triangles, leftover) = assemble_triangles(mode, &indices);
+        diagnostics.push(DiagnosticKind::IncompleteTriangle, leftover.min(1), || {
+            format!("{}: index count {} is not a multiple of 3; the rest was dropped", place(), indices.len())
+        });
+        let base = out.positions.len() as u32;
+        let start = out.triangles.len() as u32;
+        let mut part_normals = None;
+        if let Some(a) = primitive.get(&gltf::Semantic::Normals) {
+            match read_vectors::<3>(&a, buffers) {
+                Ok(n) if n.len() == vertex_count => part_normals = Some(n),
+                Ok(_) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("{}: NORMAL count differs from POSITION; ignored", place())),
+                Err(e) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("{}: NORMAL unreadable ({e}); ignored", place())),
+            }
+        }
+        let mut part_uvs = None;
+        if let Some(a) = primitive.get(&gltf::Semantic::TexCoords(0)) {
+            match read_vectors::<2>(&a, buffers) {
+                Ok(t) if t.len() == vertex_count => part_uvs = Some(t),
+                _ => diagnostics.push(DiagnosticKind::InvalidTexcoords, 1, || format!("{}: TEXCOORD_0 unusable; ignored", place())),
+            }
+        }
+        all_have_normals &= part_normals.is_some();
+        all_have_uvs &= part_uvs.is_some();
+        if all_have_normals {
+            normals.extend(part_normals.unwrap_or_default().into_iter().map(Vec3::from));
+        }
+        if all_have_uvs {
+            uvs.extend(part_uvs.unwrap_or_default().into_iter().map(Vec2::from));
+        }
+        out.positions.extend(positions.into_iter().map(Vec3::from));
+        out.triangles.extend(triangles.into_iter().map(|t| t.map(|v| v + base)));
+        out.groups.push(TriangleGroup {
+            start,
+            count: out.triangles.len() as u32 - start,
+            material: primitive.material().index().map(MaterialId::from),
+        });
+    }
+    drop_nonfinite_faces(&mut out.positions, &mut out.triangles, &mut out.groups, diagnostics, &format!("mesh {}", mesh.index()));
+    if all_have_normals && !out.positions.is_empty() {
+        if normals.iter().all(|n| n.is_finite()) {
+            out.normals = Some(normals);
+        } else {
+            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("mesh {}: NORMAL has non-finite values; ignored", mesh.index()));
+        }
+    }
+    if all_have_uvs && !out.positions.is_empty() && uvs.iter().all(|t| t.is_finite()) {
+        out.uvs = Some(uvs);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uris_stay_inside_the_folder() {
+        assert_eq!(resolve_relative_uri("a%20b.bin").unwrap(), PathBuf::from("a b.bin"));
+        assert_eq!(resolve_relative_uri("sub/x.bin").unwrap(), PathBuf::from("sub/x.bin"));
+        for bad in ["../x.bin", "sub/../../x.bin", "/etc/passwd", "\\\\server\\x", "file:///etc/passwd", "http://h/x.bin", "C:/x.bin", "%2e%2e/x.bin"] {
+            assert!(resolve_relative_uri(bad).is_err(), "{bad} accepted");
+        }
+    }
+
+    #[test]
+    fn json_pointers() {
+        assert_eq!(json_pointer("meshes[0].primitives[1].attributes[\"POSITION\"]"), "/meshes/0/primitives/1/attributes/POSITION");
+        assert_eq!(json_pointer("asset"), "/asset");
+    }
+
+    #[test]
+    fn strips_and_fans_follow_the_spec() {
+        let (strip, _) = assemble_triangles(Mode::TriangleStrip, &[0, 1, 2, 3, 4]);
+        assert_eq!(strip, vec![[0, 1, 2], [2, 1, 3], [2, 3, 4]]);
+        let (fan, _) = assemble_triangles(Mode::TriangleFan, &[0, 1, 2, 3]);
+        assert_eq!(fan, vec![[1, 2, 0], [2, 3, 0]]);
+        let (list, leftover) = assemble_triangles(Mode::Triangles, &[0, 1, 2, 3]);
+        assert_eq!((list.len(), leftover), (1, 1));
+    }
+
+    #[test]
+    fn normalised_components_decode_per_spec() {
+        assert_eq!(decode_component(&[0x80], DataType::I8, true), -1.0);
+        assert_eq!(decode_component(&[0x7f], DataType::I8, true), 1.0);
+        assert_eq!(decode_component(&[0xff, 0xff], DataType::U16, true), 1.0);
+        assert_eq!(decode_component(&[0x10, 0x00], DataType::I16, false), 16.0);
+    }
 }

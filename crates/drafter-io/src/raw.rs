@@ -28,21 +28,10 @@ pub(crate) fn single_mesh_scene(
 ) -> Result<Scene, ParseError> {
     let mut mesh = Mesh { name: name.to_owned(), ..Mesh::default() };
     mesh.positions = raw.positions.iter().map(|&p| Vec3::from(p)).collect();
-    let finite: Vec<bool> = mesh.positions.iter().map(|p| p.is_finite()).collect();
-    let bad_vertices = finite.iter().filter(|&&f| !f).count();
-    if let Some(first) = finite.iter().position(|&f| !f) {
-        diagnostics.push(DiagnosticKind::NonFinitePosition, bad_vertices, || format!("vertex {first} is NaN or infinite"));
-        // Keep the array dense; the bad vertices are unreferenced after the faces go.
-        for (p, &ok) in mesh.positions.iter_mut().zip(&finite) {
-            if !ok {
-                *p = Vec3::ZERO;
-            }
-        }
-    }
     let total = raw.triangles.len();
-    mesh.triangles = raw.triangles.into_iter().filter(|t| t.iter().all(|&v| finite[v as usize])).collect();
-    let dropped = total - mesh.triangles.len();
-    diagnostics.push(DiagnosticKind::DroppedFace, dropped, || format!("{dropped} faces used non-finite vertices"));
+    mesh.triangles = raw.triangles;
+    mesh.groups = vec![TriangleGroup { start: 0, count: total as u32, material: None }];
+    drop_nonfinite_faces(&mut mesh.positions, &mut mesh.triangles, &mut mesh.groups, diagnostics, name);
     if let Some(normals) = raw.normals {
         if normals.len() == mesh.positions.len() && normals.iter().all(|n| n.iter().all(|c| c.is_finite())) {
             mesh.normals = Some(normals.into_iter().map(Vec3::from).collect());
@@ -57,7 +46,6 @@ pub(crate) fn single_mesh_scene(
             "no triangle with finite vertex positions".to_owned()
         }));
     }
-    mesh.groups = vec![TriangleGroup { start: 0, count: mesh.triangles.len() as u32, material: None }];
     let mut scene = Scene::new(format);
     scene.meshes.push(mesh);
     scene.instances.push(drafter_core::Instance {
@@ -67,4 +55,41 @@ pub(crate) fn single_mesh_scene(
         world_from_object: DMat4::IDENTITY,
     });
     Ok(scene)
+}
+
+/// Drops triangles that use a non-finite position (NaN or infinite), keeping `groups` consistent,
+/// and zeroes those positions so the array stays dense and finite. Reports both with diagnostics.
+pub(crate) fn drop_nonfinite_faces(
+    positions: &mut [Vec3],
+    triangles: &mut Vec<[u32; 3]>,
+    groups: &mut [TriangleGroup],
+    diagnostics: &mut Diagnostics,
+    context: &str,
+) {
+    let finite: Vec<bool> = positions.iter().map(|p| p.is_finite()).collect();
+    let Some(first) = finite.iter().position(|&f| !f) else { return };
+    let bad_vertices = finite.iter().filter(|&&f| !f).count();
+    diagnostics.push(DiagnosticKind::NonFinitePosition, bad_vertices, || {
+        format!("{context}: vertex {first} is NaN or infinite")
+    });
+    for (p, &ok) in positions.iter_mut().zip(&finite) {
+        if !ok {
+            *p = Vec3::ZERO;
+        }
+    }
+    let keep = |t: &[u32; 3]| t.iter().all(|&v| finite[v as usize]);
+    let mut kept = Vec::with_capacity(triangles.len());
+    if groups.is_empty() {
+        kept.extend(triangles.iter().copied().filter(keep));
+    }
+    for group in groups.iter_mut() {
+        let range = group.start as usize..(group.start + group.count) as usize;
+        let start = kept.len() as u32;
+        kept.extend(triangles[range].iter().copied().filter(keep));
+        group.start = start;
+        group.count = kept.len() as u32 - start;
+    }
+    let dropped = triangles.len() - kept.len();
+    *triangles = kept;
+    diagnostics.push(DiagnosticKind::DroppedFace, dropped, || format!("{context}: {dropped} faces used non-finite vertices"));
 }

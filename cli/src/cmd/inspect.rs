@@ -1,0 +1,252 @@
+//! `drafter inspect FILE [--json]`: format, parts, totals, world bounds and welded topology.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use drafter_core::{Diagnostic, MeshId, Scene, Topology, Weld};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::exit::BadInput;
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum WeldMode {
+    Snap,
+    Exact,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The file to inspect (glTF, GLB, OBJ, STL, OFF, PLY).
+    pub file: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// How positions are welded before topology is counted: `snap` (identical up to float noise,
+    /// 1e-9 of the bounding diagonal; the default) or `exact` (bit-identical).
+    #[arg(long, value_enum, default_value_t = WeldMode::Snap)]
+    pub weld: WeldMode,
+    /// Weld positions closer than this fraction of each mesh's bounding diagonal instead.
+    #[arg(long, value_name = "FRACTION")]
+    pub weld_tolerance: Option<f64>,
+    /// Treat any input diagnostic as bad input (exit code 2).
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// The report, also the `--json` schema. Topology is computed per unique mesh after welding and
+/// summed; boundary and non-manifold edges follow the incidence convention of
+/// [`Topology::incidence_edge_counts`], edges and components the welded topology.
+#[derive(Debug, Serialize)]
+pub struct Report {
+    pub file: String,
+    pub format: &'static str,
+    /// Triangles drawn in the world (every instance counted).
+    pub triangles: usize,
+    /// Vertices over all instances.
+    pub vertices: usize,
+    /// Unique meshes used by the scene.
+    pub meshes: usize,
+    /// Mesh instances (parts as the file gives them).
+    pub instances: usize,
+    pub unique_triangles: usize,
+    pub bounds: Bounds,
+    pub topology: TopologyStats,
+    pub parts: Vec<PartRow>,
+    pub mesh_topology: Vec<MeshRow>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Bounds {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    pub size: [f64; 3],
+}
+
+#[derive(Debug, Default, Serialize, Clone, Copy)]
+pub struct TopologyStats {
+    pub welded_vertices: usize,
+    pub edges: usize,
+    pub boundary_edges: usize,
+    pub nonmanifold_edges: usize,
+    pub components: usize,
+    pub degenerate_triangles: usize,
+}
+
+impl std::ops::AddAssign for TopologyStats {
+    fn add_assign(&mut self, o: Self) {
+        self.welded_vertices += o.welded_vertices;
+        self.edges += o.edges;
+        self.boundary_edges += o.boundary_edges;
+        self.nonmanifold_edges += o.nonmanifold_edges;
+        self.components += o.components;
+        self.degenerate_triangles += o.degenerate_triangles;
+    }
+}
+
+#[derive(Debug, Serialize)]
+pub struct PartRow {
+    pub name: String,
+    pub mesh: MeshId,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub mirrored: bool,
+}
+
+#[derive(Debug, Serialize)]
+pub struct MeshRow {
+    pub mesh: MeshId,
+    pub name: String,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub instances: usize,
+    #[serde(flatten)]
+    pub topology: TopologyStats,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let imported = drafter_io::import(&args.file)?;
+    let weld = match (args.weld_tolerance, args.weld) {
+        (Some(fraction), _) => Weld::Relative(fraction),
+        (None, WeldMode::Snap) => Weld::default(),
+        (None, WeldMode::Exact) => Weld::Exact,
+    };
+    let report = build_report(&args.file.display().to_string(), &imported.scene, imported.diagnostics, weld);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_text(&report);
+    }
+    if args.strict && !report.diagnostics.is_empty() {
+        return Err(BadInput(format!(
+            "{}: {} kinds of input problems (--strict); first: {}",
+            report.file,
+            report.diagnostics.len(),
+            report.diagnostics[0]
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+pub fn build_report(file: &str, scene: &Scene, diagnostics: Vec<Diagnostic>, weld: Weld) -> Report {
+    let mut uses = vec![0usize; scene.meshes.len()];
+    for inst in &scene.instances {
+        uses[inst.mesh.index()] += 1;
+    }
+    let used: Vec<usize> = (0..scene.meshes.len()).filter(|&m| uses[m] > 0).collect();
+    let mesh_topology: Vec<MeshRow> = used
+        .par_iter()
+        .map(|&m| {
+            let mesh = &scene.meshes[m];
+            let topo = Topology::build(mesh, weld);
+            // Incidence convention (collapsed faces count), as trimesh and MeshLab report.
+            let (boundary_edges, nonmanifold_edges) = topo.incidence_edge_counts();
+            MeshRow {
+                mesh: MeshId::from(m),
+                name: mesh.name.clone(),
+                vertices: mesh.vertex_count(),
+                triangles: mesh.triangle_count(),
+                instances: uses[m],
+                topology: TopologyStats {
+                    welded_vertices: topo.referenced_vertex_count(),
+                    edges: topo.edge_count(),
+                    boundary_edges,
+                    nonmanifold_edges,
+                    components: topo.component_count,
+                    degenerate_triangles: topo.degenerate_triangle_count(),
+                },
+            }
+        })
+        .collect();
+    let mut topology = TopologyStats::default();
+    for row in &mesh_topology {
+        topology += row.topology;
+    }
+    let b = scene.world_bounds();
+    let (min, max) = if b.is_empty() { ([0.0; 3], [0.0; 3]) } else { (b.min.to_array(), b.max.to_array()) };
+    Report {
+        file: file.to_owned(),
+        format: scene.format.name(),
+        triangles: scene.instanced_triangle_count(),
+        vertices: scene.instanced_vertex_count(),
+        meshes: used.len(),
+        instances: scene.instances.len(),
+        unique_triangles: used.iter().map(|&m| scene.meshes[m].triangle_count()).sum(),
+        bounds: Bounds { min, max, size: [max[0] - min[0], max[1] - min[1], max[2] - min[2]] },
+        topology,
+        parts: scene
+            .instances
+            .iter()
+            .map(|i| PartRow {
+                name: i.name.clone(),
+                mesh: i.mesh,
+                vertices: scene.mesh(i.mesh).vertex_count(),
+                triangles: scene.mesh(i.mesh).triangle_count(),
+                mirrored: i.flips_winding(),
+            })
+            .collect(),
+        mesh_topology,
+        diagnostics,
+    }
+}
+
+/// Rows of the part and mesh tables printed before "... N more".
+const TABLE_ROWS: usize = 40;
+
+fn print_text(r: &Report) {
+    println!("{} ({})", r.file, r.format);
+    println!(
+        "  {} instances of {} meshes: {} triangles in the world ({} unique), {} vertices",
+        r.instances, r.meshes, r.triangles, r.unique_triangles, r.vertices
+    );
+    let f = |v: [f64; 3]| format!("({:.6}, {:.6}, {:.6})", v[0], v[1], v[2]);
+    println!("  world bounds {} .. {}  size {}", f(r.bounds.min), f(r.bounds.max), f(r.bounds.size));
+    let t = &r.topology;
+    println!(
+        "  topology (welded, per unique mesh, summed): {} welded vertices, {} edges, {} boundary, {} non-manifold, {} components, {} degenerate triangles",
+        t.welded_vertices, t.edges, t.boundary_edges, t.nonmanifold_edges, t.components, t.degenerate_triangles
+    );
+    println!("\n  {:<40} {:>6} {:>10} {:>10}", "part", "mesh", "vertices", "triangles");
+    for p in r.parts.iter().take(TABLE_ROWS) {
+        let mirrored = if p.mirrored { " (mirrored)" } else { "" };
+        println!("  {:<40} {:>6} {:>10} {:>10}{mirrored}", truncate(&p.name, 40), p.mesh.0, p.vertices, p.triangles);
+    }
+    if r.parts.len() > TABLE_ROWS {
+        println!("  ... {} more parts (--json lists all)", r.parts.len() - TABLE_ROWS);
+    }
+    println!(
+        "\n  {:<6} {:<28} {:>5} {:>9} {:>9} {:>8} {:>8} {:>6} {:>5} {:>5}",
+        "mesh", "name", "uses", "triangles", "welded v", "edges", "boundary", "nonman", "comp", "degen"
+    );
+    for m in r.mesh_topology.iter().take(TABLE_ROWS) {
+        let t = &m.topology;
+        println!(
+            "  {:<6} {:<28} {:>5} {:>9} {:>9} {:>8} {:>8} {:>6} {:>5} {:>5}",
+            m.mesh.0,
+            truncate(&m.name, 28),
+            m.instances,
+            m.triangles,
+            t.welded_vertices,
+            t.edges,
+            t.boundary_edges,
+            t.nonmanifold_edges,
+            t.components,
+            t.degenerate_triangles
+        );
+    }
+    if r.mesh_topology.len() > TABLE_ROWS {
+        println!("  ... {} more meshes (--json lists all)", r.mesh_topology.len() - TABLE_ROWS);
+    }
+    if !r.diagnostics.is_empty() {
+        println!("\n  input problems recovered from:");
+        for d in &r.diagnostics {
+            println!("    {d}");
+        }
+    }
+}
+
+fn truncate(s: &str, n: usize) -> String {
+    if s.chars().count() <= n { s.to_owned() } else { s.chars().take(n - 1).chain(['…']).collect() }
+}

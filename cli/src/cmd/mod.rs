@@ -1,0 +1,3 @@
+//! One module per subcommand, each with `Args` (clap derive) and `run(Args) -> anyhow::Result<()>`.
+
+pub mod inspect;

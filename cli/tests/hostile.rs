@@ -1,0 +1,254 @@
+//! Hostile inputs: each must exit 2 with one line on stderr that names the file and the problem,
+//! without a panic, with peak memory (the child's max RSS, from wait4) under 100 MB.
+#![allow(unsafe_code)] // wait4 is the only way to read one child's peak RSS.
+
+mod common;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+
+use base64::Engine as _;
+
+const PEAK_LIMIT_KB: i64 = 100 * 1024;
+
+struct Outcome {
+    code: i32,
+    stderr: String,
+    stdout: String,
+    peak_kb: i64,
+}
+
+fn inspect(file: &Path, extra: &[&str]) -> Outcome {
+    let mut child = common::drafter()
+        .arg("inspect")
+        .args(extra)
+        .arg(file)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn drafter");
+    let mut stdout = String::new();
+    let mut stderr = String::new();
+    let mut out_pipe = child.stdout.take().expect("stdout");
+    let mut err_pipe = child.stderr.take().expect("stderr");
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        out_pipe.read_to_string(&mut s).expect("read stdout");
+        s
+    });
+    err_pipe.read_to_string(&mut stderr).expect("read stderr");
+    stdout.push_str(&reader.join().expect("stdout thread"));
+    let mut status = 0;
+    // SAFETY: plain FFI call on our own child's pid with valid out-pointers.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let pid = child.id() as libc::pid_t;
+    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(waited, pid, "wait4 failed");
+    let code = if libc::WIFEXITED(status) { libc::WEXITSTATUS(status) } else { -libc::WTERMSIG(status) };
+    Outcome { code, stderr, stdout, peak_kb: usage.ru_maxrss }
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).expect("write input");
+    p
+}
+
+/// Runs `drafter inspect` on `file` and checks the contract for bad input; `needle` must appear in
+/// the message.
+#[track_caller]
+fn assert_rejected(file: &Path, needle: &str) {
+    let o = inspect(file, &[]);
+    let name = file.file_name().expect("name").to_string_lossy().into_owned();
+    assert_eq!(o.code, 2, "{name}: exit {} (stderr: {})", o.code, o.stderr);
+    let lines: Vec<&str> = o.stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{name}: stderr must be one line: {:?}", o.stderr);
+    assert!(lines[0].contains(&name), "{name}: message does not name the file: {}", lines[0]);
+    assert!(lines[0].to_lowercase().contains(&needle.to_lowercase()), "{name}: message lacks {needle:?}: {}", lines[0]);
+    assert!(o.peak_kb < PEAK_LIMIT_KB, "{name}: peak RSS {} KB", o.peak_kb);
+    assert!(o.stdout.is_empty(), "{name}: wrote to stdout on failure");
+}
+
+/// A valid one-triangle glTF with an embedded buffer; `edit` mutates its JSON before writing.
+fn gltf_triangle(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let mut bin = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 0] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let mut json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": bin.len(), "uri": uri}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 6}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}
+        ]
+    });
+    edit(&mut json);
+    serde_json::to_vec_pretty(&json).expect("json")
+}
+
+fn binary_stl(claimed: u32, facets: usize, first_vertex: [f32; 3]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b[..5].copy_from_slice(b"solid");
+    b.extend_from_slice(&claimed.to_le_bytes());
+    for _ in 0..facets {
+        b.extend_from_slice(&[0u8; 12]);
+        for v in [first_vertex, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in v {
+                b.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        b.extend_from_slice(&[0, 0]);
+    }
+    b
+}
+
+#[test]
+fn the_valid_baselines_import() {
+    let dir = common::scratch("hostile-baseline");
+    for (name, bytes) in [
+        ("ok.gltf", gltf_triangle(|_| {})),
+        ("ok.stl", binary_stl(2, 2, [0.0; 3])),
+        ("ok.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec()),
+    ] {
+        let o = inspect(&write(&dir, name, &bytes), &[]);
+        assert_eq!(o.code, 0, "{name}: {}", o.stderr);
+    }
+}
+
+#[test]
+fn empty_files() {
+    let dir = common::scratch("hostile-empty");
+    for name in ["empty.gltf", "empty.glb", "empty.obj", "empty.stl", "empty.off", "empty.ply", "empty"] {
+        assert_rejected(&write(&dir, name, b""), "empty");
+    }
+}
+
+#[test]
+fn unknown_format_lists_the_supported_ones() {
+    let dir = common::scratch("hostile-unknown");
+    assert_rejected(&write(&dir, "model.xyz", b"\x00\x01garbage"), "supported: glTF");
+}
+
+#[test]
+fn truncated_files() {
+    let dir = common::scratch("hostile-truncated");
+    let gltf = gltf_triangle(|_| {});
+    assert_rejected(&write(&dir, "cut.gltf", &gltf[..gltf.len() / 2]), "line");
+    // A GLB whose header claims more bytes than the file has.
+    let mut glb = b"glTF".to_vec();
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&1_000_000u32.to_le_bytes());
+    glb.extend_from_slice(&[0u8; 20]);
+    assert_rejected(&write(&dir, "cut.glb", &glb), "GLB");
+    assert_rejected(&write(&dir, "cut.off", b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n"), "line");
+    assert_rejected(&write(&dir, "cut.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"), "line");
+    assert_rejected(&write(&dir, "cut.stl", b"solid cut\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"), "line");
+}
+
+#[test]
+fn headers_claiming_more_than_the_file_holds() {
+    let dir = common::scratch("hostile-claims");
+    // Binary STL: header says 4 billion triangles, 2 present. Must not allocate 200 GB.
+    let mut stl = binary_stl(u32::MAX, 2, [0.0; 3]);
+    stl[..5].copy_from_slice(b"\x00\x00\x00\x00\x00");
+    assert_rejected(&write(&dir, "liar.stl", &stl), "triangles");
+    assert_rejected(&write(&dir, "liar.off", b"OFF\n4000000000 4000000000 0\n0 0 0\n"), "line");
+    assert_rejected(
+        &write(&dir, "liar.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x00\x00\x00\x00"),
+        "byte",
+    );
+    assert_rejected(
+        &write(&dir, "liar.gltf", &gltf_triangle(|j| j["accessors"][0]["count"] = 1_000_000_000.into())),
+        "/accessors/0",
+    );
+    assert_rejected(
+        &write(&dir, "liar-buffer.gltf", &gltf_triangle(|j| j["buffers"][0]["byteLength"] = 1_000_000.into())),
+        "/buffers/0",
+    );
+    assert_rejected(
+        &write(&dir, "liar-view.gltf", &gltf_triangle(|j| j["bufferViews"][0]["byteOffset"] = 4_000_000_000u64.into())),
+        "/bufferViews/0",
+    );
+}
+
+#[test]
+fn out_of_range_indices() {
+    let dir = common::scratch("hostile-indices");
+    let mut bad_index = gltf_triangle(|_| {});
+    // Rewrite the index buffer (inside the data URI) so it points at vertex 7.
+    let text = String::from_utf8(bad_index.clone()).expect("utf8");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let uri = json["buffers"][0]["uri"].as_str().expect("uri");
+    let mut bin = base64::engine::general_purpose::STANDARD.decode(&uri[uri.find(',').expect("comma") + 1..]).expect("b64");
+    bin[38..40].copy_from_slice(&7u16.to_le_bytes());
+    bad_index = gltf_triangle(|j| {
+        j["buffers"][0]["uri"] =
+            format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin)).into()
+    });
+    assert_rejected(&write(&dir, "index.gltf", &bad_index), "out of range");
+    assert_rejected(&write(&dir, "index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "line 4");
+    assert_rejected(&write(&dir, "index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"), "line");
+    assert_rejected(&write(&dir, "index.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "line");
+    assert_rejected(
+        &write(&dir, "node.gltf", &gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())),
+        "/nodes/0/mesh",
+    );
+}
+
+#[test]
+fn non_finite_positions_drop_faces_or_fail_when_nothing_is_left() {
+    let dir = common::scratch("hostile-nan");
+    // Every facet uses a NaN vertex: nothing drawable is left.
+    assert_rejected(&write(&dir, "allnan.stl", &binary_stl(3, 3, [f32::NAN, 0.0, 0.0])), "finite");
+    // Some faces use one: they are dropped with a diagnostic; --strict turns that into bad input.
+    let file = write(&dir, "somenan.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 0\nf 1 2 3\nf 1 2 4\n");
+    let o = inspect(&file, &["--json"]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let json: serde_json::Value = serde_json::from_str(&o.stdout).expect("json");
+    assert_eq!(json["triangles"], 1);
+    let kinds: Vec<&str> = json["diagnostics"].as_array().expect("list").iter().filter_map(|d| d["kind"].as_str()).collect();
+    assert!(kinds.contains(&"dropped_face"), "{kinds:?}");
+    let strict = inspect(&file, &["--strict"]);
+    assert_eq!(strict.code, 2);
+}
+
+#[test]
+fn uris_outside_the_folder_are_refused() {
+    let dir = common::scratch("hostile-uri");
+    std::fs::write(dir.join("../outside.bin"), vec![0u8; 64]).expect("write");
+    for (name, uri) in [("dotdot.gltf", "../outside.bin"), ("absolute.gltf", "/etc/hostname"), ("scheme.gltf", "http://example.invalid/x.bin"), ("file.gltf", "file:///etc/hostname")] {
+        let bytes = gltf_triangle(|j| j["buffers"][0]["uri"] = uri.into());
+        assert_rejected(&write(&dir, name, &bytes), "/buffers/0");
+    }
+}
+
+#[test]
+fn required_extensions_we_cannot_decode_are_named() {
+    let dir = common::scratch("hostile-ext");
+    let bytes = gltf_triangle(|j| {
+        j["extensionsUsed"] = serde_json::json!(["EXT_meshopt_compression"]);
+        j["extensionsRequired"] = serde_json::json!(["EXT_meshopt_compression"]);
+    });
+    assert_rejected(&write(&dir, "meshopt.gltf", &bytes), "EXT_meshopt_compression");
+}
+
+#[test]
+fn malformed_json_names_the_line() {
+    let dir = common::scratch("hostile-json");
+    assert_rejected(&write(&dir, "bad.gltf", b"{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [,]\n}\n"), "line 3");
+    assert_rejected(&write(&dir, "wrongtype.gltf", &gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())), "/accessors/0");
+}
