@@ -432,7 +432,7 @@ OFF
         for len in 1..last_face {
             let prefix = &full[..len];
             let (line, _) = line_of(read(prefix));
-            assert!(line >= 1 && line <= 21, "line {line} for prefix of {len} bytes");
+            assert!((1..=21).contains(&line), "line {line} for prefix of {len} bytes");
         }
         // Cut in the face list: the counts no longer fit the bytes left, which the header line hears of ...
         let (line, message) = line_of(read(&full[..CUBE_QUADS.find("4 4 5").expect("face 1")]));

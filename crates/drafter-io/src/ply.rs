@@ -330,21 +330,25 @@ fn read_body<S: Source>(header: &Header, source: &mut S) -> Result<RawMesh, Pars
 }
 
 /// Refuses an element whose count the bytes left cannot back, before anything is allocated by it.
+/// The place is the element's header line in ASCII, the offset where its records would start in
+/// binary; the message names the header line either way.
 fn check_backed<S: Source>(element: &Element, format: Format, source: &S) -> Result<(), ParseError> {
     let min = element.min_record_bytes(format);
-    let room = match format {
-        Format::Ascii => (source.remaining() as u64).saturating_add(1), // the last line may lack its end
-        Format::BinaryLittleEndian => source.remaining() as u64,
+    let (room, place) = match format {
+        // The last line may lack its line end.
+        Format::Ascii => ((source.remaining() as u64).saturating_add(1), Place::Line(element.line)),
+        Format::BinaryLittleEndian => (source.remaining() as u64, source.here()),
     };
     if fits(element.count, min, room) {
         Ok(())
     } else {
-        Err(ParseError::at_line(
-            element.line,
+        Err(ParseError::new(
+            place,
             format!(
-                "header says {} {} records but the {} bytes left can hold at most {}",
-                element.count,
+                "element '{}' (header line {}) claims {} records but the {} bytes left can hold at most {}",
                 element.name,
+                element.line,
+                element.count,
                 source.remaining(),
                 room / min.max(1)
             ),
@@ -510,6 +514,8 @@ trait Source {
     fn end_record(&mut self) -> Result<(), Fault>;
     /// Where the last value read is.
     fn last_place(&self) -> Place;
+    /// Where the next value starts.
+    fn here(&self) -> Place;
     fn remaining(&self) -> usize;
 }
 
@@ -565,6 +571,10 @@ impl Source for AsciiSource<'_> {
     }
 
     fn last_place(&self) -> Place {
+        Place::Line(self.tokens.line())
+    }
+
+    fn here(&self) -> Place {
         Place::Line(self.tokens.line())
     }
 
@@ -650,6 +660,10 @@ impl Source for BinarySource<'_> {
 
     fn last_place(&self) -> Place {
         Place::Byte((self.base + self.last) as u64)
+    }
+
+    fn here(&self) -> Place {
+        Place::Byte((self.base + self.pos) as u64)
     }
 
     fn remaining(&self) -> usize {
@@ -904,11 +918,14 @@ end_header
         let skipped: &[u8] = b"ply\nformat binary_little_endian 1.0\nelement junk 18446744073709551615\nproperty list uint uint blob\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n\xff\xff\xff\xff";
         let check = || {
             let (place, message) = error(read(vertices.as_bytes()));
-            assert_eq!(place, Place::Line(3));
-            assert!(message.starts_with("header says 4000000000 vertex records but the 0 bytes left"), "{message}");
+            assert_eq!(place, Place::Byte(vertices.len() as u64));
+            assert!(
+                message.starts_with("element 'vertex' (header line 3) claims 4000000000 records but the 0 bytes left"),
+                "{message}"
+            );
             let (place, message) = error(read(faces.as_bytes()));
             assert_eq!(place, Place::Line(7));
-            assert!(message.starts_with("header says 4294967295 face records"), "{message}");
+            assert!(message.starts_with("element 'face' (header line 7) claims 4294967295 records"), "{message}");
             let (place, message) = error(read(skipped));
             assert_eq!(place, Place::Byte(skipped.len() as u64));
             assert_eq!(message, "unexpected end of file in junk 0 of 18446744073709551615");

@@ -1,0 +1,210 @@
+//! glTF features the importer must honour, each on a tiny file built here: hierarchy with matrix and
+//! TRS transforms, instancing (a mesh stored once), mirrored nodes, strips and fans, quantized
+//! positions (KHR_mesh_quantization), the default scene, skipped points/lines, GLB and external
+//! buffers.
+
+use std::path::Path;
+
+use base64::Engine as _;
+use drafter_core::{DiagnosticKind, SourceFormat};
+use glam::{DMat4, DVec3, Vec3};
+use serde_json::{Value, json};
+
+/// A binary blob plus the buffer views/accessors that describe it, built up piece by piece.
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    fn push(&mut self, bytes: &[u8], accessor: Value) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
+        self.bin.extend_from_slice(bytes);
+        let mut a = accessor;
+        a["bufferView"] = (self.views.len() - 1).into();
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    fn positions(&mut self, p: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = p.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+        let (lo, hi) = p.iter().fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), v| {
+            (std::array::from_fn(|i| lo[i].min(v[i])), std::array::from_fn(|i| hi[i].max(v[i])))
+        });
+        self.push(&bytes, json!({"componentType": 5126, "count": p.len(), "type": "VEC3", "min": lo, "max": hi}))
+    }
+
+    fn indices(&mut self, i: &[u16]) -> usize {
+        let bytes: Vec<u8> = i.iter().flat_map(|c| c.to_le_bytes()).collect();
+        self.push(&bytes, json!({"componentType": 5123, "count": i.len(), "type": "SCALAR"}))
+    }
+
+    fn document(self, mut doc: Value) -> Vec<u8> {
+        let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&self.bin));
+        doc["asset"] = json!({"version": "2.0"});
+        doc["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
+        doc["bufferViews"] = Value::Array(self.views);
+        doc["accessors"] = Value::Array(self.accessors);
+        serde_json::to_vec(&doc).expect("json")
+    }
+}
+
+const TRI: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+fn import(bytes: &[u8]) -> drafter_io::Imported {
+    drafter_io::import_bytes(Path::new("mem.gltf"), bytes).expect("imports")
+}
+
+#[test]
+fn hierarchy_instancing_and_mirroring() {
+    let mut b = Builder::default();
+    let pos = b.positions(&TRI);
+    let idx = b.indices(&[0, 1, 2]);
+    let doc = b.document(json!({
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"name": "root", "translation": [10.0, 0.0, 0.0], "children": [1, 2, 3]},
+            {"name": "a", "mesh": 0},
+            {"name": "b", "mesh": 0, "matrix": [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,5,1]},
+            {"name": "mirror", "mesh": 0, "scale": [-1.0, 1.0, 1.0], "rotation": [0.0, 0.0, 0.7071068, 0.7071068]}
+        ],
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": pos}, "indices": idx}]}]
+    }));
+    let imported = import(&doc);
+    let s = &imported.scene;
+    assert_eq!(s.meshes.len(), 1, "a mesh used by three nodes is stored once");
+    assert_eq!(s.instances.len(), 3);
+    assert_eq!(s.instanced_triangle_count(), 3);
+    let names: Vec<&str> = s.instances.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(names, ["a", "b", "mirror"]);
+    let world = |i: usize, p: [f64; 3]| s.instances[i].world_from_object.transform_point3(DVec3::from(p));
+    assert!(world(0, [1.0, 0.0, 0.0]).abs_diff_eq(DVec3::new(11.0, 0.0, 0.0), 1e-12));
+    assert!(world(1, [1.0, 0.0, 0.0]).abs_diff_eq(DVec3::new(12.0, 0.0, 5.0), 1e-12));
+    assert!(!s.instances[0].flips_winding());
+    assert!(s.instances[2].flips_winding(), "negative scale mirrors");
+    assert_eq!(s.nodes[1].parent, Some(drafter_core::NodeId(0)));
+    assert_eq!(s.roots, vec![drafter_core::NodeId(0)]);
+}
+
+#[test]
+fn default_scene_is_used_and_points_are_skipped() {
+    let mut b = Builder::default();
+    let pos = b.positions(&TRI);
+    let doc = b.document(json!({
+        "scene": 1,
+        "scenes": [{"nodes": [0]}, {"nodes": [1]}],
+        "nodes": [{"name": "not default", "mesh": 0}, {"name": "default", "mesh": 1}],
+        "meshes": [
+            {"primitives": [{"attributes": {"POSITION": pos}}]},
+            {"primitives": [{"attributes": {"POSITION": pos}}, {"attributes": {"POSITION": pos}, "mode": 0}]}
+        ]
+    }));
+    let imported = import(&doc);
+    assert_eq!(imported.scene.instances.len(), 1);
+    assert_eq!(imported.scene.instances[0].name, "default");
+    assert_eq!(imported.scene.instanced_triangle_count(), 1, "non-indexed triangles; points skipped");
+    assert!(imported.diagnostics.iter().any(|d| d.kind == DiagnosticKind::SkippedPrimitive));
+}
+
+#[test]
+fn strips_fans_and_primitive_groups() {
+    let mut b = Builder::default();
+    let quad = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+    let pos = b.positions(&quad);
+    let strip = b.indices(&[0, 1, 2, 3]);
+    let fan = b.indices(&[0, 1, 3, 2]);
+    let doc = b.document(json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "materials": [{"name": "m0"}, {"name": "m1", "pbrMetallicRoughness": {"metallicFactor": 0.25}}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": pos}, "indices": strip, "mode": 5, "material": 0},
+            {"attributes": {"POSITION": pos}, "indices": fan, "mode": 6, "material": 1}
+        ]}]
+    }));
+    let s = import(&doc).scene;
+    let mesh = &s.meshes[0];
+    assert_eq!(mesh.triangles.len(), 4);
+    assert_eq!(mesh.positions.len(), 8, "primitives are concatenated");
+    assert_eq!(mesh.groups.len(), 2);
+    assert_eq!(mesh.groups[1].start, 2);
+    assert_eq!(s.materials[1].metallic, 0.25);
+    // Every triangle of this planar quad must face +z (consistent winding).
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        assert!((b - a).cross(c - a).z > 0.0, "{t:?} faces away");
+    }
+}
+
+#[test]
+fn quantized_positions_decode() {
+    let mut b = Builder::default();
+    // Normalised i16 positions (KHR_mesh_quantization), scaled back by the node.
+    let q: Vec<u8> = [[0i16, 0, 0, 0], [32767, 0, 0, 0], [0, 32767, 0, 0]].iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let pos = b.push(&q, json!({"componentType": 5122, "normalized": true, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}));
+    b.views[pos]["byteStride"] = 8.into();
+    let doc = b.document(json!({
+        "extensionsUsed": ["KHR_mesh_quantization"],
+        "extensionsRequired": ["KHR_mesh_quantization"],
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "scale": [4.0, 4.0, 4.0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}]
+    }));
+    let s = import(&doc).scene;
+    assert_eq!(s.meshes[0].positions[1], Vec3::X);
+    let w = s.instances[0].world_from_object;
+    assert_eq!(w, DMat4::from_scale(DVec3::splat(4.0)));
+}
+
+#[test]
+fn glb_and_external_buffers_load() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gltf-features");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let mut b = Builder::default();
+    let pos = b.positions(&TRI);
+    let bin = b.bin.clone();
+    let mut doc: Value = serde_json::from_slice(&b.document(json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}]
+    })))
+    .expect("json");
+    // External file with a space in its name (percent-encoded URI).
+    std::fs::write(dir.join("my data.bin"), &bin).expect("bin");
+    doc["buffers"][0]["uri"] = "my%20data.bin".into();
+    let path = dir.join("ext.gltf");
+    std::fs::write(&path, serde_json::to_vec(&doc).expect("json")).expect("gltf");
+    let ext = drafter_io::import(&path).expect("external buffer");
+    assert_eq!(ext.scene.format, SourceFormat::Gltf);
+    assert_eq!(ext.scene.instanced_triangle_count(), 1);
+
+    // The same as GLB: JSON chunk + BIN chunk, buffer without uri.
+    doc["buffers"][0].as_object_mut().expect("obj").remove("uri");
+    let mut json_chunk = serde_json::to_vec(&doc).expect("json");
+    while json_chunk.len() % 4 != 0 {
+        json_chunk.push(b' ');
+    }
+    let mut bin_chunk = bin;
+    while bin_chunk.len() % 4 != 0 {
+        bin_chunk.push(0);
+    }
+    let total = 12 + 8 + json_chunk.len() + 8 + bin_chunk.len();
+    let mut glb = b"glTF".to_vec();
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&(total as u32).to_le_bytes());
+    glb.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json_chunk);
+    glb.extend_from_slice(&(bin_chunk.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin_chunk);
+    let imported = drafter_io::import_bytes(Path::new("x.glb"), &glb).expect("glb");
+    assert_eq!(imported.scene.format, SourceFormat::Glb);
+    assert_eq!(imported.scene.meshes[0].positions, TRI.map(Vec3::from).to_vec());
+}
