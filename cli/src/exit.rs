@@ -20,6 +20,7 @@ impl std::error::Error for BadInput {}
 /// Prints `err` as one line and picks the exit code.
 pub fn report(err: &anyhow::Error) -> ExitCode {
     let bad_input = err.chain().any(|e| e.is::<drafter_io::ImportError>() || e.is::<BadInput>());
+    // drafter_bake::BakeError::Internal stays an internal error (exit 1).
     // One line: the chain joined, newlines flattened.
     let message = err.chain().map(|e| e.to_string()).collect::<Vec<_>>().join(": ").replace('\n', " ");
     eprintln!("drafter: error: {message}");

@@ -19,6 +19,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Bake a model into an extended glTF: parts, oriented boxes, projectors and gradients.
+    Bake(cmd::bake::Args),
     /// Print what a file contains: parts, meshes, triangle counts, bounds and welded topology.
     Inspect(cmd::inspect::Args),
 }
@@ -26,6 +28,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {
+        Command::Bake(args) => cmd::bake::run(args),
         Command::Inspect(args) => cmd::inspect::run(args),
     });
     match result {

@@ -80,7 +80,11 @@ fn inspect_matches_the_corpus_readme() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         if row.needs_draco {
             if out.status.code() != Some(2) || !stderr.contains("KHR_draco_mesh_compression") {
-                failures.push(format!("{}: expected exit 2 naming KHR_draco_mesh_compression, got {:?} {stderr}", row.path, out.status.code()));
+                failures.push(format!(
+                    "{}: expected exit 2 naming KHR_draco_mesh_compression, got {:?} {stderr}",
+                    row.path,
+                    out.status.code()
+                ));
             }
             continue;
         }

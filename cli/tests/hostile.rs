@@ -19,6 +19,7 @@ struct Outcome {
     peak_kb: i64,
 }
 
+#[allow(clippy::zombie_processes)] // reaped by wait4 below, which std cannot see
 fn inspect(file: &Path, extra: &[&str]) -> Outcome {
     let mut child = common::drafter()
         .arg("inspect")
@@ -79,7 +80,8 @@ fn gltf_triangle(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     for i in [0u16, 1, 2, 0] {
         bin.extend_from_slice(&i.to_le_bytes());
     }
-    let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
     let mut json = serde_json::json!({
         "asset": {"version": "2.0"},
         "scene": 0,
@@ -156,7 +158,10 @@ fn truncated_files() {
     assert_rejected(&write(&dir, "cut.glb", &glb), "GLB");
     assert_rejected(&write(&dir, "cut.off", b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n"), "line");
     assert_rejected(&write(&dir, "cut.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"), "line");
-    assert_rejected(&write(&dir, "cut.stl", b"solid cut\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"), "line");
+    assert_rejected(
+        &write(&dir, "cut.stl", b"solid cut\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"),
+        "line",
+    );
 }
 
 #[test]
@@ -193,20 +198,19 @@ fn out_of_range_indices() {
     let text = String::from_utf8(bad_index.clone()).expect("utf8");
     let json: serde_json::Value = serde_json::from_str(&text).expect("json");
     let uri = json["buffers"][0]["uri"].as_str().expect("uri");
-    let mut bin = base64::engine::general_purpose::STANDARD.decode(&uri[uri.find(',').expect("comma") + 1..]).expect("b64");
+    let mut bin =
+        base64::engine::general_purpose::STANDARD.decode(&uri[uri.find(',').expect("comma") + 1..]).expect("b64");
     bin[38..40].copy_from_slice(&7u16.to_le_bytes());
     bad_index = gltf_triangle(|j| {
         j["buffers"][0]["uri"] =
-            format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin)).into()
+            format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin))
+                .into()
     });
     assert_rejected(&write(&dir, "index.gltf", &bad_index), "out of range");
     assert_rejected(&write(&dir, "index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "line 4");
     assert_rejected(&write(&dir, "index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"), "line");
     assert_rejected(&write(&dir, "index.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "line");
-    assert_rejected(
-        &write(&dir, "node.gltf", &gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())),
-        "/nodes/0/mesh",
-    );
+    assert_rejected(&write(&dir, "node.gltf", &gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())), "/nodes/0/mesh");
 }
 
 #[test]
@@ -220,7 +224,8 @@ fn non_finite_positions_drop_faces_or_fail_when_nothing_is_left() {
     assert_eq!(o.code, 0, "{}", o.stderr);
     let json: serde_json::Value = serde_json::from_str(&o.stdout).expect("json");
     assert_eq!(json["triangles"], 1);
-    let kinds: Vec<&str> = json["diagnostics"].as_array().expect("list").iter().filter_map(|d| d["kind"].as_str()).collect();
+    let kinds: Vec<&str> =
+        json["diagnostics"].as_array().expect("list").iter().filter_map(|d| d["kind"].as_str()).collect();
     assert!(kinds.contains(&"dropped_face"), "{kinds:?}");
     let strict = inspect(&file, &["--strict"]);
     assert_eq!(strict.code, 2);
@@ -230,7 +235,12 @@ fn non_finite_positions_drop_faces_or_fail_when_nothing_is_left() {
 fn uris_outside_the_folder_are_refused() {
     let dir = common::scratch("hostile-uri");
     std::fs::write(dir.join("../outside.bin"), vec![0u8; 64]).expect("write");
-    for (name, uri) in [("dotdot.gltf", "../outside.bin"), ("absolute.gltf", "/etc/hostname"), ("scheme.gltf", "http://example.invalid/x.bin"), ("file.gltf", "file:///etc/hostname")] {
+    for (name, uri) in [
+        ("dotdot.gltf", "../outside.bin"),
+        ("absolute.gltf", "/etc/hostname"),
+        ("scheme.gltf", "http://example.invalid/x.bin"),
+        ("file.gltf", "file:///etc/hostname"),
+    ] {
         let bytes = gltf_triangle(|j| j["buffers"][0]["uri"] = uri.into());
         assert_rejected(&write(&dir, name, &bytes), "/buffers/0");
     }
@@ -249,6 +259,12 @@ fn required_extensions_we_cannot_decode_are_named() {
 #[test]
 fn malformed_json_names_the_line() {
     let dir = common::scratch("hostile-json");
-    assert_rejected(&write(&dir, "bad.gltf", b"{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [,]\n}\n"), "line 3");
-    assert_rejected(&write(&dir, "wrongtype.gltf", &gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())), "/accessors/0");
+    assert_rejected(
+        &write(&dir, "bad.gltf", b"{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [,]\n}\n"),
+        "line 3",
+    );
+    assert_rejected(
+        &write(&dir, "wrongtype.gltf", &gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())),
+        "/accessors/0",
+    );
 }

@@ -1,3 +1,4 @@
 //! One module per subcommand, each with `Args` (clap derive) and `run(Args) -> anyhow::Result<()>`.
 
+pub mod bake;
 pub mod inspect;

@@ -17,5 +17,5 @@ mod topology;
 
 pub use diagnostic::{Diagnostic, DiagnosticKind, Diagnostics};
 pub use ids::{EdgeId, InstanceId, MaterialId, MeshId, NodeId, PartId};
-pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceFormat, TriangleGroup};
+pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceDocument, SourceFormat, TriangleGroup};
 pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld};

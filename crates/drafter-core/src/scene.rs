@@ -50,13 +50,19 @@ impl Default for Material {
 
 /// A contiguous range of a mesh's triangles that share a material (one glTF primitive, one OBJ
 /// material run).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct TriangleGroup {
     /// First triangle of the group.
     pub start: u32,
     /// Number of triangles.
     pub count: u32,
     pub material: Option<MaterialId>,
+    /// The glTF primitive (index within its mesh) the group was read from, if any.
+    pub primitive: Option<u32>,
+    /// First vertex of the group's own vertex range (glTF primitives do not share vertices).
+    pub first_vertex: u32,
+    /// Number of vertices in the group's range.
+    pub vertex_count: u32,
 }
 
 /// Geometry stored once and drawn by any number of instances.
@@ -169,6 +175,16 @@ impl Aabb {
     }
 }
 
+/// The glTF document a scene was read from, kept whole so that a writer can pass through what the
+/// scene model does not represent (extras, unknown extensions, textures, cameras, `_` attributes).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SourceDocument {
+    /// The JSON text (the JSON chunk of a .glb).
+    pub json: String,
+    /// Every buffer's bytes, in buffer order, already loaded and length-checked.
+    pub buffers: Vec<Vec<u8>>,
+}
+
 /// A whole imported file.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -181,11 +197,21 @@ pub struct Scene {
     pub roots: Vec<NodeId>,
     /// Every placement of a mesh, in hierarchy order (depth-first, children in file order).
     pub instances: Vec<Instance>,
+    /// The source glTF document, for glTF input.
+    pub source: Option<std::sync::Arc<SourceDocument>>,
 }
 
 impl Scene {
     pub fn new(format: SourceFormat) -> Self {
-        Self { format, meshes: Vec::new(), materials: Vec::new(), nodes: Vec::new(), roots: Vec::new(), instances: Vec::new() }
+        Self {
+            format,
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            nodes: Vec::new(),
+            roots: Vec::new(),
+            instances: Vec::new(),
+            source: None,
+        }
     }
 
     pub fn mesh(&self, id: MeshId) -> &Mesh {

@@ -98,10 +98,7 @@ impl Topology {
         for (v, &w) in welded_of_vertex.iter().enumerate().rev() {
             welded_positions[w as usize] = positions[v];
         }
-        let faces: Vec<[u32; 3]> = triangles
-            .par_iter()
-            .map(|t| t.map(|v| welded_of_vertex[v as usize]))
-            .collect();
+        let faces: Vec<[u32; 3]> = triangles.par_iter().map(|t| t.map(|v| welded_of_vertex[v as usize])).collect();
         let face_degenerate: Vec<bool> = faces
             .par_iter()
             .map(|&[a, b, c]| {
@@ -205,7 +202,9 @@ impl Topology {
 
     /// Number of welded vertices referenced by at least one face.
     pub fn referenced_vertex_count(&self) -> usize {
-        (0..self.welded_positions.len()).filter(|&v| self.vertex_face_offsets[v] != self.vertex_face_offsets[v + 1]).count()
+        (0..self.welded_positions.len())
+            .filter(|&v| self.vertex_face_offsets[v] != self.vertex_face_offsets[v + 1])
+            .count()
     }
 }
 
@@ -227,11 +226,12 @@ fn weld_exact(positions: &[Vec3]) -> Vec<u32> {
 }
 
 fn weld_snap(positions: &[Vec3], fraction: f64) -> Vec<u32> {
-    let (lo, hi) = positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
-        (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-    });
+    let (lo, hi) =
+        positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+        });
     let cell = if positions.is_empty() { 0.0 } else { (hi - lo).length() * fraction.abs() };
-    if !(cell > 0.0) || !cell.is_finite() {
+    if !(cell.is_finite() && cell > 0.0) {
         return weld_exact(positions);
     }
     // Rounding the coordinate itself (not relative to the box) keeps 0.0 at a cell centre, so noise
@@ -290,7 +290,7 @@ fn weld_tolerance(positions: &[Vec3], fraction: f64) -> Vec<u32> {
     }
     let diagonal = if positions.is_empty() { 0.0 } else { (bounds_max - bounds_min).length() };
     let tolerance = fraction.abs() * diagonal;
-    if !(tolerance > 0.0) || !tolerance.is_finite() {
+    if !(tolerance.is_finite() && tolerance > 0.0) {
         return weld_exact(positions);
     }
     let cell_of = |p: DVec3| -> [i64; 3] { ((p - bounds_min) / tolerance).floor().to_array().map(|c| c as i64) };
@@ -564,7 +564,16 @@ mod tests {
 
     #[test]
     fn components_join_through_shared_vertices() {
-        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(-1.0, 0.0, 0.0), Vec3::NEG_Y, Vec3::splat(5.0), Vec3::splat(6.0), Vec3::new(5.0, 6.0, 5.0)];
+        let p = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::NEG_Y,
+            Vec3::splat(5.0),
+            Vec3::splat(6.0),
+            Vec3::new(5.0, 6.0, 5.0),
+        ];
         let t = vec![[0, 1, 2], [0, 3, 4], [5, 6, 7]];
         let topo = Topology::from_triangles(&p, &t, Weld::Exact);
         assert_eq!(topo.component_count, 2);

@@ -19,7 +19,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t1 = Instant::now();
         let imported = drafter_io::import_bytes(&path, &bytes)?;
         let t2 = Instant::now();
-        let topologies: Vec<Topology> = imported.scene.meshes.par_iter().map(|m| Topology::build(m, Weld::Exact)).collect();
+        let topologies: Vec<Topology> =
+            imported.scene.meshes.par_iter().map(|m| Topology::build(m, Weld::Exact)).collect();
         let t3 = Instant::now();
         triangles = topologies.iter().map(|t| t.faces.len()).sum::<usize>();
         read.push((t1 - t0).as_secs_f64() * 1e3);
@@ -31,8 +32,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         v.sort_by(f64::total_cmp);
         (v[v.len() / 2], v[0])
     };
-    println!("{} ({} unique triangles, {} threads, {runs} runs)", path.display(), triangles, rayon::current_num_threads());
-    for (name, v) in [("read file", &mut read), ("parse to scene", &mut parse), ("topology", &mut topo), ("total", &mut total)] {
+    println!(
+        "{} ({} unique triangles, {} threads, {runs} runs)",
+        path.display(),
+        triangles,
+        rayon::current_num_threads()
+    );
+    for (name, v) in
+        [("read file", &mut read), ("parse to scene", &mut parse), ("topology", &mut topo), ("total", &mut total)]
+    {
         let (median, best) = stat(v);
         println!("  {name:<15} median {median:8.1} ms   best {best:8.1} ms");
     }

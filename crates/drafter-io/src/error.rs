@@ -82,9 +82,9 @@ pub enum ImportError {
 impl ImportError {
     pub fn path(&self) -> &Path {
         match self {
-            ImportError::Io { path, .. } | ImportError::Invalid { path, .. } | ImportError::UnsupportedFormat { path, .. } => {
-                path
-            }
+            ImportError::Io { path, .. }
+            | ImportError::Invalid { path, .. }
+            | ImportError::UnsupportedFormat { path, .. } => path,
         }
     }
 }

@@ -17,8 +17,8 @@ use std::path::{Component, Path, PathBuf};
 
 use base64::Engine as _;
 use drafter_core::{
-    DiagnosticKind, Diagnostics, Instance, Material, MaterialId, Mesh, MeshId, Node, NodeId, Scene, SourceFormat,
-    TriangleGroup,
+    DiagnosticKind, Diagnostics, Instance, Material, MaterialId, Mesh, MeshId, Node, NodeId, Scene, SourceDocument,
+    SourceFormat, TriangleGroup,
 };
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -30,8 +30,13 @@ use crate::raw::drop_nonfinite_faces;
 
 /// Required extensions we can honour: quantized attributes are decoded here; the others change only
 /// appearance or textures, which the bake does not decode.
-const ACCEPTED_REQUIRED_EXTENSIONS: &[&str] =
-    &["KHR_mesh_quantization", "KHR_texture_transform", "KHR_texture_basisu", "EXT_texture_webp", "KHR_lights_punctual"];
+const ACCEPTED_REQUIRED_EXTENSIONS: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+    "KHR_lights_punctual",
+];
 
 pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -> Result<Scene, ImportError> {
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(e).in_path(path))?;
@@ -41,7 +46,18 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     validate(doc.as_json()).map_err(|e| e.in_path(path))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(doc, gltf.blob.as_deref(), folder).map_err(|e| e.in_path(path))?;
-    build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))
+    let mut scene = build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))?;
+    // Keep the JSON text as written (not re-serialised), so nothing the gltf crate does not model is lost.
+    let json_bytes = if format == SourceFormat::Glb { glb_json_chunk(bytes) } else { bytes };
+    let json = String::from_utf8_lossy(json_bytes).into_owned();
+    scene.source = Some(std::sync::Arc::new(SourceDocument { json, buffers }));
+    Ok(scene)
+}
+
+/// The JSON chunk of a GLB container that `gltf` has already parsed successfully.
+fn glb_json_chunk(bytes: &[u8]) -> &[u8] {
+    let length = bytes.get(12..16).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    bytes.get(20..20 + length).unwrap_or_default()
 }
 
 fn gltf_error(e: gltf::Error) -> ParseError {
@@ -99,7 +115,9 @@ fn check_required_extensions(root: &gltf::json::Root) -> Result<(), ParseError> 
         if !accepted {
             return Err(ParseError::at_json(
                 format!("/extensionsRequired/{i}"),
-                format!("requires extension {name}, which drafter cannot decode (decompress or convert the file first)"),
+                format!(
+                    "requires extension {name}, which drafter cannot decode (decompress or convert the file first)"
+                ),
             ));
         }
     }
@@ -146,7 +164,9 @@ fn load_uri(uri: &str, folder: &Path) -> Result<Vec<u8>, String> {
         let Some((_, payload)) = rest.split_once(";base64,") else {
             return Err("data URI is not base64".into());
         };
-        return base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64 in data URI: {e}"));
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("bad base64 in data URI: {e}"));
     }
     let relative = resolve_relative_uri(uri)?;
     let full = folder.join(&relative);
@@ -205,7 +225,10 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
         _ => Dimensions::Vec4,
     };
     if accessor.dimensions() != expected {
-        return Err(ParseError::at_json(pointer, format!("expected type {expected:?}, found {:?}", accessor.dimensions())));
+        return Err(ParseError::at_json(
+            pointer,
+            format!("expected type {expected:?}, found {:?}", accessor.dimensions()),
+        ));
     }
     let count = accessor.count();
     let component = accessor.data_type().size();
@@ -217,7 +240,11 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
             let bytes = view_bytes(&view, buffers)?;
             let stride = view.stride().unwrap_or(element).max(element);
             let start = accessor.offset();
-            let needed = if count == 0 { Some(0) } else { (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(element)) };
+            let needed = if count == 0 {
+                Some(0)
+            } else {
+                (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(element))
+            };
             match needed {
                 Some(n) if n <= bytes.len() => {}
                 _ => {
@@ -249,7 +276,10 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
                 return Err(ParseError::at_json(pointer, "accessor has neither bufferView nor sparse data"));
             }
             if count > 1 << 26 {
-                return Err(ParseError::at_json(pointer, format!("sparse accessor count {count} is implausibly large")));
+                return Err(ParseError::at_json(
+                    pointer,
+                    format!("sparse accessor count {count} is implausibly large"),
+                ));
             }
             vec![[0.0f32; N]; count]
         }
@@ -268,19 +298,30 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
         let values_view = sparse.values().view();
         let value_bytes = view_bytes(&values_view, buffers)?;
         let value_start = sparse.values().offset();
-        let fits = |start: usize, size: usize, len: usize| n.checked_mul(size).and_then(|x| x.checked_add(start)).is_some_and(|end| end <= len);
+        let fits = |start: usize, size: usize, len: usize| {
+            n.checked_mul(size).and_then(|x| x.checked_add(start)).is_some_and(|end| end <= len)
+        };
         if !fits(index_start, index_size, index_bytes.len()) || !fits(value_start, element, value_bytes.len()) {
-            return Err(ParseError::at_json(format!("{pointer}/sparse"), format!("{n} sparse entries do not fit in their buffer views")));
+            return Err(ParseError::at_json(
+                format!("{pointer}/sparse"),
+                format!("{n} sparse entries do not fit in their buffer views"),
+            ));
         }
         for k in 0..n {
             let at = index_start + k * index_size;
             let target = match index_size {
                 1 => index_bytes[at] as usize,
                 2 => u16::from_le_bytes([index_bytes[at], index_bytes[at + 1]]) as usize,
-                _ => u32::from_le_bytes([index_bytes[at], index_bytes[at + 1], index_bytes[at + 2], index_bytes[at + 3]]) as usize,
+                _ => {
+                    u32::from_le_bytes([index_bytes[at], index_bytes[at + 1], index_bytes[at + 2], index_bytes[at + 3]])
+                        as usize
+                }
             };
             let Some(slot) = out.get_mut(target) else {
-                return Err(ParseError::at_json(format!("{pointer}/sparse"), format!("sparse index {target} is out of range ({count} elements)")));
+                return Err(ParseError::at_json(
+                    format!("{pointer}/sparse"),
+                    format!("sparse index {target} is out of range ({count} elements)"),
+                ));
             };
             let at = value_start + k * element;
             for (c, value) in slot.iter_mut().enumerate() {
@@ -299,7 +340,11 @@ fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&
         Some(end) if end <= declared => Ok(&buffer[start..end]),
         _ => Err(ParseError::at_json(
             format!("/bufferViews/{}", view.index()),
-            format!("bytes {start}..{} lie outside buffer {} of {declared} bytes", start.saturating_add(view.length()), view.buffer().index()),
+            format!(
+                "bytes {start}..{} lie outside buffer {} of {declared} bytes",
+                start.saturating_add(view.length()),
+                view.buffer().index()
+            ),
         )),
     }
 }
@@ -344,18 +389,30 @@ fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: us
     if accessor.sparse().is_some() || accessor.view().is_none() {
         // Sparse or view-less indices are legal but meaningless for geometry; read generically.
         let values = read_vectors::<1>(accessor, buffers)?;
-        return values.into_iter().enumerate().map(|(i, [v])| check_index(v as u32, i, vertex_count, &pointer)).collect();
+        return values
+            .into_iter()
+            .enumerate()
+            .map(|(i, [v])| check_index(v as u32, i, vertex_count, &pointer))
+            .collect();
     }
     let Some(view) = accessor.view() else { return Ok(Vec::new()) };
     let bytes = view_bytes(&view, buffers)?;
     let count = accessor.count();
     let stride = view.stride().unwrap_or(size).max(size);
     let start = accessor.offset();
-    let needed = if count == 0 { Some(0) } else { (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(size)) };
-    if !needed.is_some_and(|n| n <= bytes.len()) {
+    let needed = if count == 0 {
+        Some(0)
+    } else {
+        (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(size))
+    };
+    if needed.is_none_or(|n| n > bytes.len()) {
         return Err(ParseError::at_json(
             pointer,
-            format!("{count} indices (offset {start}) do not fit in bufferView {} of {} bytes", view.index(), bytes.len()),
+            format!(
+                "{count} indices (offset {start}) do not fit in bufferView {} of {} bytes",
+                view.index(),
+                bytes.len()
+            ),
         ));
     }
     let mut out = Vec::with_capacity(count);
@@ -468,13 +525,16 @@ fn build_scene(
     let mut stack: Vec<(NodeId, DMat4)> = roots.iter().rev().map(|&r| (r, DMat4::IDENTITY)).collect();
     while let Some((id, parent_world)) = stack.pop() {
         if std::mem::replace(&mut visited[id.index()], true) {
-            diagnostics.push(DiagnosticKind::NodeCycle, 1, || format!("node {id} is reached more than once; repeat skipped"));
+            diagnostics
+                .push(DiagnosticKind::NodeCycle, 1, || format!("node {id} is reached more than once; repeat skipped"));
             continue;
         }
         let node = &scene.nodes[id.index()];
         let world = parent_world * node.parent_from_local;
         if !world.is_finite() {
-            diagnostics.push(DiagnosticKind::BadTransform, 1, || format!("node {id} has a non-finite transform; subtree skipped"));
+            diagnostics.push(DiagnosticKind::BadTransform, 1, || {
+                format!("node {id} has a non-finite transform; subtree skipped")
+            });
             continue;
         }
         if let Some(mesh) = node.mesh {
@@ -518,7 +578,9 @@ fn import_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], diagnostics: &mut Diagnos
         let place = || format!("/meshes/{}/primitives/{}", mesh.index(), primitive.index());
         let mode = primitive.mode();
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
-            diagnostics.push(DiagnosticKind::SkippedPrimitive, 1, || format!("{}: mode {mode:?} is not triangles; skipped", place()));
+            diagnostics.push(DiagnosticKind::SkippedPrimitive, 1, || {
+                format!("{}: mode {mode:?} is not triangles; skipped", place())
+            });
             continue;
         }
         let Some(position_accessor) = primitive.get(&gltf::Semantic::Positions) else {
@@ -541,15 +603,20 @@ fn import_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], diagnostics: &mut Diagnos
         if let Some(a) = primitive.get(&gltf::Semantic::Normals) {
             match read_vectors::<3>(&a, buffers) {
                 Ok(n) if n.len() == vertex_count => part_normals = Some(n),
-                Ok(_) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("{}: NORMAL count differs from POSITION; ignored", place())),
-                Err(e) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("{}: NORMAL unreadable ({e}); ignored", place())),
+                Ok(_) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || {
+                    format!("{}: NORMAL count differs from POSITION; ignored", place())
+                }),
+                Err(e) => diagnostics.push(DiagnosticKind::InvalidNormals, 1, || {
+                    format!("{}: NORMAL unreadable ({e}); ignored", place())
+                }),
             }
         }
         let mut part_uvs = None;
         if let Some(a) = primitive.get(&gltf::Semantic::TexCoords(0)) {
             match read_vectors::<2>(&a, buffers) {
                 Ok(t) if t.len() == vertex_count => part_uvs = Some(t),
-                _ => diagnostics.push(DiagnosticKind::InvalidTexcoords, 1, || format!("{}: TEXCOORD_0 unusable; ignored", place())),
+                _ => diagnostics
+                    .push(DiagnosticKind::InvalidTexcoords, 1, || format!("{}: TEXCOORD_0 unusable; ignored", place())),
             }
         }
         all_have_normals &= part_normals.is_some();
@@ -566,14 +633,25 @@ fn import_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], diagnostics: &mut Diagnos
             start,
             count: out.triangles.len() as u32 - start,
             material: primitive.material().index().map(MaterialId::from),
+            primitive: Some(primitive.index() as u32),
+            first_vertex: base,
+            vertex_count: vertex_count as u32,
         });
     }
-    drop_nonfinite_faces(&mut out.positions, &mut out.triangles, &mut out.groups, diagnostics, &format!("mesh {}", mesh.index()));
+    drop_nonfinite_faces(
+        &mut out.positions,
+        &mut out.triangles,
+        &mut out.groups,
+        diagnostics,
+        &format!("mesh {}", mesh.index()),
+    );
     if all_have_normals && !out.positions.is_empty() {
         if normals.iter().all(|n| n.is_finite()) {
             out.normals = Some(normals);
         } else {
-            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("mesh {}: NORMAL has non-finite values; ignored", mesh.index()));
+            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || {
+                format!("mesh {}: NORMAL has non-finite values; ignored", mesh.index())
+            });
         }
     }
     if all_have_uvs && !out.positions.is_empty() && uvs.iter().all(|t| t.is_finite()) {
@@ -590,14 +668,26 @@ mod tests {
     fn uris_stay_inside_the_folder() {
         assert_eq!(resolve_relative_uri("a%20b.bin").unwrap(), PathBuf::from("a b.bin"));
         assert_eq!(resolve_relative_uri("sub/x.bin").unwrap(), PathBuf::from("sub/x.bin"));
-        for bad in ["../x.bin", "sub/../../x.bin", "/etc/passwd", "\\\\server\\x", "file:///etc/passwd", "http://h/x.bin", "C:/x.bin", "%2e%2e/x.bin"] {
+        for bad in [
+            "../x.bin",
+            "sub/../../x.bin",
+            "/etc/passwd",
+            "\\\\server\\x",
+            "file:///etc/passwd",
+            "http://h/x.bin",
+            "C:/x.bin",
+            "%2e%2e/x.bin",
+        ] {
             assert!(resolve_relative_uri(bad).is_err(), "{bad} accepted");
         }
     }
 
     #[test]
     fn json_pointers() {
-        assert_eq!(json_pointer("meshes[0].primitives[1].attributes[\"POSITION\"]"), "/meshes/0/primitives/1/attributes/POSITION");
+        assert_eq!(
+            json_pointer("meshes[0].primitives[1].attributes[\"POSITION\"]"),
+            "/meshes/0/primitives/1/attributes/POSITION"
+        );
         assert_eq!(json_pointer("asset"), "/asset");
     }
 

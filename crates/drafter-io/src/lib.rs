@@ -65,7 +65,8 @@ fn raw_scene(
 
 /// Decides the format of `bytes`, content first.
 pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<SourceFormat, ImportError> {
-    let unsupported = |reason: &str| ImportError::UnsupportedFormat { path: path.to_path_buf(), reason: reason.to_owned() };
+    let unsupported =
+        |reason: &str| ImportError::UnsupportedFormat { path: path.to_path_buf(), reason: reason.to_owned() };
     if bytes.is_empty() {
         return Err(ParseError::in_file("empty file").in_path(path));
     }

@@ -23,8 +23,9 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     let folder = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ..Default::default() };
     let mut reader = std::io::BufReader::new(bytes);
-    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| load_material_library(&folder, mtl))
-        .map_err(|e| locate_error(bytes, &e.to_string()).in_path(path))?;
+    let (models, materials) =
+        tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| load_material_library(&folder, mtl))
+            .map_err(|e| locate_error(bytes, &e.to_string()).in_path(path))?;
     let materials = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -43,7 +44,8 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
         mesh.positions = m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
         mesh.triangles = m.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         if let Some(bad) = mesh.triangles.iter().flatten().find(|&&v| v as usize >= vertex_count) {
-            return Err(ParseError::in_file(format!("group {:?} uses vertex {bad} of {vertex_count}", model.name)).in_path(path));
+            return Err(ParseError::in_file(format!("group {:?} uses vertex {bad} of {vertex_count}", model.name))
+                .in_path(path));
         }
         if m.normals.len() == m.positions.len() {
             mesh.normals = Some(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
@@ -52,17 +54,26 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
             mesh.uvs = Some(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect());
         }
         let material = m.material_id.filter(|&i| i < scene.materials.len()).map(MaterialId::from);
-        mesh.groups = vec![TriangleGroup { start: 0, count: mesh.triangles.len() as u32, material }];
+        mesh.groups = vec![TriangleGroup {
+            start: 0,
+            count: mesh.triangles.len() as u32,
+            material,
+            vertex_count: vertex_count as u32,
+            ..TriangleGroup::default()
+        }];
         drop_nonfinite_faces(&mut mesh.positions, &mut mesh.triangles, &mut mesh.groups, diagnostics, &model.name);
         if mesh.normals.as_ref().is_some_and(|n| n.iter().any(|v| !v.is_finite())) {
-            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || format!("group {:?}: non-finite normals ignored", model.name));
+            diagnostics.push(DiagnosticKind::InvalidNormals, 1, || {
+                format!("group {:?}: non-finite normals ignored", model.name)
+            });
             mesh.normals = None;
         }
         if mesh.triangles.is_empty() {
             continue;
         }
         let id = MeshId::from(scene.meshes.len());
-        let name = if model.name.is_empty() || model.name == "unnamed_object" { format!("group {id}") } else { model.name };
+        let name =
+            if model.name.is_empty() || model.name == "unnamed_object" { format!("group {id}") } else { model.name };
         scene.instances.push(Instance { name, mesh: id, node: None, world_from_object: DMat4::IDENTITY });
         scene.meshes.push(mesh);
     }
@@ -142,7 +153,13 @@ fn locate_error(bytes: &[u8], message: &str) -> ParseError {
                         };
                         let resolved = if i < 0 { count + i } else { i - 1 };
                         if i == 0 || resolved < 0 || resolved >= count {
-                            let kind = if slot == 0 { "vertex" } else if slot == 1 { "texture coordinate" } else { "normal" };
+                            let kind = if slot == 0 {
+                                "vertex"
+                            } else if slot == 1 {
+                                "texture coordinate"
+                            } else {
+                                "normal"
+                            };
                             return ParseError::at_line(
                                 line_no,
                                 format!("{message}: {kind} index {i} is out of range ({count} defined so far)"),

@@ -30,7 +30,8 @@ pub(crate) fn single_mesh_scene(
     mesh.positions = raw.positions.iter().map(|&p| Vec3::from(p)).collect();
     let total = raw.triangles.len();
     mesh.triangles = raw.triangles;
-    mesh.groups = vec![TriangleGroup { start: 0, count: total as u32, material: None }];
+    let vertex_count = mesh.positions.len() as u32;
+    mesh.groups = vec![TriangleGroup { start: 0, count: total as u32, vertex_count, ..TriangleGroup::default() }];
     drop_nonfinite_faces(&mut mesh.positions, &mut mesh.triangles, &mut mesh.groups, diagnostics, name);
     if let Some(normals) = raw.normals {
         if normals.len() == mesh.positions.len() && normals.iter().all(|n| n.iter().all(|c| c.is_finite())) {
@@ -91,5 +92,6 @@ pub(crate) fn drop_nonfinite_faces(
     }
     let dropped = triangles.len() - kept.len();
     *triangles = kept;
-    diagnostics.push(DiagnosticKind::DroppedFace, dropped, || format!("{context}: {dropped} faces used non-finite vertices"));
+    diagnostics
+        .push(DiagnosticKind::DroppedFace, dropped, || format!("{context}: {dropped} faces used non-finite vertices"));
 }

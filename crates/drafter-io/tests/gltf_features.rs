@@ -20,7 +20,7 @@ struct Builder {
 
 impl Builder {
     fn push(&mut self, bytes: &[u8], accessor: Value) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
@@ -45,7 +45,10 @@ impl Builder {
     }
 
     fn document(self, mut doc: Value) -> Vec<u8> {
-        let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&self.bin));
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.bin)
+        );
         doc["asset"] = json!({"version": "2.0"});
         doc["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
         doc["bufferViews"] = Value::Array(self.views);
@@ -65,6 +68,7 @@ fn hierarchy_instancing_and_mirroring() {
     let mut b = Builder::default();
     let pos = b.positions(&TRI);
     let idx = b.indices(&[0, 1, 2]);
+    let half = std::f32::consts::FRAC_1_SQRT_2;
     let doc = b.document(json!({
         "scene": 0,
         "scenes": [{"nodes": [0]}],
@@ -72,7 +76,7 @@ fn hierarchy_instancing_and_mirroring() {
             {"name": "root", "translation": [10.0, 0.0, 0.0], "children": [1, 2, 3]},
             {"name": "a", "mesh": 0},
             {"name": "b", "mesh": 0, "matrix": [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,5,1]},
-            {"name": "mirror", "mesh": 0, "scale": [-1.0, 1.0, 1.0], "rotation": [0.0, 0.0, 0.7071068, 0.7071068]}
+            {"name": "mirror", "mesh": 0, "scale": [-1.0, 1.0, 1.0], "rotation": [0.0, 0.0, half, half]}
         ],
         "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": pos}, "indices": idx}]}]
     }));
@@ -146,8 +150,12 @@ fn strips_fans_and_primitive_groups() {
 fn quantized_positions_decode() {
     let mut b = Builder::default();
     // Normalised i16 positions (KHR_mesh_quantization), scaled back by the node.
-    let q: Vec<u8> = [[0i16, 0, 0, 0], [32767, 0, 0, 0], [0, 32767, 0, 0]].iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
-    let pos = b.push(&q, json!({"componentType": 5122, "normalized": true, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}));
+    let q: Vec<u8> =
+        [[0i16, 0, 0, 0], [32767, 0, 0, 0], [0, 32767, 0, 0]].iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let pos = b.push(
+        &q,
+        json!({"componentType": 5122, "normalized": true, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}),
+    );
     b.views[pos]["byteStride"] = 8.into();
     let doc = b.document(json!({
         "extensionsUsed": ["KHR_mesh_quantization"],
@@ -187,7 +195,7 @@ fn glb_and_external_buffers_load() {
     // The same as GLB: JSON chunk + BIN chunk, buffer without uri.
     doc["buffers"][0].as_object_mut().expect("obj").remove("uri");
     let mut json_chunk = serde_json::to_vec(&doc).expect("json");
-    while json_chunk.len() % 4 != 0 {
+    while !json_chunk.len().is_multiple_of(4) {
         json_chunk.push(b' ');
     }
     let mut bin_chunk = bin;

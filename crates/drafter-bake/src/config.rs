@@ -1,0 +1,269 @@
+//! Bake options, and the `--config FILE.toml` that overrides them per part.
+//!
+//! ```toml
+//! [segment]
+//! mode = "auto"              # nodes | components | regions | auto
+//! region_angle_deg = 30.0
+//!
+//! [obb]
+//! method = "default"         # aabb | pca | hull | default | optimal
+//!
+//! [gradient]
+//! q = 10                     # quantisation, 1..=255
+//! f = 0.5                    # fade step, [0, 1]
+//! p = 1.0                    # power, [0.01, 10]
+//! transfer = "identity"      # identity | smoothstep | ease_in | ease_out | invert
+//!
+//! [[part]]                   # any number; `name` or `id` selects the part(s)
+//! name = "gear"
+//! method = "optimal"
+//! direction = [0.0, 0.0, 1.0]
+//! anchor = [0.0, 0.0, 0.0]
+//! scale = 2.0
+//! q = 17
+//! f = 1.0
+//! p = 0.19
+//! style = "metal"            # gradient | cel | gooch | goochel | phong | metal | hatch
+//! ```
+//!
+//! Unknown keys and out-of-range values are errors that name the key.
+
+use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
+use drafter_format::{Container, InputInfo};
+use drafter_segment::{SegmentMode, SegmentOptions};
+use serde::Deserialize;
+
+use crate::BakeError;
+
+/// Shading style hints a part may carry (the viewer's styles).
+pub const STYLES: [&str; 7] = ["gradient", "cel", "gooch", "goochel", "phong", "metal", "hatch"];
+
+/// Every option of a bake, one struct per stage.
+#[derive(Clone, Debug)]
+pub struct BakeConfig {
+    pub segment: SegmentOptions,
+    pub obb: ObbOptions,
+    /// The gradient parameters of every part without an override.
+    pub gradient: GradientParams,
+    pub transfer: TransferCurve,
+    /// Per-part overrides, applied in order (a later one wins).
+    pub overrides: Vec<PartOverride>,
+    /// Provenance written into the file.
+    pub input: InputInfo,
+    pub container: Container,
+}
+
+impl Default for BakeConfig {
+    fn default() -> Self {
+        Self {
+            segment: SegmentOptions::default(),
+            obb: ObbOptions::default(),
+            gradient: GradientParams::default(),
+            transfer: TransferCurve::default(),
+            overrides: Vec::new(),
+            input: InputInfo { name: String::new(), format: String::new(), sha256: String::new() },
+            container: Container::Glb,
+        }
+    }
+}
+
+/// Which parts an override applies to.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PartSelector {
+    /// Every part with this name.
+    Name(String),
+    /// The part with this id.
+    Id(u32),
+}
+
+/// Per-part settings from the config file; `None` keeps the computed value.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartOverride {
+    #[serde(skip, default = "default_selector")]
+    pub selector: PartSelector,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    id: Option<u32>,
+    pub method: Option<ObbMethod>,
+    pub direction: Option<[f64; 3]>,
+    pub anchor: Option<[f64; 3]>,
+    pub scale: Option<f64>,
+    pub q: Option<u32>,
+    pub f: Option<f32>,
+    pub p: Option<f32>,
+    pub transfer: Option<TransferCurve>,
+    pub style: Option<String>,
+}
+
+fn default_selector() -> PartSelector {
+    PartSelector::Id(u32::MAX)
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileConfig {
+    #[serde(default)]
+    segment: SegmentSection,
+    #[serde(default)]
+    obb: ObbSection,
+    #[serde(default)]
+    gradient: GradientSection,
+    #[serde(default, rename = "part")]
+    parts: Vec<PartOverride>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentSection {
+    mode: Option<SegmentMode>,
+    region_angle_deg: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObbSection {
+    method: Option<ObbMethod>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GradientSection {
+    q: Option<u32>,
+    f: Option<f32>,
+    p: Option<f32>,
+    transfer: Option<TransferCurve>,
+}
+
+impl BakeConfig {
+    /// Applies a TOML config (see the module docs) on top of `self`. Errors name the key.
+    pub fn apply_toml(&mut self, text: &str) -> Result<(), BakeError> {
+        let file: FileConfig = toml::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))?;
+        if let Some(mode) = file.segment.mode {
+            self.segment.mode = mode;
+        }
+        if let Some(angle) = file.segment.region_angle_deg {
+            if !(0.0..=180.0).contains(&angle) {
+                return Err(BakeError::Config(format!("segment.region_angle_deg = {angle} is outside [0, 180]")));
+            }
+            self.segment.region_angle_deg = angle;
+        }
+        if let Some(method) = file.obb.method {
+            self.obb.method = method;
+        }
+        let g = &file.gradient;
+        self.gradient = GradientParams {
+            q: g.q.unwrap_or(self.gradient.q),
+            f: g.f.unwrap_or(self.gradient.f),
+            p: g.p.unwrap_or(self.gradient.p),
+        };
+        self.gradient.validate().map_err(|e| BakeError::Config(format!("gradient: {e}")))?;
+        if let Some(t) = g.transfer {
+            self.transfer = t;
+        }
+        for (i, mut part) in file.parts.into_iter().enumerate() {
+            let at = format!("part[{i}]");
+            part.selector = match (part.name.take(), part.id.take()) {
+                (Some(name), None) => PartSelector::Name(name),
+                (None, Some(id)) => PartSelector::Id(id),
+                _ => return Err(BakeError::Config(format!("{at}: give exactly one of `name` or `id`"))),
+            };
+            part.validate(&self.gradient).map_err(|e| BakeError::Config(format!("{at}: {e}")))?;
+            self.overrides.push(part);
+        }
+        Ok(())
+    }
+}
+
+impl PartOverride {
+    /// An override selecting `selector` and changing nothing yet.
+    pub fn new(selector: PartSelector) -> Self {
+        Self {
+            selector,
+            name: None,
+            id: None,
+            method: None,
+            direction: None,
+            anchor: None,
+            scale: None,
+            q: None,
+            f: None,
+            p: None,
+            transfer: None,
+            style: None,
+        }
+    }
+
+    /// The gradient parameters of a part that starts from `base`.
+    pub fn gradient(&self, base: &GradientParams) -> GradientParams {
+        GradientParams { q: self.q.unwrap_or(base.q), f: self.f.unwrap_or(base.f), p: self.p.unwrap_or(base.p) }
+    }
+
+    fn validate(&self, base: &GradientParams) -> Result<(), String> {
+        self.gradient(base).validate().map_err(|e| e.to_string())?;
+        if let Some(d) = self.direction {
+            let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if !(length.is_finite() && length > 1e-12) {
+                return Err(format!("direction {d:?} is not a non-zero finite vector"));
+            }
+        }
+        if let Some(a) = self.anchor
+            && !a.iter().all(|c| c.is_finite()) {
+                return Err(format!("anchor {a:?} is not finite"));
+            }
+        if let Some(s) = self.scale
+            && !(s.is_finite() && s > 0.0) {
+                return Err(format!("scale = {s} must be finite and > 0"));
+            }
+        if let Some(style) = &self.style
+            && !STYLES.contains(&style.as_str()) {
+                return Err(format!("style = {style:?} is not one of {}", STYLES.join(", ")));
+            }
+        Ok(())
+    }
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_config_parses() {
+        let mut c = BakeConfig::default();
+        c.apply_toml(
+            "[segment]\nmode = \"components\"\n[obb]\nmethod = \"optimal\"\n[gradient]\nq = 7\nf = 0.715\np = 1.4\n\
+             [[part]]\nname = \"gear\"\nstyle = \"metal\"\ndirection = [0.0, 0.0, 2.0]\n[[part]]\nid = 3\nq = 17\n",
+        )
+        .unwrap();
+        assert_eq!(c.segment.mode, SegmentMode::Components);
+        assert_eq!(c.obb.method, ObbMethod::Optimal);
+        assert_eq!((c.gradient.q, c.gradient.f, c.gradient.p), (7, 0.715, 1.4));
+        assert_eq!(c.overrides.len(), 2);
+        assert_eq!(c.overrides[0].selector, PartSelector::Name("gear".into()));
+        assert_eq!(c.overrides[1].selector, PartSelector::Id(3));
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let cases = [
+            ("[obb]\nmethdo = \"pca\"\n", "methdo"),
+            ("[gradient]\nq = 0\n", "q"),
+            ("[gradient]\np = 99.0\n", "p"),
+            ("[[part]]\nname = \"a\"\nstyle = \"neon\"\n", "style"),
+            ("[[part]]\nname = \"a\"\nid = 2\n", "exactly one"),
+            ("[[part]]\nid = 1\nscale = -1.0\n", "scale"),
+            ("[[part]]\nid = 1\ndirection = [0.0, 0.0, 0.0]\n", "direction"),
+            ("[segment]\nmode = \"blobs\"\n", "blobs"),
+        ];
+        for (text, needle) in cases {
+            let err = BakeConfig::default().apply_toml(text).unwrap_err().to_string();
+            assert!(err.contains(needle), "{text:?}: {err}");
+            assert!(!err.contains('\n'), "multi-line: {err}");
+        }
+    }
+}

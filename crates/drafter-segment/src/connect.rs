@@ -1,0 +1,341 @@
+//! Which faces of a welded mesh belong together: edge-connected components and crease-bounded
+//! regions. See the crate docs for the rules.
+
+use drafter_core::{EDGE_NONE, Topology};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use crate::union_find::{ConcurrentUnionFind, UnionFind};
+
+/// Which vertex-connected components are inside-out (negative signed volume), so that edge
+/// directions are read reversed there when faces are paired around a non-manifold edge.
+pub(crate) struct Orientation {
+    inside_out: Vec<bool>,
+}
+
+impl Orientation {
+    /// Computed only when the mesh has a non-manifold edge; otherwise nothing reads it.
+    fn new(topo: &Topology) -> Self {
+        if !(0..topo.edge_count()).into_par_iter().any(|e| topo.edge_valence(e) >= 3) {
+            return Self { inside_out: Vec::new() };
+        }
+        let volume = topo
+            .faces
+            .par_iter()
+            .zip(topo.face_component.par_iter())
+            .with_min_len(1 << 14)
+            .fold(
+                || vec![0.0f64; topo.component_count],
+                |mut acc, (&[a, b, c], &comp)| {
+                    let p = |v: u32| topo.welded_positions[v as usize].as_dvec3();
+                    acc[comp as usize] += p(a).dot(p(b).cross(p(c)));
+                    acc
+                },
+            )
+            .reduce(
+                || vec![0.0f64; topo.component_count],
+                |mut x, y| {
+                    x.iter_mut().zip(y).for_each(|(x, y)| *x += y);
+                    x
+                },
+            );
+        Self { inside_out: volume.into_iter().map(|v| v < 0.0).collect() }
+    }
+}
+
+/// Edges along which a face has no partner.
+pub(crate) struct FreeEdges {
+    /// Non-manifold edges whose faces could not be paired.
+    pub(crate) unpaired: usize,
+    /// Faces with a boundary edge or an unpaired non-manifold edge.
+    pub(crate) open_faces: Vec<bool>,
+}
+
+/// Calls `link(f, g)` (from several threads) for every pair of faces joined across an edge: the
+/// two faces of a manifold edge, and at a non-manifold edge the faces paired by the radial rule
+/// (see the crate docs). Returns the free edges: boundary edges, and non-manifold edges whose faces
+/// could not be paired (left unjoined).
+fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
+    let orientation = Orientation::new(topo);
+    let (unpaired, open) = (0..topo.edge_count())
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .fold(
+            || (0usize, Vec::new(), Vec::new()),
+            |(mut unpaired, mut open, mut fan), e| {
+                let faces = topo.faces_of_edge(e);
+                match faces.len() {
+                    0 => {}
+                    1 => open.push(faces[0]),
+                    2 => link(faces[0], faces[1]),
+                    _ => {
+                        if !radial_pairs(topo, &orientation, e, faces, &mut fan, &link) {
+                            unpaired += 1;
+                            open.extend_from_slice(faces);
+                        }
+                    }
+                }
+                (unpaired, open, fan)
+            },
+        )
+        .map(|(unpaired, open, _)| (unpaired, open))
+        .reduce(
+            || (0, Vec::new()),
+            |(u1, mut o1), (u2, mut o2)| {
+                o1.append(&mut o2);
+                (u1 + u2, o1)
+            },
+        );
+    let mut open_faces = vec![false; topo.faces.len()];
+    for f in open {
+        open_faces[f as usize] = true;
+    }
+    FreeEdges { unpaired, open_faces }
+}
+
+/// Pairs the faces around non-manifold edge `e` into the wedges of the solids that meet there.
+///
+/// Around the edge `a → b` (a < b), a face that runs `a → b` has its outward normal pointing to
+/// increasing angle, one that runs `b → a` to decreasing angle. For closed, outward-oriented solids
+/// that do not overlap, the faces sorted by angle therefore alternate `b → a`, `a → b`, and each
+/// solid fills the wedge from a `b → a` face to the next `a → b` face. Ties (coincident faces of
+/// two solids touching along a face) put `a → b` first: the empty wedge between two solids has zero
+/// width. Returns false, linking nothing, when the fan does not alternate.
+fn radial_pairs(
+    topo: &Topology,
+    orientation: &Orientation,
+    e: usize,
+    faces: &[u32],
+    fan: &mut Vec<(f64, i8, u32)>,
+    link: &impl Fn(u32, u32),
+) -> bool {
+    let [a, b] = topo.edges[e];
+    let pa = topo.welded_positions[a as usize].as_dvec3();
+    let axis = (topo.welded_positions[b as usize].as_dvec3() - pa).normalize_or_zero();
+    if axis == DVec3::ZERO {
+        return false;
+    }
+    let u = axis.any_orthonormal_vector();
+    let v = axis.cross(u);
+    fan.clear();
+    for &f in faces {
+        let tri = topo.faces[f as usize];
+        let Some(k) = topo.face_edges[f as usize].iter().position(|&x| x as usize == e) else {
+            return false;
+        };
+        let forward = tri[k] == a;
+        let forward = forward != orientation.inside_out[topo.face_component[f as usize] as usize];
+        let c = topo.welded_positions[tri[(k + 2) % 3] as usize].as_dvec3() - pa;
+        let angle = c.dot(v).atan2(c.dot(u));
+        fan.push((angle, if forward { CLOSES } else { OPENS }, f));
+    }
+    fan.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+    if !alternate(fan) {
+        return false;
+    }
+    let n = fan.len();
+    for i in 0..n {
+        if fan[i].1 == OPENS {
+            link(fan[i].2, fan[(i + 1) % n].2);
+        }
+    }
+    true
+}
+
+/// Sign of a fan entry whose face runs `a → b`: it closes a solid's wedge.
+const CLOSES: i8 = 0;
+/// Sign of a fan entry whose face runs `b → a`: it opens a solid's wedge.
+const OPENS: i8 = 1;
+
+/// Angles closer than this (radians) count as equal around a non-manifold edge: coplanar faces of
+/// two solids that touch along a face differ by rounding only.
+const ANGLE_TIE: f64 = 1e-3;
+
+/// Orders a fan sorted by angle so that opening and closing faces alternate around the edge, if
+/// that is possible by reordering faces of equal angle (within [`ANGLE_TIE`]). The fan is rotated
+/// to start after its widest gap, so no run of equal angles wraps around. Within a run, closing
+/// faces go first (two solids touching along a face leave an empty wedge of zero width); when
+/// that does not alternate, each run is ordered to continue the alternation (a zero-thickness
+/// sheet between two wedges).
+fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
+    let n = fan.len();
+    if n % 2 != 0 {
+        return false;
+    }
+    let gap = |fan: &[(f64, i8, u32)], i: usize| {
+        let next = if i + 1 == n { fan[0].0 + std::f64::consts::TAU } else { fan[i + 1].0 };
+        next - fan[i].0
+    };
+    let mut widest = n - 1;
+    for i in 0..n {
+        if gap(fan, i) > gap(fan, widest) {
+            widest = i;
+        }
+    }
+    fan.rotate_left((widest + 1) % n);
+    for i in 1..n {
+        if fan[i].0 < fan[i - 1].0 {
+            fan[i].0 += std::f64::consts::TAU;
+        }
+    }
+    let mut runs = Vec::new();
+    let mut start = 0;
+    while start < n {
+        let mut end = start + 1;
+        while end < n && fan[end].0 - fan[end - 1].0 < ANGLE_TIE {
+            end += 1;
+        }
+        runs.push(start..end);
+        start = end;
+    }
+    let alternates = |fan: &[(f64, i8, u32)]| (0..n).all(|i| fan[i].1 != fan[(i + 1) % n].1);
+    for run in &runs {
+        fan[run.clone()].sort_by_key(|x| (x.1, x.2));
+    }
+    if alternates(fan) {
+        return true;
+    }
+    // Greedy: each run continues the alternation of the runs before it.
+    let original = fan.to_vec();
+    for first in [OPENS, CLOSES] {
+        let mut need = first;
+        let mut ok = true;
+        for run in &runs {
+            let entries = &original[run.clone()];
+            let mut same: Vec<_> = entries.iter().filter(|x| x.1 == need).copied().collect();
+            let mut other: Vec<_> = entries.iter().filter(|x| x.1 != need).copied().collect();
+            if !(same.len() == other.len() || same.len() == other.len() + 1) {
+                ok = false;
+                break;
+            }
+            same.sort_by_key(|x| x.2);
+            other.sort_by_key(|x| x.2);
+            let mut k = run.start;
+            for i in 0..same.len() {
+                fan[k] = same[i];
+                k += 1;
+                if let Some(&o) = other.get(i) {
+                    fan[k] = o;
+                    k += 1;
+                }
+            }
+            need = 1 - fan[run.end - 1].1;
+        }
+        if ok && need == first {
+            return true;
+        }
+    }
+    false
+}
+
+/// Faces with no edge (all three welded vertices not distinct) join the first edge-carrying face
+/// around one of their vertices, so that they do not stand alone as parts.
+fn attach_collapsed(topo: &Topology, uf: &mut UnionFind) {
+    for (f, edges) in topo.face_edges.iter().enumerate() {
+        if edges.iter().all(|&e| e == EDGE_NONE) {
+            let target = topo.faces[f]
+                .iter()
+                .flat_map(|&v| topo.faces_of_vertex(v as usize).iter().copied())
+                .find(|&g| topo.face_edges[g as usize].iter().any(|&e| e != EDGE_NONE));
+            if let Some(g) = target {
+                uf.union(f as u32, g);
+            }
+        }
+    }
+}
+
+/// Result of a per-mesh labelling: one label per face, labels `0..count` in order of first face.
+pub(crate) struct Labelling {
+    pub(crate) labels: Vec<u32>,
+    pub(crate) count: u32,
+    /// Non-manifold edges whose faces could not be paired.
+    pub(crate) unpaired_edges: usize,
+    /// Per label: true when one of its faces has a free edge (the label is not a closed surface).
+    pub(crate) open: Vec<bool>,
+}
+
+impl Labelling {
+    fn new(labels: Vec<u32>, count: u32, free: FreeEdges) -> Self {
+        let mut open = vec![false; count as usize];
+        for (f, &l) in labels.iter().enumerate() {
+            if free.open_faces[f] {
+                open[l as usize] = true;
+            }
+        }
+        Self { labels, count, unpaired_edges: free.unpaired, open }
+    }
+}
+
+/// Edge-connected components.
+pub(crate) fn components(topo: &Topology) -> Labelling {
+    let uf = ConcurrentUnionFind::new(topo.faces.len());
+    let free = for_each_link(topo, |f, g| uf.union(f, g));
+    let mut uf = uf.into_sequential();
+    attach_collapsed(topo, &mut uf);
+    let (labels, count) = uf.labels();
+    Labelling::new(labels, count, free)
+}
+
+/// Unit normal of each face from the welded positions (zero for a degenerate face).
+pub(crate) fn face_normals(topo: &Topology) -> Vec<Vec3> {
+    topo.faces
+        .par_iter()
+        .map(|&[a, b, c]| {
+            let p = |v: u32| topo.welded_positions[v as usize].as_dvec3();
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            n.try_normalize().map_or(Vec3::ZERO, |n| n.as_vec3())
+        })
+        .collect()
+}
+
+/// Crease-bounded regions: edge-connected faces joined only where the angle between their normals
+/// is below `angle_deg`. Faces without a normal join their first linked neighbour that has one.
+pub(crate) fn regions(topo: &Topology, angle_deg: f64) -> Labelling {
+    let normals = face_normals(topo);
+    let cos_limit = angle_deg.clamp(0.0, 180.0).to_radians().cos() as f32;
+    let uf = ConcurrentUnionFind::new(topo.faces.len());
+    let degenerate_links = std::sync::Mutex::new(Vec::new());
+    let free = for_each_link(topo, |f, g| {
+        let (nf, ng) = (normals[f as usize], normals[g as usize]);
+        if nf == Vec3::ZERO || ng == Vec3::ZERO {
+            // Rare: a lock is cheaper than threading a list through every worker.
+            if let Ok(mut list) = degenerate_links.lock() {
+                list.push((f, g));
+            }
+            return;
+        }
+        // Faces that disagree on orientation across the edge (both run it the same way) are
+        // compared with one normal flipped.
+        let ng = if same_direction(topo, f, g) { -ng } else { ng };
+        if nf.dot(ng) > cos_limit {
+            uf.union(f, g);
+        }
+    });
+    let mut uf = uf.into_sequential();
+    let mut degenerate_links = degenerate_links.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner());
+    degenerate_links.sort_unstable();
+    // Each degenerate face joins one set only, so it can not bridge two regions.
+    let mut attached = vec![false; topo.faces.len()];
+    for pass in 0..2 {
+        for &(f, g) in &degenerate_links {
+            for (x, y) in [(f, g), (g, f)] {
+                let x_degenerate = normals[x as usize] == Vec3::ZERO;
+                let y_ok = normals[y as usize] != Vec3::ZERO || pass == 1;
+                if x_degenerate && y_ok && !attached[x as usize] {
+                    attached[x as usize] = true;
+                    uf.union(x, y);
+                }
+            }
+        }
+    }
+    attach_collapsed(topo, &mut uf);
+    let (labels, count) = uf.labels();
+    Labelling::new(labels, count, free)
+}
+
+/// True when faces `f` and `g` run their shared edge in the same direction.
+fn same_direction(topo: &Topology, f: u32, g: u32) -> bool {
+    let (tf, tg) = (topo.faces[f as usize], topo.faces[g as usize]);
+    let directed = |t: [u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+    directed(tf).iter().any(|d| directed(tg).contains(d))
+}

@@ -1,0 +1,383 @@
+//! A minimal glTF 2.0 document model and its binary (.glb) writer: exactly what the samples need (nodes with
+//! TRS or matrix transforms, one triangle primitive per mesh with POSITION, NORMAL and indices, metallic-roughness
+//! materials), written so the Khronos validator reports no error, warning, info or hint.
+//!
+//! Layout of the BIN chunk: per mesh, positions, normals, then indices, each in its own buffer view (targets
+//! ARRAY_BUFFER / ELEMENT_ARRAY_BUFFER) starting on a 4-byte boundary; accessors start at offset 0 of their view.
+//! Indices are u16 when every index fits below 65535 (the restart value a primitive must not use), else u32.
+//! The JSON chunk is padded with spaces, the BIN chunk with zeros, both to 4 bytes.
+//!
+//! Determinism: JSON objects are built with keys inserted in sorted order (see [`object`]), so the bytes are the
+//! same whether or not some other crate of the build turns on serde_json's `preserve_order`; floats are written
+//! by serde_json's shortest round-trip formatting; nothing depends on time or hashing.
+//!
+//! Each primitive's `extras.brepFaces` lists its B-rep faces as `[surface, firstTriangle, triangleCount]` (the
+//! triangles of a face are contiguous), for tests that want the CAD face of a triangle as ground truth.
+
+use serde_json::{Map, Value};
+
+use crate::solid::{Surface, TriMesh};
+
+/// glTF `componentType` of f32.
+const FLOAT: u32 = 5126;
+/// glTF `componentType` of u16.
+const UNSIGNED_SHORT: u32 = 5123;
+/// glTF `componentType` of u32.
+const UNSIGNED_INT: u32 = 5125;
+/// glTF buffer view target for vertex attributes.
+const ARRAY_BUFFER: u32 = 34962;
+/// glTF buffer view target for indices.
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+/// GLB magic "glTF".
+const GLB_MAGIC: u32 = 0x4654_6C67;
+/// GLB chunk type "JSON".
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+/// GLB chunk type "BIN\0".
+const CHUNK_BIN: u32 = 0x004E_4942;
+/// Written to `asset.generator`.
+pub const GENERATOR: &str = "drafter-samples";
+
+/// Index of a material in its [`Document`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct MaterialId(pub usize);
+/// Index of a mesh in its [`Document`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct MeshId(pub usize);
+/// Index of a node in its [`Document`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct NodeId(pub usize);
+
+/// A metallic-roughness material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// Name, e.g. "steel".
+    pub name: String,
+    /// Linear RGBA base colour factor.
+    pub base_color: [f64; 4],
+    /// Metallic factor in [0, 1].
+    pub metallic: f64,
+    /// Roughness factor in [0, 1].
+    pub roughness: f64,
+}
+
+/// A mesh of one triangle primitive.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Name, e.g. "spur_gear".
+    pub name: String,
+    /// The triangles, in the mesh's object space.
+    pub geometry: TriMesh,
+    /// Material of the primitive.
+    pub material: MaterialId,
+}
+
+/// A node's local transform (parent_from_node).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Transform {
+    /// No transform written.
+    Identity,
+    /// Translation, rotation (unit quaternion x, y, z, w) and scale; components at their default are not written.
+    Trs {
+        /// Translation.
+        translation: [f64; 3],
+        /// Unit quaternion (x, y, z, w).
+        rotation: [f64; 4],
+        /// Scale; a negative determinant mirrors the subtree.
+        scale: [f64; 3],
+    },
+    /// Column-major 4×4 matrix; it must decompose into TRS.
+    Matrix([f64; 16]),
+}
+
+impl Transform {
+    /// A pure translation.
+    pub fn translation(translation: [f64; 3]) -> Self {
+        Self::Trs { translation, rotation: [0.0, 0.0, 0.0, 1.0], scale: [1.0; 3] }
+    }
+}
+
+/// A scene-graph node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Name, e.g. "gear_input".
+    pub name: String,
+    /// Local transform.
+    pub transform: Transform,
+    /// Mesh drawn at this node, if any.
+    pub mesh: Option<MeshId>,
+    /// Child nodes.
+    pub children: Vec<NodeId>,
+}
+
+/// A glTF document with a single scene.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Document {
+    /// Name of the scene.
+    pub scene_name: String,
+    /// Root nodes of the scene.
+    pub roots: Vec<NodeId>,
+    /// All nodes.
+    pub nodes: Vec<Node>,
+    /// All meshes.
+    pub meshes: Vec<Mesh>,
+    /// All materials.
+    pub materials: Vec<Material>,
+}
+
+impl Document {
+    /// An empty document whose scene is called `scene_name`.
+    pub fn new(scene_name: &str) -> Self {
+        Self { scene_name: scene_name.to_owned(), ..Self::default() }
+    }
+
+    /// Adds a material.
+    pub fn add_material(&mut self, material: Material) -> MaterialId {
+        self.materials.push(material);
+        MaterialId(self.materials.len() - 1)
+    }
+
+    /// Adds a mesh.
+    pub fn add_mesh(&mut self, name: &str, geometry: TriMesh, material: MaterialId) -> MeshId {
+        self.meshes.push(Mesh { name: name.to_owned(), geometry, material });
+        MeshId(self.meshes.len() - 1)
+    }
+
+    /// Adds a node under `parent` (or as a scene root when `None`).
+    pub fn add_node(
+        &mut self,
+        parent: Option<NodeId>,
+        name: &str,
+        transform: Transform,
+        mesh: Option<MeshId>,
+    ) -> NodeId {
+        let id = NodeId(self.nodes.len());
+        self.nodes.push(Node { name: name.to_owned(), transform, mesh, children: Vec::new() });
+        match parent {
+            Some(parent) => self.nodes[parent.0].children.push(id),
+            None => self.roots.push(id),
+        }
+        id
+    }
+
+    /// The document as GLB bytes.
+    pub fn to_glb(&self) -> Vec<u8> {
+        let mut bin = BinBuilder::default();
+        let meshes: Vec<Value> = self.meshes.iter().map(|mesh| mesh_json(mesh, &mut bin)).collect();
+        let mut top = vec![
+            ("asset", object(vec![("generator", GENERATOR.into()), ("version", "2.0".into())])),
+            ("scene", 0.into()),
+            (
+                "scenes",
+                Value::Array(vec![object(vec![
+                    ("name", self.scene_name.as_str().into()),
+                    ("nodes", self.roots.iter().map(|n| Value::from(n.0)).collect()),
+                ])]),
+            ),
+            ("nodes", self.nodes.iter().map(node_json).collect()),
+            ("meshes", Value::Array(meshes)),
+            ("materials", self.materials.iter().map(material_json).collect()),
+        ];
+        if !bin.data.is_empty() {
+            top.push(("accessors", Value::Array(std::mem::take(&mut bin.accessors))));
+            top.push(("bufferViews", Value::Array(std::mem::take(&mut bin.views))));
+            top.push(("buffers", Value::Array(vec![object(vec![("byteLength", bin.data.len().into())])])));
+        }
+        // glTF arrays must not be empty: leave out what the document does not have.
+        top.retain(|(_, value)| value.as_array().is_none_or(|a| !a.is_empty()));
+        let mut json = object(top).to_string().into_bytes();
+        pad(&mut json, b' ');
+        let mut data = bin.data;
+        pad(&mut data, 0);
+
+        let chunks_len = 8 + json.len() + if data.is_empty() { 0 } else { 8 + data.len() };
+        let mut glb = Vec::with_capacity(12 + chunks_len);
+        glb.extend_from_slice(&GLB_MAGIC.to_le_bytes());
+        glb.extend_from_slice(&2u32.to_le_bytes());
+        glb.extend_from_slice(&((12 + chunks_len) as u32).to_le_bytes());
+        glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        glb.extend_from_slice(&CHUNK_JSON.to_le_bytes());
+        glb.extend_from_slice(&json);
+        if !data.is_empty() {
+            glb.extend_from_slice(&(data.len() as u32).to_le_bytes());
+            glb.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+            glb.extend_from_slice(&data);
+        }
+        glb
+    }
+}
+
+/// A JSON object with its keys inserted in sorted order, so the output does not depend on whether serde_json's
+/// map keeps insertion order (`preserve_order`) or sorts (the default).
+pub fn object(mut entries: Vec<(&str, Value)>) -> Value {
+    entries.sort_by(|a, b| a.0.cmp(b.0));
+    let mut map = Map::new();
+    for (key, value) in entries {
+        map.insert(key.to_owned(), value);
+    }
+    Value::Object(map)
+}
+
+fn pad(bytes: &mut Vec<u8>, with: u8) {
+    while !bytes.len().is_multiple_of(4) {
+        bytes.push(with);
+    }
+}
+
+/// The BIN chunk being assembled, with its buffer views and accessors.
+#[derive(Debug, Default)]
+struct BinBuilder {
+    data: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl BinBuilder {
+    /// Appends a 4-byte-aligned buffer view and an accessor over all of it; returns the accessor index.
+    fn push(&mut self, bytes: &[u8], target: u32, accessor: Vec<(&str, Value)>) -> usize {
+        pad(&mut self.data, 0);
+        self.views.push(object(vec![
+            ("buffer", 0.into()),
+            ("byteOffset", self.data.len().into()),
+            ("byteLength", bytes.len().into()),
+            ("target", target.into()),
+        ]));
+        self.data.extend_from_slice(bytes);
+        let mut accessor = accessor;
+        accessor.push(("bufferView", (self.views.len() - 1).into()));
+        self.accessors.push(object(accessor));
+        self.accessors.len() - 1
+    }
+}
+
+fn floats(values: &[[f32; 3]]) -> Vec<u8> {
+    values.iter().flatten().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+/// f32 written as the f64 of the same value, so readers comparing in either precision see equality.
+fn float_array(values: [f32; 3]) -> Value {
+    values.iter().map(|&v| Value::from(f64::from(v))).collect()
+}
+
+fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
+    let geometry = &mesh.geometry;
+    let count = geometry.positions.len();
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in &geometry.positions {
+        for axis in 0..3 {
+            min[axis] = min[axis].min(p[axis]);
+            max[axis] = max[axis].max(p[axis]);
+        }
+    }
+    let vec3 = |extra: Vec<(&'static str, Value)>| {
+        let mut fields = vec![("componentType", FLOAT.into()), ("count", count.into()), ("type", "VEC3".into())];
+        fields.extend(extra);
+        fields
+    };
+    let position = bin.push(
+        &floats(&geometry.positions),
+        ARRAY_BUFFER,
+        vec3(vec![("min", float_array(min)), ("max", float_array(max))]),
+    );
+    let normal = bin.push(&floats(&geometry.normals), ARRAY_BUFFER, vec3(Vec::new()));
+    let flat = geometry.triangles.iter().flatten();
+    let (index_bytes, component): (Vec<u8>, u32) = if count <= usize::from(u16::MAX) {
+        (flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(), UNSIGNED_SHORT)
+    } else {
+        (flat.flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
+    };
+    let indices = bin.push(
+        &index_bytes,
+        ELEMENT_ARRAY_BUFFER,
+        vec![
+            ("componentType", component.into()),
+            ("count", (3 * geometry.triangles.len()).into()),
+            ("type", "SCALAR".into()),
+        ],
+    );
+    let faces: Value = geometry
+        .faces
+        .iter()
+        .map(|f| {
+            Value::from(vec![Value::from(surface_name(f.surface)), f.first_triangle.into(), f.triangle_count.into()])
+        })
+        .collect();
+    let primitive = object(vec![
+        ("attributes", object(vec![("NORMAL", normal.into()), ("POSITION", position.into())])),
+        ("extras", object(vec![("brepFaces", faces)])),
+        ("indices", indices.into()),
+        ("material", mesh.material.0.into()),
+    ]);
+    object(vec![("name", mesh.name.as_str().into()), ("primitives", Value::Array(vec![primitive]))])
+}
+
+/// Name of a surface kind in `extras.brepFaces`.
+pub fn surface_name(surface: Surface) -> &'static str {
+    match surface {
+        Surface::Plane => "plane",
+        Surface::Cylinder => "cylinder",
+        Surface::Cone => "cone",
+        Surface::Extrusion => "extrusion",
+    }
+}
+
+fn node_json(node: &Node) -> Value {
+    let mut fields: Vec<(&str, Value)> = vec![("name", node.name.as_str().into())];
+    if let Some(mesh) = node.mesh {
+        fields.push(("mesh", mesh.0.into()));
+    }
+    if !node.children.is_empty() {
+        fields.push(("children", node.children.iter().map(|c| Value::from(c.0)).collect()));
+    }
+    match node.transform {
+        Transform::Identity => {}
+        Transform::Trs { translation, rotation, scale } => {
+            if translation != [0.0; 3] {
+                fields.push(("translation", translation.iter().map(|&v| Value::from(v)).collect()));
+            }
+            if rotation != [0.0, 0.0, 0.0, 1.0] {
+                fields.push(("rotation", rotation.iter().map(|&v| Value::from(v)).collect()));
+            }
+            if scale != [1.0; 3] {
+                fields.push(("scale", scale.iter().map(|&v| Value::from(v)).collect()));
+            }
+        }
+        Transform::Matrix(m) => fields.push(("matrix", m.iter().map(|&v| Value::from(v)).collect())),
+    }
+    object(fields)
+}
+
+fn material_json(material: &Material) -> Value {
+    object(vec![
+        ("name", material.name.as_str().into()),
+        (
+            "pbrMetallicRoughness",
+            object(vec![
+                ("baseColorFactor", material.base_color.iter().map(|&v| Value::from(v)).collect()),
+                ("metallicFactor", material.metallic.into()),
+                ("roughnessFactor", material.roughness.into()),
+            ]),
+        ),
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn object_keys_come_out_sorted_whatever_the_insertion_order() {
+        let v = object(vec![("b", 1.into()), ("a", 2.into()), ("c", 3.into())]);
+        assert_eq!(v.to_string(), r#"{"a":2,"b":1,"c":3}"#);
+    }
+
+    #[test]
+    fn empty_document_is_a_valid_glb_header_and_padded_json() {
+        let glb = Document::new("empty").to_glb();
+        assert_eq!(&glb[0..4], b"glTF");
+        assert_eq!(u32::from_le_bytes([glb[8], glb[9], glb[10], glb[11]]) as usize, glb.len());
+        assert_eq!(glb.len() % 4, 0);
+        let json_len = u32::from_le_bytes([glb[12], glb[13], glb[14], glb[15]]) as usize;
+        assert_eq!(20 + json_len, glb.len(), "no BIN chunk without meshes");
+    }
+}
