@@ -55,6 +55,41 @@ pub struct Report {
     pub parts: Vec<PartRow>,
     pub mesh_topology: Vec<MeshRow>,
     pub diagnostics: Vec<Diagnostic>,
+    /// The `DRAFTER_illustration` data of a baked file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baked: Option<BakedSummary>,
+}
+
+/// What a baked file carries: the root extension and every part, by id.
+#[derive(Debug, Serialize)]
+pub struct BakedSummary {
+    pub root: drafter_format::RootExtension,
+    pub parts: Vec<drafter_format::PartRecord>,
+    /// Primitives with per-triangle part labels.
+    pub labelled_primitives: usize,
+}
+
+/// Reads the extension if the file is a baked glTF; `None` for anything else.
+fn read_baked(path: &std::path::Path, bytes: &[u8]) -> Result<Option<BakedSummary>> {
+    let (json, _) = match drafter_format::split_container(bytes) {
+        Ok(parts) => parts,
+        Err(_) => return Ok(None),
+    };
+    if !json.windows(drafter_format::EXTENSION.len()).any(|w| w == drafter_format::EXTENSION.as_bytes()) {
+        return Ok(None);
+    }
+    let folder = path.parent().map(std::path::Path::to_path_buf).unwrap_or_default();
+    // The importer has already confined and checked the buffer URIs.
+    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+    match drafter_format::read(bytes, &external) {
+        Ok(baked) => Ok(Some(BakedSummary {
+            parts: baked.parts().into_iter().cloned().collect(),
+            labelled_primitives: baked.primitive_labels.len(),
+            root: baked.root,
+        })),
+        Err(drafter_format::FormatError::NotBaked(_)) => Ok(None),
+        Err(e) => Err(BadInput(format!("{}: {e}", path.display())).into()),
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -106,13 +141,15 @@ pub struct MeshRow {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let imported = drafter_io::import(&args.file)?;
+    let bytes = std::fs::read(&args.file).map_err(|source| drafter_io::ImportError::Io { path: args.file.clone(), source })?;
+    let imported = drafter_io::import_bytes(&args.file, &bytes)?;
     let weld = match (args.weld_tolerance, args.weld) {
         (Some(fraction), _) => Weld::Relative(fraction),
         (None, WeldMode::Snap) => Weld::default(),
         (None, WeldMode::Exact) => Weld::Exact,
     };
-    let report = build_report(&args.file.display().to_string(), &imported.scene, imported.diagnostics, weld);
+    let mut report = build_report(&args.file.display().to_string(), &imported.scene, imported.diagnostics, weld);
+    report.baked = read_baked(&args.file, &bytes)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -189,6 +226,7 @@ pub fn build_report(file: &str, scene: &Scene, diagnostics: Vec<Diagnostic>, wel
             .collect(),
         mesh_topology,
         diagnostics,
+        baked: None,
     }
 }
 
@@ -238,6 +276,42 @@ fn print_text(r: &Report) {
     }
     if r.mesh_topology.len() > TABLE_ROWS {
         println!("  ... {} more meshes (--json lists all)", r.mesh_topology.len() - TABLE_ROWS);
+    }
+    if let Some(b) = &r.baked {
+        let input = &b.root.input;
+        println!(
+            "\n  baked by {} (extension {} v{}) from {} ({}, sha256 {}…): {} parts, {} labelled primitives",
+            b.root.generator,
+            drafter_format::EXTENSION,
+            b.root.version,
+            input.name,
+            input.format,
+            input.sha256.get(..12).unwrap_or(&input.sha256),
+            b.root.part_count,
+            b.labelled_primitives
+        );
+        println!(
+            "  {:>4} {:<28} {:>9} {:>8} {:>12} {:>24} {:>10} {:>14} {:>6}",
+            "id", "part", "triangles", "obb", "volume", "projector direction", "scale", "gradient q/f/p", "style"
+        );
+        for p in b.parts.iter().take(TABLE_ROWS) {
+            let d = p.projector.direction;
+            println!(
+                "  {:>4} {:<28} {:>9} {:>8} {:>12.4e} {:>24} {:>10.4} {:>14} {:>6}",
+                p.id,
+                truncate(&p.name, 28),
+                p.triangles,
+                p.obb.method,
+                p.obb.volume,
+                format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2]),
+                p.projector.scale,
+                format!("{}/{}/{}", p.gradient.q, p.gradient.f, p.gradient.p),
+                p.style.as_deref().unwrap_or("-")
+            );
+        }
+        if b.parts.len() > TABLE_ROWS {
+            println!("  ... {} more parts (--json lists all)", b.parts.len() - TABLE_ROWS);
+        }
     }
     if !r.diagnostics.is_empty() {
         println!("\n  input problems recovered from:");
