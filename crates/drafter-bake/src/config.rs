@@ -209,17 +209,20 @@ impl PartOverride {
             }
         }
         if let Some(a) = self.anchor
-            && !a.iter().all(|c| c.is_finite()) {
-                return Err(format!("anchor {a:?} is not finite"));
-            }
+            && !a.iter().all(|c| c.is_finite())
+        {
+            return Err(format!("anchor {a:?} is not finite"));
+        }
         if let Some(s) = self.scale
-            && !(s.is_finite() && s > 0.0) {
-                return Err(format!("scale = {s} must be finite and > 0"));
-            }
+            && !(s.is_finite() && s > 0.0)
+        {
+            return Err(format!("scale = {s} must be finite and > 0"));
+        }
         if let Some(style) = &self.style
-            && !STYLES.contains(&style.as_str()) {
-                return Err(format!("style = {style:?} is not one of {}", STYLES.join(", ")));
-            }
+            && !STYLES.contains(&style.as_str())
+        {
+            return Err(format!("style = {style:?} is not one of {}", STYLES.join(", ")));
+        }
         Ok(())
     }
 }

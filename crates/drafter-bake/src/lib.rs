@@ -169,14 +169,18 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
         let matched: Vec<usize> = if match &o.selector {
             PartSelector::Id(id) => (*id as usize) < parts.len(),
             PartSelector::Name(_) => true,
-        } { {
-            (0..parts.len())
-                .filter(|&p| match &o.selector {
-                    PartSelector::Id(id) => p == *id as usize,
-                    PartSelector::Name(n) => &parts.parts[p].name == n,
-                })
-                .collect()
-        } } else { Default::default() };
+        } {
+            {
+                (0..parts.len())
+                    .filter(|&p| match &o.selector {
+                        PartSelector::Id(id) => p == *id as usize,
+                        PartSelector::Name(n) => &parts.parts[p].name == n,
+                    })
+                    .collect()
+            }
+        } else {
+            Default::default()
+        };
         if matched.is_empty() {
             let what = match &o.selector {
                 PartSelector::Id(id) => format!("id {id} (the scene has {} parts)", parts.len()),
@@ -246,7 +250,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
 }
 
 /// World-space positions of the vertices used by `part` (each mesh vertex once).
-fn part_points(scene: &Scene, parts: &Parts, part: PartId) -> Vec<DVec3> {
+pub fn part_points(scene: &Scene, parts: &Parts, part: PartId) -> Vec<DVec3> {
     let info = parts.part(part);
     let instance = &scene.instances[info.instance.index()];
     let mesh = scene.mesh(instance.mesh);
