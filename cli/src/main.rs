@@ -23,6 +23,10 @@ enum Command {
     Bake(cmd::bake::Args),
     /// Print what a file contains: parts, meshes, triangle counts, bounds and welded topology.
     Inspect(cmd::inspect::Args),
+    /// Render a model headless to PNG in an illustration style (gradient, cel, gooch, metal, ...).
+    Render(cmd::render::Args),
+    /// Measure: `bench render FILE` prints frame time per style as a ratio to phong.
+    Bench(cmd::bench::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +34,8 @@ fn main() -> ExitCode {
     let result = std::panic::catch_unwind(|| match cli.command {
         Command::Bake(args) => cmd::bake::run(args),
         Command::Inspect(args) => cmd::inspect::run(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

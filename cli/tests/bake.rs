@@ -25,9 +25,10 @@ fn corpus_models() -> Vec<PathBuf> {
                     walk(&p, out);
                 }
             } else if let Some(ext) = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase())
-                && ["gltf", "glb", "obj", "stl", "off", "ply"].contains(&ext.as_str()) {
-                    out.push(p);
-                }
+                && ["gltf", "glb", "obj", "stl", "off", "ply"].contains(&ext.as_str())
+            {
+                out.push(p);
+            }
         }
     }
     let mut out = Vec::new();
@@ -62,10 +63,11 @@ fn check_schema(file: &Path) -> Value {
     let (json, _) = drafter_format::split_container(&bytes).expect("container");
     let doc: Value = serde_json::from_slice(json).expect("json");
     let ext = drafter_format::EXTENSION;
-    let (root, node, prim) = (
+    let (root, node, prim, mesh) = (
         schema("DRAFTER_illustration.root.schema.json"),
         schema("DRAFTER_illustration.node.schema.json"),
         schema("DRAFTER_illustration.primitive.schema.json"),
+        schema("DRAFTER_illustration.mesh.schema.json"),
     );
     let errors =
         |v: &jsonschema::Validator, value: &Value| v.iter_errors(value).map(|e| e.to_string()).collect::<Vec<_>>();
@@ -78,6 +80,10 @@ fn check_schema(file: &Path) -> Value {
         }
     }
     for m in doc["meshes"].as_array().into_iter().flatten() {
+        if let Some(e) = m.get("extensions").and_then(|e| e.get(ext)) {
+            let r = errors(&mesh, e);
+            assert!(r.is_empty(), "{}: mesh: {r:?}", file.display());
+        }
         for p in m["primitives"].as_array().into_iter().flatten() {
             if let Some(e) = p.get("extensions").and_then(|e| e.get(ext)) {
                 let r = errors(&prim, e);
@@ -239,4 +245,59 @@ fn overrides_reach_the_file() {
     assert_eq!(parts[0].obb.method, "optimal");
     assert_eq!((parts[1].gradient.q, parts[1].gradient.p), (7.0, f64::from(1.4f32)));
     assert_eq!(parts[1].style, None);
+}
+
+/// The edge-visibility bitfields of baked files obey the draft's encode-once rules, checked by
+/// drafter-lines' independent decoder against the baked geometry (welded again here).
+#[test]
+fn edge_visibility_decodes_and_recounts() {
+    let dir = common::scratch("bake-edges");
+    let models = common::shared_models();
+    for input in [
+        repo().join("samples/assembly.glb"),
+        models.join("obj/common-3d-test-models/fandisk.obj"),
+        models.join("obj/occt/motor.stl"),
+        models.join("gltf/RodAssembly/rod.glb"),
+    ] {
+        let output = dir.join("e.glb");
+        bake(&input, &output, &[]);
+        let bytes = std::fs::read(&output).expect("baked");
+        let (json, bin) = drafter_format::split_container(&bytes).expect("container");
+        let doc: Value = serde_json::from_slice(json).expect("json");
+        let bin = bin.expect("bin");
+        let scene = drafter_io::import_bytes(&output, &bytes).expect("imports").scene;
+        let mut decoded = 0;
+        for (m, mesh) in scene.meshes.iter().enumerate() {
+            let topology = drafter_core::Topology::build(mesh, drafter_core::Weld::default());
+            for group in &mesh.groups {
+                let p = group.primitive.expect("glTF primitive") as usize;
+                let Some(ext) =
+                    doc["meshes"][m]["primitives"][p]["extensions"].get(drafter_format::EDGE_VISIBILITY_EXTENSION)
+                else {
+                    continue;
+                };
+                let visibility: Vec<u8> =
+                    drafter_format::read_scalars(&doc, ext["visibility"].as_u64().expect("acc") as usize, bin)
+                        .expect("visibility")
+                        .into_iter()
+                        .map(|v| v as u8)
+                        .collect();
+                let normals: Vec<u16> = match ext.get("silhouetteNormals").and_then(Value::as_u64) {
+                    Some(a) => drafter_format::read_scalars(&doc, a as usize, bin)
+                        .expect("normals")
+                        .into_iter()
+                        .map(|v| v as u16)
+                        .collect(),
+                    None => Vec::new(),
+                };
+                let triangles = &mesh.triangles[group.start as usize..(group.start + group.count) as usize];
+                let counts =
+                    drafter_lines::decode_edge_visibility(triangles, &topology.welded_of_vertex, &visibility, &normals)
+                        .unwrap_or_else(|e| panic!("{}: mesh {m} primitive {p}: {e}", input.display()));
+                let _ = counts;
+                decoded += 1;
+            }
+        }
+        assert!(decoded > 0, "{}: no primitive carried edge visibility", input.display());
+    }
 }

@@ -43,6 +43,13 @@ pub struct Args {
     /// Oriented-box method (overrides the config file).
     #[arg(long, value_enum)]
     pub obb: Option<ObbArg>,
+    /// Skip the normal stage (keep the input's normals and vertex layout).
+    #[arg(long)]
+    pub no_normals: bool,
+    /// Write the enhanced normals into NORMAL (and the crease-aware ones into _ENHANCED_NORMAL), so
+    /// that plain glTF viewers show the enhancement.
+    #[arg(long)]
+    pub enhanced_in_normal: bool,
     /// Worker threads (default: all cores). The output is identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -111,6 +118,12 @@ pub fn run(args: Args) -> Result<()> {
             ObbArg::Default => ObbMethod::Default,
             ObbArg::Optimal => ObbMethod::Optimal,
         };
+    }
+    if args.no_normals {
+        config.normals.enabled = false;
+    }
+    if args.enhanced_in_normal {
+        config.normals.enhanced_in_normal = true;
     }
     config.container = container_for(&output)?;
 

@@ -141,7 +141,8 @@ pub struct MeshRow {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let bytes = std::fs::read(&args.file).map_err(|source| drafter_io::ImportError::Io { path: args.file.clone(), source })?;
+    let bytes =
+        std::fs::read(&args.file).map_err(|source| drafter_io::ImportError::Io { path: args.file.clone(), source })?;
     let imported = drafter_io::import_bytes(&args.file, &bytes)?;
     let weld = match (args.weld_tolerance, args.weld) {
         (Some(fraction), _) => Weld::Relative(fraction),

@@ -14,6 +14,18 @@
 //! p = 1.0                    # power, [0.01, 10]
 //! transfer = "identity"      # identity | smoothstep | ease_in | ease_out | invert
 //!
+//! [normals]
+//! enabled = true
+//! strength = 0.5             # k of n_E = normalize(n + k(n - n_L)), [0, 5]
+//! iterations = 20            # low-pass iterations, 0..=200
+//! crease_angle_deg = 30.0    # vertex normals are not averaged across sharper edges
+//! enhanced_in_normal = false # true: NORMAL holds the enhanced normals, for plain viewers
+//!
+//! [lines]
+//! enabled = true
+//! crease_angle_deg = 30.0    # sharper edges are creases (hard edges, drawn white)
+//! hierarchies = true         # store silhouette hierarchies where they beat brute force
+//!
 //! [[part]]                   # any number; `name` or `id` selects the part(s)
 //! name = "gear"
 //! method = "optimal"
@@ -30,6 +42,7 @@
 
 use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
 use drafter_format::{Container, InputInfo};
+use drafter_normals::NormalsOptions;
 use drafter_segment::{SegmentMode, SegmentOptions};
 use serde::Deserialize;
 
@@ -42,6 +55,8 @@ pub const STYLES: [&str; 7] = ["gradient", "cel", "gooch", "goochel", "phong", "
 #[derive(Clone, Debug)]
 pub struct BakeConfig {
     pub segment: SegmentOptions,
+    pub normals: NormalsStage,
+    pub lines: LinesStage,
     pub obb: ObbOptions,
     /// The gradient parameters of every part without an override.
     pub gradient: GradientParams,
@@ -57,6 +72,8 @@ impl Default for BakeConfig {
     fn default() -> Self {
         Self {
             segment: SegmentOptions::default(),
+            normals: NormalsStage::default(),
+            lines: LinesStage::default(),
             obb: ObbOptions::default(),
             gradient: GradientParams::default(),
             transfer: TransferCurve::default(),
@@ -64,6 +81,43 @@ impl Default for BakeConfig {
             input: InputInfo { name: String::new(), format: String::new(), sha256: String::new() },
             container: Container::Glb,
         }
+    }
+}
+
+/// The normal stage (Cignoni et al. 2005 enhancement + crease-aware vertex normals).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NormalsStage {
+    /// Compute and write normals. Default true.
+    pub enabled: bool,
+    /// Filter and layout options (defaults: drafter-normals').
+    pub options: NormalsOptions,
+    /// Write the enhanced normals into `NORMAL` (and the crease-aware ones into
+    /// `_ENHANCED_NORMAL`), so plain viewers show the enhancement. Default false.
+    pub enhanced_in_normal: bool,
+}
+
+impl Default for NormalsStage {
+    fn default() -> Self {
+        Self { enabled: true, options: NormalsOptions::default(), enhanced_in_normal: false }
+    }
+}
+
+/// The line stage (edge classes, EXT_mesh_primitive_edge_visibility, silhouette hierarchies).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinesStage {
+    /// Classify and write edges. Default true.
+    pub enabled: bool,
+    /// Dihedral angle above which an edge is a crease. Default
+    /// [`drafter_lines::DEFAULT_CREASE_ANGLE_DEG`] (30°); range [0, 180].
+    pub crease_angle_deg: f32,
+    /// Build and store silhouette hierarchies where they beat brute force (drafter-lines decides by
+    /// candidate count and a cost model). Default true.
+    pub hierarchies: bool,
+}
+
+impl Default for LinesStage {
+    fn default() -> Self {
+        Self { enabled: true, crease_angle_deg: drafter_lines::DEFAULT_CREASE_ANGLE_DEG, hierarchies: true }
     }
 }
 
@@ -110,6 +164,10 @@ struct FileConfig {
     obb: ObbSection,
     #[serde(default)]
     gradient: GradientSection,
+    #[serde(default)]
+    normals: NormalsSection,
+    #[serde(default)]
+    lines: LinesSection,
     #[serde(default, rename = "part")]
     parts: Vec<PartOverride>,
 }
@@ -119,6 +177,24 @@ struct FileConfig {
 struct SegmentSection {
     mode: Option<SegmentMode>,
     region_angle_deg: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LinesSection {
+    enabled: Option<bool>,
+    crease_angle_deg: Option<f32>,
+    hierarchies: Option<bool>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NormalsSection {
+    enabled: Option<bool>,
+    strength: Option<f32>,
+    iterations: Option<u32>,
+    crease_angle_deg: Option<f32>,
+    enhanced_in_normal: Option<bool>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -148,6 +224,44 @@ impl BakeConfig {
                 return Err(BakeError::Config(format!("segment.region_angle_deg = {angle} is outside [0, 180]")));
             }
             self.segment.region_angle_deg = angle;
+        }
+        let l = &file.lines;
+        if let Some(enabled) = l.enabled {
+            self.lines.enabled = enabled;
+        }
+        if let Some(a) = l.crease_angle_deg {
+            if !(0.0..=180.0).contains(&a) {
+                return Err(BakeError::Config(format!("lines.crease_angle_deg = {a} is outside [0, 180]")));
+            }
+            self.lines.crease_angle_deg = a;
+        }
+        if let Some(h) = l.hierarchies {
+            self.lines.hierarchies = h;
+        }
+        let n = &file.normals;
+        if let Some(enabled) = n.enabled {
+            self.normals.enabled = enabled;
+        }
+        if let Some(k) = n.strength {
+            if !(0.0..=5.0).contains(&k) {
+                return Err(BakeError::Config(format!("normals.strength = {k} is outside [0, 5]")));
+            }
+            self.normals.options.enhance.strength = k;
+        }
+        if let Some(i) = n.iterations {
+            if i > 200 {
+                return Err(BakeError::Config(format!("normals.iterations = {i} is outside 0..=200")));
+            }
+            self.normals.options.enhance.iterations = i;
+        }
+        if let Some(a) = n.crease_angle_deg {
+            if !(0.0..=180.0).contains(&a) {
+                return Err(BakeError::Config(format!("normals.crease_angle_deg = {a} is outside [0, 180]")));
+            }
+            self.normals.options.crease.crease_angle_deg = a;
+        }
+        if let Some(e) = n.enhanced_in_normal {
+            self.normals.enhanced_in_normal = e;
         }
         if let Some(method) = file.obb.method {
             self.obb.method = method;
@@ -262,6 +376,8 @@ mod tests {
             ("[[part]]\nid = 1\nscale = -1.0\n", "scale"),
             ("[[part]]\nid = 1\ndirection = [0.0, 0.0, 0.0]\n", "direction"),
             ("[segment]\nmode = \"blobs\"\n", "blobs"),
+            ("[normals]\nstrength = 9.0\n", "strength"),
+            ("[normals]\nsmooth = true\n", "smooth"),
         ];
         for (text, needle) in cases {
             let err = BakeConfig::default().apply_toml(text).unwrap_err().to_string();

@@ -4,7 +4,12 @@
 //! 1. `segment` — parts (drafter-segment);
 //! 2. `bounds` — per part, an oriented box of its world-space vertices, the projector derived from
 //!    it and the gradient parameters, then per-part overrides from the config (drafter-bounds);
-//! 3. `write` — the extended glTF (drafter-format).
+//! 3. `normals` — per unique mesh, crease-aware vertex normals on a new vertex layout and the
+//!    Cignoni et al. 2005 enhanced normals (drafter-normals);
+//! 4. `lines` — per unique mesh, edge classes on the welded topology (creases, boundaries, part
+//!    borders, silhouette candidates), their EXT_mesh_primitive_edge_visibility encoding per
+//!    primitive, and the silhouette hierarchies (drafter-lines);
+//! 5. `write` — the extended glTF (drafter-format).
 //!
 //! Invariant: this is the only crate that knows the order. The output bytes depend only on the
 //! scene and the config, never on timings or the thread count (parts are processed in parallel and
@@ -15,17 +20,19 @@ mod config;
 use std::time::Instant;
 
 use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
-use drafter_core::{Diagnostic, PartId, Scene};
+use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
 use drafter_format::{
-    BakeOutput, BoxRecord, FORMAT_VERSION, GENERATOR, GradientRecord, InputInfo, PartRecord, ProjectorRecord,
-    RootExtension, Written,
+    BakeOutput, BoxRecord, ConeBvhData, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord, HardEdgeClass,
+    InputInfo, MeshSilhouettes, NormalsInfo, PartRecord, PrimitiveEdges, ProjectorRecord, RootExtension, VertexData,
+    Written,
 };
+use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use config::{BakeConfig, PartOverride, PartSelector, STYLES};
+pub use config::{BakeConfig, LinesStage, NormalsStage, PartOverride, PartSelector, STYLES};
 
 /// Why a bake failed.
 #[derive(Debug, thiserror::Error)]
@@ -57,7 +64,34 @@ pub struct BakeReport {
     pub stages: Vec<StageTiming>,
     /// Bytes of the written file(s).
     pub output_bytes: u64,
+    /// What the normal stage did, summed over unique meshes (absent when it was off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normals: Option<NormalsSummary>,
+    /// What the line stage found, summed over unique meshes (absent when it was off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines: Option<LinesSummary>,
     pub diagnostics: Vec<Diagnostic>,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct LinesSummary {
+    pub meshes: usize,
+    pub edges: drafter_lines::EdgeClassCounts,
+    pub silhouette_candidates: usize,
+    /// Meshes whose orthographic / perspective queries use a stored hierarchy.
+    pub gauss_maps: usize,
+    pub cone_bvhs: usize,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct NormalsSummary {
+    pub meshes: usize,
+    pub input_vertices: usize,
+    pub output_vertices: usize,
+    /// Output vertices beyond one per welded vertex: the splits hard edges need.
+    pub split_vertices: usize,
+    pub degenerate_faces: usize,
+    pub face_iterations: u64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -103,13 +137,38 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     let mut timed =
         |name: &'static str, start: Instant| stages.push(StageTiming { name, ms: start.elapsed().as_secs_f64() * 1e3 });
 
+    // Welded topology of every mesh used by an instance, built once and shared by the stages.
     let start = Instant::now();
-    let (parts, mut diagnostics) = drafter_segment::segment(scene, &config.segment);
+    let topologies = build_topologies(scene, config.segment.weld);
+    timed("topology", start);
+
+    let start = Instant::now();
+    let (parts, mut diagnostics) = drafter_segment::segment_with_topologies(scene, &topologies, &config.segment);
     timed("segment", start);
 
     let start = Instant::now();
     let records = bound_parts(scene, &parts, config)?;
     timed("bounds", start);
+
+    let start = Instant::now();
+    let (vertex_data, normals_summary) = if config.normals.enabled {
+        let (data, summary, normal_diagnostics) = compute_normals(scene, &topologies, &config.normals);
+        diagnostics.extend(normal_diagnostics);
+        (data, Some(summary))
+    } else {
+        (vec![None; scene.meshes.len()], None)
+    };
+    timed("normals", start);
+
+    let start = Instant::now();
+    let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
+        let (edges, silhouettes, summary, line_diagnostics) = compute_lines(scene, &topologies, &parts, &config.lines);
+        diagnostics.extend(line_diagnostics);
+        (edges, silhouettes, Some(summary))
+    } else {
+        (vec![Vec::new(); scene.meshes.len()], vec![None; scene.meshes.len()], None)
+    };
+    timed("lines", start);
 
     let start = Instant::now();
     let bounds = scene.world_bounds();
@@ -121,6 +180,12 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
         settings: settings_echo(config),
         scene_center: center.to_array(),
         part_count: parts.len() as u32,
+        normals: config.normals.enabled.then(|| NormalsInfo {
+            strength: f64::from(config.normals.options.enhance.strength),
+            iterations: config.normals.options.enhance.iterations,
+            crease_angle_deg: f64::from(config.normals.options.crease.crease_angle_deg),
+            enhanced_in_normal: config.normals.enhanced_in_normal,
+        }),
     };
     let instance_parts: Vec<Vec<PartRecord>> = parts
         .instances
@@ -133,9 +198,13 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
             mesh_labels[inst.mesh.index()].get_or_insert_with(|| table.labels().to_vec());
         }
     }
-    let output = BakeOutput { scene, root, instance_parts, mesh_labels };
+    let output =
+        BakeOutput { scene, root, instance_parts, mesh_labels, vertex_data, primitive_edges, mesh_silhouettes };
     let written = drafter_format::write(&output, &config.container)
         .map_err(|e| BakeError::Internal { stage: "write", message: e.to_string() })?;
+    for note in &written.notes {
+        diagnostics.push(Diagnostic { kind: DiagnosticKind::Other, count: 1, first_example: note.clone() });
+    }
     timed("write", start);
 
     let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
@@ -146,9 +215,236 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
         parts: records.iter().map(part_report).collect(),
         stages,
         output_bytes,
+        normals: normals_summary,
+        lines: lines_summary,
         diagnostics,
     };
     Ok(Baked { written, report })
+}
+
+/// Normals of every mesh used by an instance, in mesh order. UV seams are kept where the mesh has
+/// texture coordinates (a vertex copies one source vertex's UV); otherwise coincident vertices of an
+/// unwelded CAD export are merged within a smooth fan, which is what smooths them correctly.
+fn compute_normals(
+    scene: &Scene,
+    topologies: &[Topology],
+    stage: &NormalsStage,
+) -> (Vec<Option<VertexData>>, NormalsSummary, Vec<Diagnostic>) {
+    let used = used_meshes(scene);
+    let results: Vec<Option<(VertexData, drafter_normals::NormalsReport, Vec<Diagnostic>)>> = scene
+        .meshes
+        .par_iter()
+        .enumerate()
+        .map(|(m, mesh)| {
+            if !used[m] || mesh.triangles.is_empty() {
+                return None;
+            }
+            let topology = &topologies[m];
+            let mut options = stage.options;
+            options.crease.keep_input_seams = mesh.uvs.is_some();
+            let (normals, diagnostics) = drafter_normals::compute_normals(mesh, topology, &options);
+            let (plain, enhanced) = if stage.enhanced_in_normal {
+                (&normals.enhanced_normals, &normals.normals)
+            } else {
+                (&normals.normals, &normals.enhanced_normals)
+            };
+            let data = VertexData {
+                source_vertex: normals.layout.source_vertex.clone(),
+                triangles: normals.layout.triangles.clone(),
+                normals: plain.iter().map(|n| n.to_array()).collect(),
+                enhanced: enhanced.iter().map(|n| n.to_array()).collect(),
+            };
+            Some((data, normals.report, diagnostics))
+        })
+        .collect();
+    let mut summary = NormalsSummary::default();
+    let mut diagnostics = Vec::new();
+    let data = results
+        .into_iter()
+        .map(|r| {
+            r.map(|(data, report, d)| {
+                summary.meshes += 1;
+                summary.input_vertices += report.input_vertices;
+                summary.output_vertices += report.output_vertices;
+                summary.split_vertices += report.split_vertices;
+                summary.degenerate_faces += report.degenerate_faces;
+                summary.face_iterations += report.face_iterations;
+                diagnostics.extend(d);
+                data
+            })
+        })
+        .collect();
+    (data, summary, diagnostics)
+}
+
+type LinesResult = (Vec<Vec<Option<PrimitiveEdges>>>, Vec<Option<MeshSilhouettes>>, LinesSummary, Vec<Diagnostic>);
+
+/// Edges of every mesh used by an instance: classes (with part borders from the segmentation),
+/// the per-primitive encoding and the silhouette index.
+fn compute_lines(scene: &Scene, topologies: &[Topology], parts: &Parts, stage: &LinesStage) -> LinesResult {
+    let used = used_meshes(scene);
+    // Per-triangle part labels of each mesh (shared by its instances), if it was split.
+    let mut labels: Vec<Option<&[u32]>> = vec![None; scene.meshes.len()];
+    for (inst, ip) in scene.instances.iter().zip(&parts.instances) {
+        if let MeshLabels::PerTriangle(table) = &ip.labels {
+            labels[inst.mesh.index()] = Some(table.labels());
+        }
+    }
+    let options = LineOptions { crease_angle_deg: stage.crease_angle_deg, ..LineOptions::default() };
+    let results: Vec<_> = scene
+        .meshes
+        .par_iter()
+        .enumerate()
+        .map(|(m, mesh)| {
+            if !used[m] || mesh.triangles.is_empty() {
+                return None;
+            }
+            let topology = &topologies[m];
+            let face_parts: Option<Vec<PartId>> = labels[m].map(|l| l.iter().map(|&x| PartId(x)).collect());
+            let feature = match drafter_lines::classify_edges(topology, face_parts.as_deref(), &options) {
+                Ok(f) => f,
+                Err(e) => {
+                    let d = Diagnostic {
+                        kind: DiagnosticKind::Other,
+                        count: 1,
+                        first_example: format!("mesh {m}: lines skipped: {e}"),
+                    };
+                    return Some((Vec::new(), None, drafter_lines::EdgeClassCounts::default(), vec![d]));
+                }
+            };
+            let mut diagnostics = feature.diagnostics();
+            let edges: Vec<Option<PrimitiveEdges>> = mesh
+                .groups
+                .iter()
+                .map(|g| {
+                    let triangles = &mesh.triangles[g.start as usize..(g.start + g.count) as usize];
+                    match drafter_lines::encode_edge_visibility(triangles, topology, &feature) {
+                        Ok(v) if v.has_visible_edges() => Some(PrimitiveEdges {
+                            hard_edge_classes: v
+                                .hard_edges
+                                .iter()
+                                .map(|&e| hard_edge_code(feature.classes[e as usize]))
+                                .collect(),
+                            visibility: v.visibility,
+                            silhouette_normals: v.silhouette_normals,
+                        }),
+                        Ok(_) => None,
+                        Err(e) => {
+                            diagnostics.push(Diagnostic {
+                                kind: DiagnosticKind::Other,
+                                count: 1,
+                                first_example: format!("mesh {m}: edge visibility not written: {e}"),
+                            });
+                            None
+                        }
+                    }
+                })
+                .collect();
+            let silhouettes =
+                (!feature.candidates.is_empty()).then(|| silhouettes_of(topology, &feature, stage.hierarchies));
+            Some((edges, silhouettes, feature.counts, diagnostics))
+        })
+        .collect();
+    let mut summary = LinesSummary::default();
+    let mut all_edges = Vec::with_capacity(results.len());
+    let mut all_silhouettes = Vec::with_capacity(results.len());
+    let mut diagnostics = Vec::new();
+    for r in results {
+        match r {
+            Some((edges, silhouettes, counts, d)) => {
+                summary.meshes += 1;
+                let e = &mut summary.edges;
+                e.boundary += counts.boundary;
+                e.non_manifold += counts.non_manifold;
+                e.part_border += counts.part_border;
+                e.crease += counts.crease;
+                e.silhouette_candidate += counts.silhouette_candidate;
+                e.coplanar += counts.coplanar;
+                e.degenerate += counts.degenerate;
+                e.inconsistent_orientation += counts.inconsistent_orientation;
+                if let Some(s) = &silhouettes {
+                    summary.silhouette_candidates += s.candidate_corners.len();
+                    summary.gauss_maps += usize::from(s.gauss_map.is_some());
+                    summary.cone_bvhs += usize::from(s.cone_bvh.is_some());
+                }
+                all_edges.push(edges);
+                all_silhouettes.push(silhouettes);
+                diagnostics.extend(d);
+            }
+            None => {
+                all_edges.push(Vec::new());
+                all_silhouettes.push(None);
+            }
+        }
+    }
+    (all_edges, all_silhouettes, summary, diagnostics)
+}
+
+fn hard_edge_code(class: EdgeClass) -> u8 {
+    match class {
+        EdgeClass::Crease => HardEdgeClass::Crease as u8,
+        EdgeClass::Boundary => HardEdgeClass::Boundary as u8,
+        EdgeClass::PartBorder => HardEdgeClass::PartBorder as u8,
+        EdgeClass::NonManifold => HardEdgeClass::NonManifold as u8,
+        _ => 0,
+    }
+}
+
+/// The candidates of a mesh with the hierarchies drafter-lines chose to store (none when brute
+/// force is as fast, or when `hierarchies` is off).
+fn silhouettes_of(topology: &Topology, feature: &drafter_lines::FeatureEdges, hierarchies: bool) -> MeshSilhouettes {
+    let options =
+        SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
+    let index = SilhouetteIndex::build(feature, &options);
+    let arrays = index.to_arrays();
+    let corner_of = |e: u32| -> u32 {
+        let f = topology.faces_of_edge(e as usize)[0];
+        let k = topology.face_edges[f as usize].iter().position(|&x| x == e).unwrap_or(0) as u32;
+        3 * f + k
+    };
+    let choice = |c: HierarchyChoice| match c {
+        HierarchyChoice::GaussMap { .. } => "gaussMap",
+        HierarchyChoice::ConeBvh { .. } => "coneBvh",
+        HierarchyChoice::BruteForce(_) => "bruteForce",
+    };
+    MeshSilhouettes {
+        candidate_corners: arrays.candidate_edges.iter().map(|&e| corner_of(e)).collect(),
+        candidate_normals: arrays.candidate_normals,
+        orthographic: choice(arrays.orthographic).to_owned(),
+        perspective: choice(arrays.perspective).to_owned(),
+        gauss_map: arrays.gauss_map.map(|g| GaussMapData {
+            base: g.base,
+            max_depth: g.max_depth,
+            node_caps: g.node_caps,
+            nodes: g.nodes,
+            order: g.order,
+        }),
+        cone_bvh: arrays.cone_bvh.map(|b| ConeBvhData {
+            node_boxes: b.node_boxes,
+            node_cones: b.node_cones,
+            nodes: b.nodes,
+            order: b.order,
+        }),
+    }
+}
+
+fn used_meshes(scene: &Scene) -> Vec<bool> {
+    let mut used = vec![false; scene.meshes.len()];
+    for inst in &scene.instances {
+        used[inst.mesh.index()] = true;
+    }
+    used
+}
+
+/// One topology per scene mesh (empty for meshes no instance uses), in mesh order.
+fn build_topologies(scene: &Scene, weld: Weld) -> Vec<Topology> {
+    let used = used_meshes(scene);
+    scene
+        .meshes
+        .par_iter()
+        .zip(used.par_iter())
+        .map(|(mesh, &used)| if used { Topology::build(mesh, weld) } else { Topology::default() })
+        .collect()
 }
 
 /// The options that shaped the file (never the thread count: output is identical at any).
@@ -156,6 +452,8 @@ fn settings_echo(config: &BakeConfig) -> serde_json::Value {
     serde_json::json!({
         "segment": {"mode": config.segment.mode, "regionAngleDeg": config.segment.region_angle_deg},
         "obb": {"method": config.obb.method.name()},
+        "normals": {"enabled": config.normals.enabled},
+        "lines": {"enabled": config.lines.enabled, "creaseAngleDeg": config.lines.crease_angle_deg, "hierarchies": config.lines.hierarchies},
         "gradient": {"q": config.gradient.q, "f": config.gradient.f, "p": config.gradient.p, "transfer": config.transfer},
         "partOverrides": config.overrides.len(),
     })

@@ -14,7 +14,7 @@ mod shapes;
 
 use std::time::Instant;
 
-use drafter_bounds::{EdgeSearch, ObbMethod, ObbOptions, oriented_box_with_stats};
+use drafter_bounds::{Coverage, HullDimension, ObbMethod, ObbOptions, oriented_box_with_stats};
 use glam::DVec3;
 
 /// Results of one method over all parts.
@@ -52,7 +52,8 @@ fn main() {
 fn parse_xyz(text: &str) -> Vec<DVec3> {
     text.lines()
         .filter_map(|line| {
-            let v: Vec<f64> = line.split([' ', ',', '\t']).filter(|s| !s.is_empty()).filter_map(|s| s.parse().ok()).collect();
+            let v: Vec<f64> =
+                line.split([' ', ',', '\t']).filter(|s| !s.is_empty()).filter_map(|s| s.parse().ok()).collect();
             (v.len() >= 3).then(|| DVec3::new(v[0], v[1], v[2]))
         })
         .collect()
@@ -72,9 +73,8 @@ fn stress_parts() -> Vec<(String, Vec<DVec3>)> {
         *p = rot * *p;
     }
     out.push(("gaussian_800k".to_owned(), big));
-    let mut shell = shapes::ellipsoid(&mut rng, 800_000, DVec3::new(1.0, 2.0, 3.0));
-    shell.truncate(800_000);
-    out.push(("ellipsoid_800k".to_owned(), shell));
+    let fine: Vec<DVec3> = shapes::cylinder(1.0, 3.0, 1024, 780).into_iter().map(|p| rot * p).collect();
+    out.push(("cylinder_800k".to_owned(), fine));
     out
 }
 
@@ -82,9 +82,11 @@ fn run(parts: &[(String, Vec<DVec3>)]) {
     let methods = [ObbMethod::Aabb, ObbMethod::Pca, ObbMethod::Hull, ObbMethod::Default, ObbMethod::Optimal];
     let mut rows: Vec<Row> = methods.iter().map(|_| Row::default()).collect();
     let mut over_budget = 0;
+    let mut flat = 0;
     let mut hull_sizes = Vec::new();
     for (name, points) in parts {
         let mut volumes = Vec::new();
+        let mut solid = true;
         for (m, method) in methods.iter().enumerate() {
             let options = ObbOptions::with_method(*method);
             // Repeat small parts so that the timer sees at least ~2 ms.
@@ -101,8 +103,9 @@ fn run(parts: &[(String, Vec<DVec3>)]) {
                     volumes.push(obb.volume);
                     rows[m].seconds.push(seconds);
                     if *method == ObbMethod::Optimal {
+                        solid = stats.hull_dimension == Some(HullDimension::Solid);
                         hull_sizes.push(stats.hull_vertices);
-                        if stats.edge_search == EdgeSearch::OverBudget {
+                        if stats.edge_search == Coverage::OverBudget || stats.face_search == Coverage::OverBudget {
                             over_budget += 1;
                         }
                     }
@@ -115,23 +118,48 @@ fn run(parts: &[(String, Vec<DVec3>)]) {
             }
         }
         let optimal = volumes[methods.len() - 1];
+        if !solid {
+            flat += 1; // flat, linear or point-like: volumes are ~0, ratios meaningless
+        }
         for (m, v) in volumes.iter().enumerate() {
-            if optimal > 0.0 && v.is_finite() {
+            if solid && optimal > 0.0 && v.is_finite() {
                 rows[m].ratios.push((v / optimal, name.clone()));
             }
         }
         if parts.len() <= 12 {
-            let cells: Vec<String> = volumes.iter().map(|v| format!("{:>10.4}", v / optimal)).collect();
-            println!("{name:<22} hull {:>6} verts  {}", hull_sizes.last().copied().unwrap_or(0), cells.join(" "));
+            // Per part: volume / optimal and milliseconds, for each method.
+            let cells: Vec<String> = volumes
+                .iter()
+                .zip(&rows)
+                .map(|(v, row)| {
+                    format!("{:>7.4} {:>8.2}ms", v / optimal, 1e3 * row.seconds.last().copied().unwrap_or(0.0))
+                })
+                .collect();
+            println!(
+                "{name:<18} {:>7} pts hull {:>5}  {}",
+                points.len(),
+                hull_sizes.last().copied().unwrap_or(0),
+                cells.join(" ")
+            );
         }
     }
     println!();
-    println!("{} parts; Optimal's edge search over budget on {over_budget}", parts.len());
+    println!(
+        "{} parts ({flat} flat or degenerate, left out of the ratios); Optimal over budget on {over_budget}",
+        parts.len()
+    );
     if !hull_sizes.is_empty() {
         hull_sizes.sort_unstable();
-        println!("hull vertices: median {}, max {}", hull_sizes[hull_sizes.len() / 2], hull_sizes[hull_sizes.len() - 1]);
+        println!(
+            "hull vertices: median {}, max {}",
+            hull_sizes[hull_sizes.len() / 2],
+            hull_sizes[hull_sizes.len() - 1]
+        );
     }
-    println!("{:<8} {:>14} {:>14} {:>12} {:>12}  worst part", "method", "mean ms/part", "max ms/part", "mean ratio", "worst ratio");
+    println!(
+        "{:<8} {:>14} {:>14} {:>12} {:>12}  worst part",
+        "method", "mean ms/part", "max ms/part", "mean ratio", "worst ratio"
+    );
     for (m, method) in methods.iter().enumerate() {
         let row = &rows[m];
         if row.seconds.is_empty() {
@@ -140,9 +168,13 @@ fn run(parts: &[(String, Vec<DVec3>)]) {
         let mean_ms = 1e3 * row.seconds.iter().sum::<f64>() / row.seconds.len() as f64;
         let max_ms = 1e3 * row.seconds.iter().cloned().fold(0.0, f64::max);
         let mean_ratio = row.ratios.iter().map(|r| r.0).sum::<f64>() / row.ratios.len().max(1) as f64;
-        let worst = row.ratios.iter().cloned().fold((f64::NAN, String::new()), |a, b| if a.0.is_nan() || b.0 > a.0 { b } else { a });
+        let worst = row
+            .ratios
+            .iter()
+            .cloned()
+            .fold((f64::NAN, String::new()), |a, b| if a.0.is_nan() || b.0 > a.0 { b } else { a });
         println!(
-            "{:<8} {:>14.3} {:>14.3} {:>12.4} {:>12.4}  {}",
+            "{:<8} {:>14.3} {:>14.3} {:>12.6} {:>12.6}  {}",
             method.name(),
             mean_ms,
             max_ms,

@@ -11,7 +11,8 @@
 //!    refinement)) — the module docs of `obb` state the algorithm, the guarantee and the limits;
 //! 3. the initial projector ([`Projector::from_obb`]) and its matrix `M = R·P·V` (`projector`);
 //! 4. the gradient function ω of Eqn. 1 / Listing 1 ([`omega`], [`GradientParams`]) and the intensity
-//!    transfer table γ ([`IntensityTransfer`]) (`gradient`).
+//!    transfer table γ ([`IntensityTransfer`]) (defined in `drafter_core::gradient`, shared with the
+//!    textures and the viewer, and re-exported here).
 //!
 //! Input points are world-space `DVec3` (transform object-space positions with [`world_points`]); every
 //! function is a pure function of its arguments, deterministic, and independent of the thread count.
@@ -33,7 +34,6 @@
 //! ```
 
 mod error;
-mod gradient;
 mod hull;
 mod linalg;
 mod obb;
@@ -43,14 +43,14 @@ mod rect;
 mod search;
 
 pub use drafter_core::Aabb;
-pub use error::{BoundsError, ParamError};
-pub use gradient::{
+pub use drafter_core::gradient::{
     DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZATION, GradientParams, INTENSITY_TABLE_LEN, IntensityTransfer,
     MAX_POWER, MAX_QUANTIZATION, MIN_POWER, TransferCurve, omega,
 };
+pub use error::{BoundsError, ParamError};
 pub use hull::{ConvexHull, DEFAULT_HULL_TOLERANCE, HullDimension, HullOptions, convex_hull};
 pub use obb::{
-    DEFAULT_FACE_NORMALS, DEFAULT_OBB_METHOD, DEFAULT_OPTIMAL_EDGE_BUDGET, EdgeSearch, Obb, ObbMethod, ObbOptions,
-    ObbStats, aabb, oriented_box, oriented_box_f32, oriented_box_with_stats, world_points,
+    Coverage, DEFAULT_FACE_NORMALS, DEFAULT_OBB_METHOD, DEFAULT_OPTIMAL_BUDGET, Obb, ObbMethod, ObbOptions, ObbStats,
+    aabb, oriented_box, oriented_box_f32, oriented_box_with_stats, world_points,
 };
 pub use projector::{BIAS_MATRIX, Projector};

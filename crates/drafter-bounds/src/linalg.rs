@@ -7,9 +7,11 @@ use glam::{DMat3, DVec3};
 /// descending order with unit eigenvectors forming a right-handed frame. Deterministic, no allocation.
 #[allow(clippy::needless_range_loop)] // index notation mirrors the textbook rotation formulas
 pub(crate) fn symmetric_eigen(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
-    let mut a = [[m.x_axis.x, m.y_axis.x, m.z_axis.x], [m.x_axis.y, m.y_axis.y, m.z_axis.y], [
-        m.x_axis.z, m.y_axis.z, m.z_axis.z,
-    ]];
+    let mut a = [
+        [m.x_axis.x, m.y_axis.x, m.z_axis.x],
+        [m.x_axis.y, m.y_axis.y, m.z_axis.y],
+        [m.x_axis.z, m.y_axis.z, m.z_axis.z],
+    ];
     // symmetrise (the caller's matrix may carry rounding asymmetry)
     for i in 0..3 {
         for j in (i + 1)..3 {

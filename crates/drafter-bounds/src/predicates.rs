@@ -35,32 +35,40 @@ pub(crate) fn orient3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], p: [f64; 3]) -> i8
 }
 
 fn orient3d_exact(a: [f64; 3], b: [f64; 3], c: [f64; 3], p: [f64; 3]) -> i8 {
-    let d = |x: f64, y: f64| -> Vec<f64> {
+    // Differences as exact two-term expansions (low, high).
+    let d = |x: f64, y: f64| -> [f64; 2] {
         let (hi, lo) = two_diff(x, y);
-        let mut e = Vec::with_capacity(2);
-        if lo != 0.0 {
-            e.push(lo);
-        }
-        if hi != 0.0 || e.is_empty() {
-            e.push(hi);
-        }
-        e
+        [lo, hi]
     };
     let u = [d(b[0], a[0]), d(b[1], a[1]), d(b[2], a[2])];
     let v = [d(c[0], a[0]), d(c[1], a[1]), d(c[2], a[2])];
     let w = [d(p[0], a[0]), d(p[1], a[1]), d(p[2], a[2])];
-    let minor = |i: usize, j: usize| -> Vec<f64> {
-        // u_i v_j − u_j v_i
-        let left = expansion_product(&u[i], &v[j]);
-        let right = expansion_product(&u[j], &v[i]);
-        expansion_sum(&left, &negate(&right))
+    // minor(i, j) = u_i v_j − u_j v_i (≤ 16 terms), then w_k · minor (≤ 64), summed (≤ 192).
+    let minor = |i: usize, j: usize, out: &mut [f64; 16]| -> usize {
+        let mut left = [0.0; 8];
+        let mut right = [0.0; 8];
+        let nl = product(&u[i], &v[j], &mut left);
+        let nr = product(&u[j], &v[i], &mut right);
+        for x in &mut right[..nr] {
+            *x = -*x;
+        }
+        sum(&left[..nl], &right[..nr], out)
     };
-    let t0 = expansion_product(&w[0], &minor(1, 2));
-    let t1 = expansion_product(&w[1], &minor(2, 0));
-    let t2 = expansion_product(&w[2], &minor(0, 1));
-    let det = expansion_sum(&expansion_sum(&t0, &t1), &t2);
+    let term = |k: usize, i: usize, j: usize, out: &mut [f64; 64]| -> usize {
+        let mut m = [0.0; 16];
+        let nm = minor(i, j, &mut m);
+        product(&w[k], &m[..nm], out)
+    };
+    let (mut t0, mut t1, mut t2) = ([0.0; 64], [0.0; 64], [0.0; 64]);
+    let n0 = term(0, 1, 2, &mut t0);
+    let n1 = term(1, 2, 0, &mut t1);
+    let n2 = term(2, 0, 1, &mut t2);
+    let mut s01 = [0.0; 128];
+    let n01 = sum(&t0[..n0], &t1[..n1], &mut s01);
+    let mut det = [0.0; 192];
+    let n = sum(&s01[..n01], &t2[..n2], &mut det);
     // The most significant component (the last non-zero one) carries the sign.
-    match det.iter().rev().find(|x| **x != 0.0) {
+    match det[..n].iter().rev().find(|x| **x != 0.0) {
         Some(x) if *x > 0.0 => 1,
         Some(_) => -1,
         None => 0,
@@ -75,6 +83,13 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let br = b - bv;
     let ar = a - av;
     (x, ar + br)
+}
+
+#[inline]
+fn fast_two_sum(a: f64, b: f64) -> (f64, f64) {
+    let x = a + b;
+    let bv = x - a;
+    (x, b - bv)
 }
 
 #[inline]
@@ -93,69 +108,104 @@ fn two_product(a: f64, b: f64) -> (f64, f64) {
     (x, a.mul_add(b, -x))
 }
 
-fn negate(e: &[f64]) -> Vec<f64> {
-    e.iter().map(|x| -x).collect()
-}
-
-/// Adds the scalar `b` to the non-overlapping expansion `e` (Shewchuk's Grow-Expansion, zero-eliminating).
-fn grow_expansion(e: &[f64], b: f64) -> Vec<f64> {
-    let mut out = Vec::with_capacity(e.len() + 1);
-    let mut q = b;
-    for &ei in e {
-        let (sum, err) = two_sum(q, ei);
-        if err != 0.0 {
-            out.push(err);
+/// `h = e + f` for non-overlapping expansions sorted by increasing magnitude (Shewchuk's
+/// Fast-Expansion-Sum, zero-eliminating). Returns the length of `h` (≥ 1); `h` must hold
+/// `e.len() + f.len()` values.
+fn sum(e: &[f64], f: &[f64], h: &mut [f64]) -> usize {
+    if e.is_empty() || f.is_empty() {
+        let src = if e.is_empty() { f } else { e };
+        let mut n = 0;
+        for &x in src {
+            if x != 0.0 {
+                h[n] = x;
+                n += 1;
+            }
         }
-        q = sum;
+        if n == 0 {
+            h[0] = 0.0;
+            n = 1;
+        }
+        return n;
     }
-    if q != 0.0 || out.is_empty() {
-        out.push(q);
-    }
-    out
-}
-
-fn expansion_sum(e: &[f64], f: &[f64]) -> Vec<f64> {
-    let mut out = e.to_vec();
-    for &fi in f {
-        out = grow_expansion(&out, fi);
-    }
-    out
-}
-
-/// Multiplies the expansion `e` by the scalar `b` (Shewchuk's Scale-Expansion, zero-eliminating).
-fn scale_expansion(e: &[f64], b: f64) -> Vec<f64> {
-    let mut out = Vec::with_capacity(2 * e.len());
-    let Some((&first, rest)) = e.split_first() else {
-        return vec![0.0];
+    let (mut ei, mut fi) = (0, 0);
+    // Take the component of smaller magnitude first.
+    let take = |ei: &mut usize, fi: &mut usize| -> f64 {
+        if *fi >= f.len() || (*ei < e.len() && (f[*fi] > e[*ei]) == (f[*fi] > -e[*ei])) {
+            *ei += 1;
+            e[*ei - 1]
+        } else {
+            *fi += 1;
+            f[*fi - 1]
+        }
     };
+    let mut q = take(&mut ei, &mut fi);
+    let mut n = 0;
+    let mut first = true;
+    while ei < e.len() || fi < f.len() {
+        let next = take(&mut ei, &mut fi);
+        let (sum, err) = if first { fast_two_sum(next, q) } else { two_sum(q, next) };
+        first = false;
+        q = sum;
+        if err != 0.0 {
+            h[n] = err;
+            n += 1;
+        }
+    }
+    if q != 0.0 || n == 0 {
+        h[n] = q;
+        n += 1;
+    }
+    n
+}
+
+/// `h = e · b` (Shewchuk's Scale-Expansion, zero-eliminating); `h` must hold `2·e.len()` values.
+fn scale(e: &[f64], b: f64, h: &mut [f64]) -> usize {
+    let Some((&first, rest)) = e.split_first() else {
+        h[0] = 0.0;
+        return 1;
+    };
+    let mut n = 0;
     let (mut q, err) = two_product(first, b);
     if err != 0.0 {
-        out.push(err);
+        h[n] = err;
+        n += 1;
     }
     for &ei in rest {
         let (hi, lo) = two_product(ei, b);
-        let (sum, err) = two_sum(q, lo);
+        let (s, err) = two_sum(q, lo);
         if err != 0.0 {
-            out.push(err);
+            h[n] = err;
+            n += 1;
         }
-        let (sum2, err2) = two_sum(hi, sum);
+        let (s2, err2) = fast_two_sum(hi, s);
         if err2 != 0.0 {
-            out.push(err2);
+            h[n] = err2;
+            n += 1;
         }
-        q = sum2;
+        q = s2;
     }
-    if q != 0.0 || out.is_empty() {
-        out.push(q);
+    if q != 0.0 || n == 0 {
+        h[n] = q;
+        n += 1;
     }
-    out
+    n
 }
 
-fn expansion_product(e: &[f64], f: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0];
-    for &fi in f {
-        out = expansion_sum(&out, &scale_expansion(e, fi));
+/// `h = e · f` for a short `e` (one scaled copy of `f` per component of `e`, summed); `h` must hold
+/// `2·e.len()·f.len()` values (at most 64 here).
+fn product(e: &[f64], f: &[f64], h: &mut [f64]) -> usize {
+    let mut acc = [0.0; 64];
+    let mut acc_len = 0;
+    let mut part = [0.0; 64];
+    let mut tmp = [0.0; 64];
+    for &ei in e {
+        let np = scale(f, ei, &mut part);
+        let n = sum(&acc[..acc_len], &part[..np], &mut tmp);
+        acc[..n].copy_from_slice(&tmp[..n]);
+        acc_len = n;
     }
-    out
+    h[..acc_len].copy_from_slice(&acc[..acc_len]);
+    acc_len
 }
 
 #[cfg(test)]
@@ -194,6 +244,35 @@ mod tests {
         // The shifted coordinates are rounded, so the sign may be anything, but it must match the exact
         // evaluation of the rounded inputs, which is what orient3d_exact computes.
         assert_eq!(s, orient3d_exact(shift(a), shift(b), shift(c), shift(on)));
+    }
+
+    #[test]
+    fn exact_path_matches_integer_arithmetic() {
+        // Integer coordinates near 2^30: differences are exact in f64, products are not, and i128
+        // evaluates the determinant exactly. Near-coplanar points make the float filter give up.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |range: i64| -> i64 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % (2 * range as u64 + 1)) as i64 - range
+        };
+        let big = 1i64 << 30;
+        for _ in 0..3000 {
+            let a = [next(big), next(big), next(big)];
+            let b = [next(big), next(big), next(big)];
+            let c = [next(big), next(big), next(big)];
+            let (k1, k2, m) = (next(1000), next(1000), 997);
+            let p: [i64; 3] = std::array::from_fn(|i| a[i] + ((b[i] - a[i]) * k1 + (c[i] - a[i]) * k2) / m + next(1));
+            let d = |x: [i64; 3], y: [i64; 3]| [(x[0] - y[0]) as i128, (x[1] - y[1]) as i128, (x[2] - y[2]) as i128];
+            let (u, v, w) = (d(b, a), d(c, a), d(p, a));
+            let det = w[0] * (u[1] * v[2] - u[2] * v[1])
+                + w[1] * (u[2] * v[0] - u[0] * v[2])
+                + w[2] * (u[0] * v[1] - u[1] * v[0]);
+            let f = |x: [i64; 3]| x.map(|c| c as f64);
+            assert_eq!(orient3d(f(a), f(b), f(c), f(p)), det.signum() as i8);
+            assert_eq!(orient3d_exact(f(a), f(b), f(c), f(p)), det.signum() as i8);
+        }
     }
 
     #[test]

@@ -142,11 +142,7 @@ mod tests {
 
     #[test]
     fn matrix_maps_box_ends_to_zero_and_one() {
-        let axes = crate::linalg::orthonormalize([
-            DVec3::new(1.0, 2.0, 0.5),
-            DVec3::new(-2.0, 1.0, 0.3),
-            DVec3::ZERO,
-        ]);
+        let axes = crate::linalg::orthonormalize([DVec3::new(1.0, 2.0, 0.5), DVec3::new(-2.0, 1.0, 0.3), DVec3::ZERO]);
         let axes = [axes[0], axes[1], axes[0].cross(axes[1])];
         let obb = test_obb(DVec3::new(3.0, -1.0, 2.0), axes, DVec3::new(2.0, 1.0, 0.5));
         let proj = Projector::from_obb(&obb, DVec3::ZERO);

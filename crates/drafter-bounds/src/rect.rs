@@ -6,24 +6,26 @@
 
 use glam::DVec2;
 
-/// Indices of the convex hull of `points`, counter-clockwise, without collinear or duplicate vertices.
-/// One index for coincident input, two for collinear input.
-pub(crate) fn convex_hull_2d(points: &[DVec2]) -> Vec<u32> {
+/// Indices of the convex hull of `points`, counter-clockwise. Points within `tol` of an earlier point
+/// (after sorting) or within `tol` of the line through their hull neighbours are dropped, so rounding
+/// noise neither adds near-duplicate vertices (whose edge directions would be noise) nor keeps
+/// collinear ones. One index for coincident input, two for collinear input.
+pub(crate) fn convex_hull_2d(points: &[DVec2], tol: f64) -> Vec<u32> {
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
     order.sort_unstable_by(|&a, &b| {
         let (pa, pb) = (points[a as usize], points[b as usize]);
         pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y)).then(a.cmp(&b))
     });
-    order.dedup_by(|a, b| points[*a as usize] == points[*b as usize]);
+    order.dedup_by(|a, b| points[*a as usize].distance(points[*b as usize]) <= tol);
     if order.len() < 3 {
         return order;
     }
-    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    // Keep b between a and c only for a left turn by more than `tol` (distance of b from line ac).
+    let keep = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a) > tol * (c - a).length();
     let mut hull: Vec<u32> = Vec::with_capacity(2 * order.len());
     for &i in &order {
         while hull.len() >= 2
-            && cross(points[hull[hull.len() - 2] as usize], points[hull[hull.len() - 1] as usize], points[i as usize])
-                <= 0.0
+            && !keep(points[hull[hull.len() - 2] as usize], points[hull[hull.len() - 1] as usize], points[i as usize])
         {
             hull.pop();
         }
@@ -32,8 +34,7 @@ pub(crate) fn convex_hull_2d(points: &[DVec2]) -> Vec<u32> {
     let lower_len = hull.len() + 1;
     for &i in order.iter().rev().skip(1) {
         while hull.len() >= lower_len
-            && cross(points[hull[hull.len() - 2] as usize], points[hull[hull.len() - 1] as usize], points[i as usize])
-                <= 0.0
+            && !keep(points[hull[hull.len() - 2] as usize], points[hull[hull.len() - 1] as usize], points[i as usize])
         {
             hull.pop();
         }
@@ -147,7 +148,7 @@ mod tests {
         for trial in 0..200 {
             let n = 3 + trial % 40;
             let pts: Vec<DVec2> = (0..n).map(|_| DVec2::new(next() * 3.0 - 1.0, next() - 0.5)).collect();
-            let hull = convex_hull_2d(&pts);
+            let hull = convex_hull_2d(&pts, 0.0);
             let poly: Vec<DVec2> = hull.iter().map(|&i| pts[i as usize]).collect();
             // convex and counter-clockwise
             for k in 0..poly.len() {
@@ -165,12 +166,13 @@ mod tests {
 
     #[test]
     fn degenerate_inputs() {
-        assert_eq!(convex_hull_2d(&[]).len(), 0);
-        assert_eq!(convex_hull_2d(&[DVec2::ONE, DVec2::ONE]).len(), 1);
+        assert_eq!(convex_hull_2d(&[], 0.0).len(), 0);
+        assert_eq!(convex_hull_2d(&[DVec2::ONE, DVec2::ONE], 0.0).len(), 1);
         let line: Vec<DVec2> = (0..5).map(|i| DVec2::splat(i as f64)).collect();
-        assert_eq!(convex_hull_2d(&line), vec![0, 4]);
-        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y, DVec2::new(0.5, 0.5)];
-        let h = convex_hull_2d(&square);
+        assert_eq!(convex_hull_2d(&line, 0.0), vec![0, 4]);
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y, DVec2::new(0.5, 0.5), DVec2::new(0.5, -1e-13)];
+        assert_eq!(convex_hull_2d(&square, 0.0).len(), 5);
+        let h = convex_hull_2d(&square, 1e-12);
         assert_eq!(h.len(), 4);
         let poly: Vec<DVec2> = h.iter().map(|&i| square[i as usize]).collect();
         assert!((min_area_rect(&poly).area - 1.0).abs() < 1e-15);

@@ -1,9 +1,15 @@
 //! Orientation search for oriented boxes: candidate orientations from hull features, each completed by
 //! the exact minimum-area rectangle, and local refinement on SO(3).
 //!
+//! Pieces: face normals with slivers resolved (`resolve_slivers`, `distinct_normals`); projections via
+//! silhouettes (`Silhouettes`, `fit_with_normal`); crease edges with their Gauss arcs (`edge_arcs`),
+//! antipodal pairs and perpendicular-arc partners in one pair scan (`edge_pairs`), closed-form edge
+//! triples pruned by width bounds (`edge_triples`); support queries by hill climbing on the hull graph
+//! (`HullGraph`, which also makes each refinement step O(walk) instead of O(hull)).
+//!
 //! All functions work on hull vertices in the local frame (see `hull::LocalPoints`) and are
-//! deterministic: parallel loops only map candidates independently and then pick the minimum by
-//! `(volume, candidate index)`, which does not depend on the thread count.
+//! deterministic: parallel loops only map candidates independently (each with its own scratch state)
+//! and the results are reduced in index order, so nothing depends on the thread count.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -52,12 +58,16 @@ pub(crate) struct HullGraph<'a> {
     pub verts: &'a [DVec3],
     offsets: Vec<u32>,
     neighbours: Vec<u32>,
+    /// Vertices inside a flat facet (all their triangles coplanar): the only places where an ascent
+    /// can stop below the maximum.
+    flat: Vec<bool>,
     /// Values within this of each other count as equal when a walk meets a plateau.
     tol: f64,
 }
 
 impl<'a> HullGraph<'a> {
-    pub(crate) fn new(verts: &'a [DVec3], tris: &[[u32; 3]]) -> Self {
+    /// `normals`: one per triangle, as from [`resolve_slivers`].
+    pub(crate) fn new(verts: &'a [DVec3], tris: &[[u32; 3]], normals: &[DVec3]) -> Self {
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(6 * tris.len());
         for t in tris {
             for k in 0..3 {
@@ -76,7 +86,24 @@ impl<'a> HullGraph<'a> {
         }
         let neighbours = pairs.into_iter().map(|(_, b)| b).collect();
         let scale = verts.iter().fold(0.0f64, |s, v| s.max(v.abs().max_element()));
-        Self { verts, offsets, neighbours, tol: 1e-12 * scale }
+        let mut first: Vec<Option<DVec3>> = vec![None; verts.len()];
+        let mut flat = vec![true; verts.len()];
+        for (t, tri) in tris.iter().enumerate() {
+            if normals[t] == DVec3::ZERO {
+                continue; // an unresolved sliver says nothing about flatness
+            }
+            for &v in tri {
+                match first[v as usize] {
+                    None => first[v as usize] = Some(normals[t]),
+                    Some(n) => {
+                        if n.dot(normals[t]) < 1.0 - 1e-12 {
+                            flat[v as usize] = false;
+                        }
+                    }
+                }
+            }
+        }
+        Self { verts, offsets, neighbours, flat, tol: 1e-12 * scale }
     }
 
     fn neighbours_of(&self, v: u32) -> &[u32] {
@@ -107,8 +134,10 @@ impl<'a> HullGraph<'a> {
             if moved {
                 continue;
             }
-            if !self.neighbours_of(v).iter().any(|&w| value(w) >= best - self.tol) {
-                break; // a strict local maximum: the maximum
+            if !self.flat[v as usize] || !self.neighbours_of(v).iter().any(|&w| value(w) >= best - self.tol) {
+                // A local maximum at a corner of the polytope is the maximum (the simplex method's
+                // optimality condition): only a vertex inside a flat facet can trap the ascent.
+                break;
             }
             match self.escape_plateau(dir, v, best) {
                 Some((w, d)) => {
@@ -125,16 +154,31 @@ impl<'a> HullGraph<'a> {
     /// `best + tol`.
     fn escape_plateau(&self, dir: DVec3, v: u32, best: f64) -> Option<(u32, f64)> {
         let value = |w: u32| dir.dot(self.verts[w as usize]);
-        let mut seen = std::collections::HashSet::new();
+        // Facets are usually small: a list beats hashing until it is long.
+        let mut seen: Vec<u32> = vec![v];
+        let mut seen_set: Option<std::collections::HashSet<u32>> = None;
         let mut stack = vec![v];
-        seen.insert(v);
         while let Some(x) = stack.pop() {
             for &w in self.neighbours_of(x) {
                 let d = value(w);
                 if d > best + self.tol {
                     return Some((w, d));
                 }
-                if d >= best - self.tol && seen.insert(w) {
+                if d < best - self.tol {
+                    continue;
+                }
+                let new = match &mut seen_set {
+                    Some(set) => set.insert(w),
+                    None if seen.contains(&w) => false,
+                    None => {
+                        seen.push(w);
+                        if seen.len() > 64 {
+                            seen_set = Some(seen.iter().copied().collect());
+                        }
+                        true
+                    }
+                };
+                if new {
                     stack.push(w);
                 }
             }
@@ -164,7 +208,8 @@ pub(crate) fn fit_with_normal(verts: &[DVec3], outline: &[u32], n: DVec3, scratc
     let [n, u, v] = frame_from_direction(n);
     scratch.clear();
     scratch.extend(outline.iter().map(|&i| DVec2::new(u.dot(verts[i as usize]), v.dot(verts[i as usize]))));
-    let ring = convex_hull_2d(scratch);
+    let scale = scratch.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let ring = convex_hull_2d(scratch, 1e-12 * scale);
     let poly: Vec<DVec2> = ring.iter().map(|&i| scratch[i as usize]).collect();
     let rect = min_area_rect(&poly);
     let a0 = u * rect.dir.x + v * rect.dir.y;
@@ -253,6 +298,21 @@ pub(crate) fn mesh_edges(tris: &[[u32; 3]]) -> Vec<[u32; 4]> {
         .collect()
 }
 
+/// The smallest width of the hull along any of `normals` (a lower bound of the width in every direction
+/// when `normals` holds every face normal and every antipodal edge-pair direction).
+pub(crate) fn min_width(verts: &[DVec3], normals: &[DVec3]) -> f64 {
+    normals
+        .par_iter()
+        .map(|n| {
+            let (lo, hi) = verts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                let d = n.dot(*v);
+                (lo.min(d), hi.max(d))
+            });
+            hi - lo
+        })
+        .reduce(|| f64::INFINITY, f64::min)
+}
+
 /// Index of the smallest candidate (ties: lowest index).
 pub(crate) fn best_index(candidates: &[Candidate]) -> Option<usize> {
     let mut best: Option<usize> = None;
@@ -307,10 +367,17 @@ pub(crate) fn refine(
     let mut step = start_step;
     let mut evals = 0;
     let s = std::f64::consts::FRAC_1_SQRT_2;
-    let combos: [(f64, f64, f64); 9] =
-        [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (s, s, 0.0), (s, -s, 0.0), (s, 0.0, s), (s, 0.0, -s), (
-            0.0, s, s,
-        ), (0.0, s, -s)];
+    let combos: [(f64, f64, f64); 9] = [
+        (1.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0),
+        (0.0, 0.0, 1.0),
+        (s, s, 0.0),
+        (s, -s, 0.0),
+        (s, 0.0, s),
+        (s, 0.0, -s),
+        (0.0, s, s),
+        (0.0, s, -s),
+    ];
     while step >= min_step && evals < max_evals {
         let mut improved = false;
         let (sin, cos) = step.sin_cos();
@@ -353,6 +420,12 @@ pub(crate) struct EdgeArc {
     /// A hull vertex lowest along `centre`: the opposite side of a box face flush with this edge is
     /// near it (walks start there, and it bounds the box's width from below).
     pub opposite: u32,
+    /// A lower bound of the hull's width along any direction on the arc (0 until `find_opposites`).
+    pub width_lb: f64,
+    /// `cos` and `sin` of `radius` and of `radius + slack`, for angle sums without trigonometric calls.
+    pub cos_r: f64,
+    pub sin_r: f64,
+    pub sin_reach: f64,
 }
 
 /// Unit normals and areas of the hull triangles.
@@ -372,6 +445,67 @@ pub(crate) fn triangle_normals(verts: &[DVec3], tris: &[[u32; 3]]) -> (Vec<DVec3
             (c.normalize_or_zero(), 0.5 * c.length())
         })
         .unzip()
+}
+
+/// Normals with slivers resolved. Quickhull keeps a point that was extreme when inserted even if it
+/// ends up within `eps` of a hull edge (the midpoint of a straight CAD edge, once the edge's ends
+/// arrive): the triangle it forms with that edge is a sliver whose computed normal is noise. Its true
+/// neighbourhood is the plane across its long edge, so a sliver takes that triangle's normal (following
+/// further slivers a few steps); the mid-edge point then sits on a crease between two real faces, as it
+/// geometrically does. Unresolvable slivers get a zero normal (ignored by the callers).
+pub(crate) fn resolve_slivers(verts: &[DVec3], tris: &[[u32; 3]], edges: &[[u32; 4]], eps: f64) -> Vec<DVec3> {
+    let (mut normals, _) = triangle_normals(verts, tris);
+    // Neighbour across each triangle's longest edge.
+    let mut across_long: Vec<Option<u32>> = vec![None; tris.len()];
+    let mut sliver = vec![false; tris.len()];
+    let long_edge = |t: &[u32; 3]| -> (u32, u32, f64) {
+        let p = t.map(|i| verts[i as usize]);
+        let len = [p[0].distance(p[1]), p[1].distance(p[2]), p[2].distance(p[0])];
+        let e = if len[0] >= len[1] && len[0] >= len[2] {
+            0
+        } else if len[1] >= len[2] {
+            1
+        } else {
+            2
+        };
+        let (a, b, m) = (p[e], p[(e + 1) % 3], p[(e + 2) % 3]);
+        let height = (b - a).cross(m - a).length() / len[e].max(f64::MIN_POSITIVE);
+        let (i, j) = (t[e], t[(e + 1) % 3]);
+        (i.min(j), i.max(j), height)
+    };
+    let longs: Vec<(u32, u32, f64)> = tris.iter().map(long_edge).collect();
+    for (t, &(_, _, height)) in longs.iter().enumerate() {
+        sliver[t] = height <= eps || normals[t] == DVec3::ZERO;
+    }
+    if !sliver.iter().any(|s| *s) {
+        return normals;
+    }
+    for &[a, b, t0, t1] in edges {
+        for (t, other) in [(t0, t1), (t1, t0)] {
+            let (la, lb, _) = longs[t as usize];
+            if sliver[t as usize] && (la, lb) == (a.min(b), a.max(b)) {
+                across_long[t as usize] = Some(other);
+            }
+        }
+    }
+    for t in 0..tris.len() {
+        if !sliver[t] {
+            continue;
+        }
+        let mut cur = t;
+        let mut resolved = DVec3::ZERO;
+        for _ in 0..8 {
+            let Some(next) = across_long[cur] else { break };
+            cur = next as usize;
+            if !sliver[cur] {
+                resolved = normals[cur];
+                break;
+            }
+        }
+        normals[t] = resolved;
+    }
+    // Only non-sliver normals are copied, and those never change: the loop order does not matter.
+    normals
 }
 
 /// Distinct face normals with their total areas, largest area first. Triangles whose normals agree to
@@ -460,6 +594,10 @@ pub(crate) fn edge_arcs(verts: &[DVec3], edges: &[[u32; 4]], normals: &[DVec3]) 
             cos_reach: (radius + ARC_SLACK).min(std::f64::consts::FRAC_PI_2).cos(),
             vertex: a,
             opposite: 0,
+            width_lb: 0.0,
+            cos_r: radius.cos(),
+            sin_r: radius.sin(),
+            sin_reach: (radius + ARC_SLACK).min(std::f64::consts::FRAC_PI_2).sin(),
         });
     }
     arcs
@@ -475,26 +613,54 @@ pub(crate) fn find_opposites(graph: &HullGraph<'_>, arcs: &mut [EdgeArc]) {
         let (v, _) = graph.support(-arc.centre, hint);
         arc.opposite = v;
         hint = v;
+        // For n on the arc, |n − centre| ≤ 2 sin(r/2), so n·(p − q) ≥ centre·(p − q) − 2 sin(r/2)|p − q|
+        // with p on the edge and q any hull vertex.
+        let d = graph.verts[arc.vertex as usize] - graph.verts[v as usize];
+        let slack = 2.0 * (0.5 * (arc.radius + ARC_SLACK)).sin() * d.length();
+        arc.width_lb = ((arc.centre.dot(d) - slack) * (1.0 - 1e-9)).max(0.0);
     }
 }
 
-/// Normals `e_i × e_j` of antipodal edge pairs: edge `i` supports the hull in direction `n` and edge `j`
-/// in direction `−n` (or the reverse). A box with that face normal has both edges flush with opposite
-/// faces. Returns `None` when the pair scan would exceed `budget` pair tests.
-pub(crate) fn antipodal_pair_normals(arcs: &[EdgeArc], budget: u64) -> Option<Vec<DVec3>> {
+/// The pairwise relations between crease edges, found in one scan over all pairs.
+#[derive(Clone, Debug)]
+pub(crate) struct EdgePairs {
+    /// Normals `e_i × e_j` of antipodal edge pairs: edge `i` supports the hull in direction `n` and edge
+    /// `j` in `−n` (or the reverse), so a box with that face normal has both edges flush with opposite
+    /// faces.
+    pub antipodal: Vec<DVec3>,
+    /// For each edge `i`, the edges `j > i` whose arcs hold perpendicular directions (candidates for
+    /// adjacent box faces); `None` when there are more than the budget.
+    pub partners: Option<Vec<Vec<u32>>>,
+}
+
+/// Scans all pairs of crease edges. `None` when the scan itself (`E²/2` tests) exceeds `budget`.
+pub(crate) fn edge_pairs(arcs: &[EdgeArc], budget: u64) -> Option<EdgePairs> {
     let e = arcs.len() as u64;
     if e * e.saturating_sub(1) / 2 > budget {
         return None;
     }
-    let per_edge: Vec<Vec<DVec3>> = (0..arcs.len())
+    // Partner lists can be quadratic: stop collecting them once their total passes the budget (the
+    // outcome, "over budget", does not depend on which thread noticed first).
+    let collected = std::sync::atomic::AtomicU64::new(0);
+    let over = std::sync::atomic::AtomicBool::new(false);
+    let per_edge: Vec<(Vec<DVec3>, Vec<u32>)> = (0..arcs.len())
         .into_par_iter()
         .map(|i| {
             let a = arcs[i];
-            let mut out = Vec::new();
-            for b in &arcs[i + 1..] {
-                // Centres must be (nearly) antipodal or equal up to the arcs' radii: |c_a · c_b| ≥ cos(r_a + r_b).
-                let reach = a.radius + b.radius + ARC_SLACK;
-                if reach < std::f64::consts::FRAC_PI_2 && a.centre.dot(b.centre).abs() < reach.cos() {
+            let mut antipodal = Vec::new();
+            let mut partners = Vec::new();
+            let keep_partners = !over.load(std::sync::atomic::Ordering::Relaxed);
+            for (j, b) in arcs.iter().enumerate().skip(i + 1) {
+                // reach = r_a + slack + r_b, by the angle-sum formulas.
+                let cos_reach = a.cos_reach * b.cos_r - a.sin_reach * b.sin_r;
+                let sin_reach = a.sin_reach * b.cos_r + a.cos_reach * b.sin_r;
+                let cos_centres = a.centre.dot(b.centre).abs();
+                // Perpendicular directions on both arcs: the centre lines are at least 90° − reach apart.
+                if keep_partners && (cos_reach <= 0.0 || cos_centres <= sin_reach) {
+                    partners.push(j as u32);
+                }
+                // Antipodal: the centres are (nearly) opposite or equal up to the radii.
+                if cos_reach > 0.0 && cos_centres < cos_reach {
                     continue;
                 }
                 let n = a.dir.cross(b.dir);
@@ -506,17 +672,27 @@ pub(crate) fn antipodal_pair_normals(arcs: &[EdgeArc], budget: u64) -> Option<Ve
                 // n lies on both circles; it (or −n) must be on arc a, and the opposite sign on arc b.
                 let sa = a.centre.dot(n);
                 let sb = b.centre.dot(n);
-                if sa.abs() >= a.cos_reach
-                    && sb.abs() >= b.cos_reach
-                    && sa * sb < 0.0
-                {
-                    out.push(n);
+                if sa.abs() >= a.cos_reach && sb.abs() >= b.cos_reach && sa * sb < 0.0 {
+                    antipodal.push(n);
                 }
             }
-            out
+            if keep_partners {
+                let total = collected.fetch_add(partners.len() as u64, std::sync::atomic::Ordering::Relaxed);
+                if total + partners.len() as u64 > budget {
+                    over.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            }
+            (antipodal, partners)
         })
         .collect();
-    Some(per_edge.into_iter().flatten().collect())
+    let over = over.load(std::sync::atomic::Ordering::Relaxed);
+    let mut antipodal = Vec::new();
+    let mut partners = Vec::with_capacity(per_edge.len());
+    for (a, p) in per_edge {
+        antipodal.extend(a);
+        partners.push(p);
+    }
+    Some(EdgePairs { antipodal, partners: (!over).then_some(partners) })
 }
 
 /// Outcome of the three-edge search.
@@ -536,33 +712,29 @@ pub(crate) struct TripleSearch {
 /// `(n1·e2)(n1·e3) = e2·e3`, i.e. `A cos 2t + B sin 2t = C`: at most two orientations per triple, in
 /// closed form. Pairs whose arcs cannot hold perpendicular directions are pruned first; the search is
 /// skipped (`complete = false`) when its work estimate exceeds `budget`.
-pub(crate) fn edge_triples(graph: &HullGraph<'_>, arcs: &[EdgeArc], budget: u64, limit: f64) -> TripleSearch {
+///
+/// `limit` is the best volume known (from cases 1–2) and `min_width` a lower bound of the hull's width
+/// in every direction: a triple whose arcs' width bounds multiply to `limit` or more cannot win and is
+/// skipped unsolved, and so is every pair for which `w_i · w_j · min_width ≥ limit`.
+pub(crate) fn edge_triples(
+    graph: &HullGraph<'_>,
+    arcs: &[EdgeArc],
+    partners: &[Vec<u32>],
+    budget: u64,
+    limit: f64,
+    min_width: f64,
+) -> TripleSearch {
     let e = arcs.len();
-    let pair_tests = (e as u64) * (e as u64).saturating_sub(1) / 2;
-    if pair_tests > budget {
-        return TripleSearch::default();
-    }
-    // Compatible partners j > i: some n_i on arc i and n_j on arc j (either sign) are perpendicular,
-    // i.e. the angle between the arcs' centre lines is at least 90° − r_i − r_j.
-    let partners: Vec<Vec<u32>> = (0..e)
-        .into_par_iter()
-        .map(|i| {
-            let a = arcs[i];
-            ((i + 1)..e)
-                .filter(|&j| {
-                    let b = arcs[j];
-                    let reach = a.radius + b.radius + ARC_SLACK;
-                    reach >= std::f64::consts::FRAC_PI_2 || a.centre.dot(b.centre).abs() <= reach.sin()
-                })
-                .map(|j| j as u32)
-                .collect()
+    // Pairs that cannot beat `limit` whatever the third width: w_i · w_j · min_width ≥ limit.
+    let partners: Vec<Vec<u32>> = partners
+        .par_iter()
+        .enumerate()
+        .map(|(i, list)| {
+            list.iter().copied().filter(|&j| arcs[i].width_lb * arcs[j as usize].width_lb * min_width < limit).collect()
         })
         .collect();
-    let work: u64 = partners
-        .iter()
-        .map(|list| list.iter().map(|&j| partners[j as usize].len() as u64).sum::<u64>())
-        .sum::<u64>()
-        + pair_tests;
+    let work: u64 =
+        partners.iter().map(|list| list.iter().map(|&j| partners[j as usize].len() as u64).sum::<u64>()).sum::<u64>();
     if work > budget {
         return TripleSearch::default();
     }
@@ -578,18 +750,19 @@ pub(crate) fn edge_triples(graph: &HullGraph<'_>, arcs: &[EdgeArc], budget: u64,
                 }
                 for &j in &partners[i] {
                     let pb = PairBasis::new(&arcs[i], &arcs[j as usize]);
+                    let wij = arcs[i].width_lb * arcs[j as usize].width_lb;
                     for &k in &partners[j as usize] {
-                        if !mark[k as usize] {
+                        if !mark[k as usize] || wij * arcs[k as usize].width_lb >= limit {
                             continue;
                         }
                         let edges = [&arcs[i], &arcs[j as usize], &arcs[k as usize]];
                         for axes in solve_triple(edges[0], edges[1], edges[2], pb).into_iter().flatten() {
                             evaluated += 1;
                             let bound = best.map_or(limit, |(_, v): (Frame, f64)| v.min(limit));
-                            if let Some(volume) = triple_volume(graph, &axes, edges, bound) {
-                                if volume < bound {
-                                    best = Some((axes, volume));
-                                }
+                            if let Some(volume) = triple_volume(graph, &axes, edges, bound)
+                                && volume < bound
+                            {
+                                best = Some((axes, volume));
                             }
                         }
                     }

@@ -5,17 +5,22 @@
 //! * [`Topology`]: a mesh's welded connectivity (edges with their incident faces, face and vertex
 //!   adjacency, components), built in O(n log n) with sorts rather than hash maps so that it is fast and
 //!   deterministic.
+//! * [`gradient`]: the gradient function ω(i, q, f, p) and intensity transfer γ of Lux et al. 2013,
+//!   shared by the stages that bake them (bounds, textures) and the viewer that evaluates them.
 //! * [`Diagnostic`]: recoverable problems of the input, aggregated by kind with a count and a first
 //!   example. Flawed input is data, not a failure.
 //!
 //! Invariant: nothing in this crate reads or writes files.
 
 mod diagnostic;
+pub mod gradient;
 mod ids;
+mod param;
 mod scene;
 mod topology;
 
 pub use diagnostic::{Diagnostic, DiagnosticKind, Diagnostics};
 pub use ids::{EdgeId, InstanceId, MaterialId, MeshId, NodeId, PartId};
+pub use param::ParamError;
 pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceDocument, SourceFormat, TriangleGroup};
 pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld};

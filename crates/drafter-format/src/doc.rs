@@ -13,6 +13,75 @@ pub(crate) const UNSIGNED_SHORT: u32 = 5123;
 pub(crate) const UNSIGNED_INT: u32 = 5125;
 pub(crate) const FLOAT: u32 = 5126;
 
+/// Extensions whose accessor and buffer-view references [`Doc::compact`] knows (or that have none).
+pub(crate) const COMPACTION_SAFE_EXTENSIONS: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_transmission",
+    "KHR_materials_unlit",
+    "KHR_materials_volume",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_variants",
+    "EXT_mesh_gpu_instancing",
+    "EXT_mesh_primitive_edge_visibility",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+];
+
+/// Keys whose integer values are accessor indices, anywhere inside our extension's objects.
+const OWN_ACCESSOR_KEYS: &[&str] = &[
+    "partLabels",
+    "hardEdgeClasses",
+    "candidateCorners",
+    "candidateNormals",
+    "nodeCaps",
+    "nodes",
+    "order",
+    "nodeBoxes",
+    "nodeCones",
+];
+const EDGE_VISIBILITY: &str = "EXT_mesh_primitive_edge_visibility";
+/// Accessor-valued keys of EXT_mesh_primitive_edge_visibility (`indices` inside `lineStrings`).
+const EDGE_VISIBILITY_ACCESSOR_KEYS: &[&str] = &["visibility", "silhouetteNormals", "indices"];
+
+/// Visits every integer value under `keys` in the tree `value`.
+fn visit_keys(value: &mut Value, keys: &[&str], visit: &mut dyn FnMut(&mut Value)) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map.iter_mut() {
+                if keys.contains(&k.as_str()) && v.is_u64() {
+                    visit(v);
+                } else {
+                    visit_keys(v, keys, visit);
+                }
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(|v| visit_keys(v, keys, visit)),
+        _ => {}
+    }
+}
+
+/// For each kept item its new index (`u32::MAX` for dropped items).
+fn renumbering(keep: &[bool]) -> Vec<u32> {
+    let mut next = 0u32;
+    keep.iter()
+        .map(|&k| {
+            if k {
+                next += 1;
+                next - 1
+            } else {
+                u32::MAX
+            }
+        })
+        .collect()
+}
+
 #[derive(Debug)]
 pub(crate) struct Doc {
     pub json: Map<String, Value>,
@@ -58,6 +127,15 @@ impl Doc {
     /// The array at `key` (empty if absent).
     pub fn array(&self, key: &str) -> &[Value] {
         self.json.get(key).and_then(Value::as_array).map_or(&[], Vec::as_slice)
+    }
+
+    /// The array at `key` for in-place edits; empty (and nothing created) if absent, so no empty
+    /// top-level array appears (the spec forbids them).
+    pub fn existing_mut(&mut self, key: &str) -> &mut [Value] {
+        match self.json.get_mut(key) {
+            Some(Value::Array(a)) => a,
+            _ => &mut [],
+        }
     }
 
     /// The array at `key`, created if absent.
@@ -121,6 +199,20 @@ impl Doc {
         self.push_accessor(json!({"bufferView": view, "componentType": FLOAT, "count": values.len(), "type": "VEC2"}))
     }
 
+    /// SCALAR FLOAT data read only by an extension.
+    pub fn push_f32_scalars(&mut self, values: &[f32]) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.push_view(&bytes, None, None);
+        self.push_accessor(json!({"bufferView": view, "componentType": FLOAT, "count": values.len(), "type": "SCALAR"}))
+    }
+
+    /// SCALAR data of exactly this component type (UNSIGNED_BYTE / UNSIGNED_SHORT / UNSIGNED_INT),
+    /// read only by an extension.
+    pub fn push_typed_scalars(&mut self, component: u32, bytes: &[u8], count: usize) -> usize {
+        let view = self.push_view(bytes, None, None);
+        self.push_accessor(json!({"bufferView": view, "componentType": component, "count": count, "type": "SCALAR"}))
+    }
+
     /// Unsigned SCALAR data in the smallest component type that holds `max(values)`.
     /// `target` is ELEMENT_ARRAY_BUFFER for indices, None for data read only by our extension.
     pub fn push_scalars(&mut self, values: &[u32], target: Option<u32>) -> usize {
@@ -139,6 +231,201 @@ impl Doc {
         self.push_accessor(
             json!({"bufferView": view, "componentType": component, "count": values.len(), "type": "SCALAR"}),
         )
+    }
+
+    /// Copies the elements `picks` of a vertex-attribute accessor into a new tightly packed accessor
+    /// (4-byte aligned elements, as the spec requires for vertex data). Works on the raw bytes, so
+    /// any component type passes through unchanged; min/max are dropped (optional for everything
+    /// but POSITION, which callers write themselves). Sparse accessors are not supported.
+    pub fn gather_attribute(&mut self, accessor: usize, picks: &[u32]) -> Result<usize, FormatError> {
+        let bad = |what: &str| FormatError::Source(format!("/accessors/{accessor}: {what}"));
+        let a = self.array("accessors").get(accessor).cloned().ok_or_else(|| bad("missing"))?;
+        if a.get("sparse").is_some() {
+            return Err(bad("sparse vertex attributes cannot be re-laid out"));
+        }
+        let component = match a.get("componentType").and_then(Value::as_u64) {
+            Some(5120 | 5121) => 1,
+            Some(5122 | 5123) => 2,
+            Some(5125 | 5126) => 4,
+            _ => return Err(bad("unknown componentType")),
+        };
+        let components = match a.get("type").and_then(Value::as_str) {
+            Some("SCALAR") => 1,
+            Some("VEC2") => 2,
+            Some("VEC3") => 3,
+            Some("VEC4" | "MAT2") => 4,
+            Some("MAT3") => 9,
+            Some("MAT4") => 16,
+            _ => return Err(bad("unknown type")),
+        };
+        let element = component * components;
+        let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
+        let view = self.array("bufferViews").get(view_index).cloned().ok_or_else(|| bad("bufferView missing"))?;
+        let stride = view.get("byteStride").and_then(Value::as_u64).map_or(element, |s| s as usize);
+        let base = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize
+            + a.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+        let count = a.get("count").and_then(Value::as_u64).unwrap_or(0) as usize;
+        let padded = element.next_multiple_of(4);
+        let mut bytes = Vec::with_capacity(picks.len() * padded);
+        for &i in picks {
+            let i = i as usize;
+            if i >= count {
+                return Err(bad("vertex index out of range"));
+            }
+            let start = base + i * stride;
+            let data = self.bin.get(start..start + element).ok_or_else(|| bad("data outside the buffer"))?;
+            bytes.extend_from_slice(data);
+            bytes.resize(bytes.len() + padded - element, 0);
+        }
+        let view = self.push_view(&bytes, Some(ARRAY_BUFFER), (padded != element).then_some(padded));
+        let mut out =
+            json!({"bufferView": view, "componentType": a["componentType"], "count": picks.len(), "type": a["type"]});
+        if a.get("normalized").and_then(Value::as_bool) == Some(true) {
+            out["normalized"] = true.into();
+        }
+        Ok(self.push_accessor(out))
+    }
+
+    /// Drops accessors and buffer views nothing refers to (the source vertex data that a new layout
+    /// replaced) and rebuilds the binary buffer from the views that remain, renumbering every
+    /// reference. References are looked for in every place the glTF 2.0 spec and the extensions in
+    /// [`COMPACTION_SAFE_EXTENSIONS`] put them; a document that uses any other extension might refer
+    /// to accessors from places unknown here, so it is left as it is (returns false).
+    pub fn compact(&mut self, own_extension: &str) -> bool {
+        let used = self.array("extensionsUsed").iter().filter_map(Value::as_str).map(str::to_owned).collect::<Vec<_>>();
+        if used.iter().any(|e| e != own_extension && !COMPACTION_SAFE_EXTENSIONS.contains(&e.as_str())) {
+            return false;
+        }
+        let accessor_count = self.array("accessors").len();
+        let view_count = self.array("bufferViews").len();
+        // 1. Which accessors are referenced.
+        let mut keep_accessor = vec![false; accessor_count];
+        self.visit_accessor_refs(own_extension, &mut |i| {
+            if let Some(k) = keep_accessor.get_mut(*i as usize) {
+                *k = true;
+            }
+        });
+        let accessor_map = renumbering(&keep_accessor);
+        // 2. Which buffer views: those of kept accessors (and their sparse parts) and of images.
+        let mut keep_view = vec![false; view_count];
+        for (a, accessor) in self.array("accessors").iter().enumerate() {
+            if !keep_accessor[a] {
+                continue;
+            }
+            for pointer in ["/bufferView", "/sparse/indices/bufferView", "/sparse/values/bufferView"] {
+                if let Some(v) = accessor.pointer(pointer).and_then(Value::as_u64)
+                    && let Some(k) = keep_view.get_mut(v as usize)
+                {
+                    *k = true;
+                }
+            }
+        }
+        for image in self.array("images") {
+            if let Some(v) = image.get("bufferView").and_then(Value::as_u64)
+                && let Some(k) = keep_view.get_mut(v as usize)
+            {
+                *k = true;
+            }
+        }
+        let view_map = renumbering(&keep_view);
+        // 3. New buffer from the kept views, 4-byte aligned.
+        let old_bin = std::mem::take(&mut self.bin);
+        let mut views = Vec::new();
+        for (v, view) in std::mem::take(self.array_mut("bufferViews")).into_iter().enumerate() {
+            if !keep_view[v] {
+                continue;
+            }
+            let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+            let length = view.get("byteLength").and_then(Value::as_u64).unwrap_or(0) as usize;
+            self.align(4);
+            let mut view = view;
+            view["byteOffset"] = self.bin.len().into();
+            self.bin.extend_from_slice(old_bin.get(start..start + length).unwrap_or_default());
+            views.push(view);
+        }
+        *self.array_mut("bufferViews") = views;
+        // 4. Renumber.
+        let accessors: Vec<Value> = std::mem::take(self.array_mut("accessors"))
+            .into_iter()
+            .enumerate()
+            .filter(|(a, _)| keep_accessor[*a])
+            .map(|(_, mut accessor)| {
+                for pointer in ["/bufferView", "/sparse/indices/bufferView", "/sparse/values/bufferView"] {
+                    if let Some(slot) = accessor.pointer_mut(pointer)
+                        && let Some(v) = slot.as_u64()
+                    {
+                        *slot = view_map[v as usize].into();
+                    }
+                }
+                accessor
+            })
+            .collect();
+        *self.array_mut("accessors") = accessors;
+        for image in self.existing_mut("images") {
+            if let Some(slot) = image.get_mut("bufferView")
+                && let Some(v) = slot.as_u64()
+            {
+                *slot = view_map[v as usize].into();
+            }
+        }
+        self.visit_accessor_refs(own_extension, &mut |i| *i = u64::from(accessor_map[*i as usize]));
+        true
+    }
+
+    /// Calls `f` on every accessor reference of the document (glTF 2.0 core, EXT_mesh_gpu_instancing
+    /// and our own extension's `partLabels`).
+    fn visit_accessor_refs(&mut self, own_extension: &str, f: &mut dyn FnMut(&mut u64)) {
+        let mut visit = |v: &mut Value| {
+            if let Some(mut i) = v.as_u64() {
+                f(&mut i);
+                *v = i.into();
+            }
+        };
+        for mesh in self.existing_mut("meshes") {
+            for prim in mesh.get_mut("primitives").and_then(Value::as_array_mut).into_iter().flatten() {
+                for (_, a) in prim.get_mut("attributes").and_then(Value::as_object_mut).into_iter().flatten() {
+                    visit(a);
+                }
+                if let Some(i) = prim.get_mut("indices") {
+                    visit(i);
+                }
+                for target in prim.get_mut("targets").and_then(Value::as_array_mut).into_iter().flatten() {
+                    for (_, a) in target.as_object_mut().into_iter().flatten() {
+                        visit(a);
+                    }
+                }
+                if let Some(ext) = prim.pointer_mut(&format!("/extensions/{own_extension}")) {
+                    visit_keys(ext, OWN_ACCESSOR_KEYS, &mut visit);
+                }
+                if let Some(ext) = prim.pointer_mut(&format!("/extensions/{EDGE_VISIBILITY}")) {
+                    visit_keys(ext, EDGE_VISIBILITY_ACCESSOR_KEYS, &mut visit);
+                }
+            }
+            if let Some(ext) = mesh.pointer_mut(&format!("/extensions/{own_extension}")) {
+                visit_keys(ext, OWN_ACCESSOR_KEYS, &mut visit);
+            }
+        }
+        for skin in self.existing_mut("skins") {
+            if let Some(i) = skin.get_mut("inverseBindMatrices") {
+                visit(i);
+            }
+        }
+        for animation in self.existing_mut("animations") {
+            for sampler in animation.get_mut("samplers").and_then(Value::as_array_mut).into_iter().flatten() {
+                for key in ["input", "output"] {
+                    if let Some(i) = sampler.get_mut(key) {
+                        visit(i);
+                    }
+                }
+            }
+        }
+        for node in self.existing_mut("nodes") {
+            let instancing =
+                node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes").and_then(Value::as_object_mut);
+            for (_, a) in instancing.into_iter().flatten() {
+                visit(a);
+            }
+        }
     }
 
     /// Adds `name` to `extensionsUsed` once.

@@ -24,7 +24,28 @@ pub struct RootExtension {
     pub scene_center: [f64; 3],
     /// Number of parts; part ids are `0..partCount`.
     pub part_count: u32,
+    /// How the normals were computed, when the bake wrote them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normals: Option<NormalsInfo>,
 }
+
+/// The normal stage's parameters (Cignoni et al. 2005), for provenance and for a viewer's toggle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct NormalsInfo {
+    /// Enhancement strength k of n_E = normalize(n + k·(n − n_L)).
+    pub strength: f64,
+    /// Low-pass iterations.
+    pub iterations: u32,
+    /// Crease angle of the vertex normals, degrees.
+    pub crease_angle_deg: f64,
+    /// True when `NORMAL` holds the enhanced normals (for plain viewers) and the attribute named by
+    /// `enhancedNormal` holds the crease-aware ones.
+    pub enhanced_in_normal: bool,
+}
+
+/// Name of the vertex attribute with the other set of normals (see [`NormalsInfo`]).
+pub const ENHANCED_NORMAL_ATTRIBUTE: &str = "_ENHANCED_NORMAL";
 
 /// Where the bake came from.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -113,4 +134,89 @@ pub struct PrimitiveExtension {
     /// primitive, in primitive order; the part is `node.parts[label]`. Absent: label 0 for all.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub part_labels: Option<u32>,
+    /// Name of the `_`-prefixed VEC3 float attribute with the enhanced normals (Cignoni et al.
+    /// 2005) — or, when the root's `normals.enhancedInNormal` is true, the crease-aware ones.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub enhanced_normal: Option<String>,
+    /// Accessor (SCALAR, UNSIGNED_BYTE): the class of each hard edge that
+    /// `EXT_mesh_primitive_edge_visibility` encodes as 2, in encoding order (see [`HardEdgeClass`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hard_edge_classes: Option<u32>,
+}
+
+/// The name of the draft Khronos extension the hard edges and silhouette candidates are written in.
+pub const EDGE_VISIBILITY_EXTENSION: &str = "EXT_mesh_primitive_edge_visibility";
+
+/// Codes of `hardEdgeClasses`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum HardEdgeClass {
+    /// Dihedral angle above the crease angle: drawn white in Gooch's convention.
+    Crease = 1,
+    /// One incident face: drawn black.
+    Boundary = 2,
+    /// Between faces of different parts: drawn black.
+    PartBorder = 3,
+    /// Three or more incident faces: drawn black.
+    NonManifold = 4,
+}
+
+/// Mesh-level object: data that spans all primitives of a mesh.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct MeshExtension {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub silhouettes: Option<SilhouettesRecord>,
+}
+
+/// The silhouette candidates of a mesh and the hierarchies that answer "which are silhouettes from
+/// here" (Gooch et al. 1999 Gauss map for orthographic views, a normal-cone BVH for eye points).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct SilhouettesRecord {
+    pub candidates: u32,
+    /// Accessor (SCALAR, UNSIGNED_INT): for candidate i, `3·t + k` — edge k (v_k → v_(k+1)) of
+    /// triangle t of the mesh, counting triangles through the primitives in order.
+    pub candidate_corners: u32,
+    /// Accessor (SCALAR, FLOAT): 6 per candidate, the two face normals (x, y, z each) in full
+    /// precision. A candidate is a silhouette for view direction u iff (n1·u) and (n2·u) have
+    /// strictly opposite signs (for an eye e: n·(e − v), v the edge's first vertex).
+    pub candidate_normals: u32,
+    /// `gaussMap` or `bruteForce`: what answers orthographic views.
+    pub orthographic: String,
+    /// `coneBvh` or `bruteForce`: what answers perspective views.
+    pub perspective: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gauss_map: Option<GaussMapRecord>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cone_bvh: Option<ConeBvhRecord>,
+}
+
+/// Gauss-map arc hierarchy arrays (accessors). See drafter-lines' `GaussMapArrays`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct GaussMapRecord {
+    /// 0 octahedron, 1 icosahedron.
+    pub base: u32,
+    pub max_depth: u32,
+    /// FLOAT, 4 per node: cap centre and cull threshold.
+    pub node_caps: u32,
+    /// UNSIGNED_INT, 4 per node: first child, child count, first own arc, end of own arcs.
+    pub nodes: u32,
+    /// UNSIGNED_INT: candidate index of each stored arc.
+    pub order: u32,
+}
+
+/// Normal-cone BVH arrays (accessors). See drafter-lines' `ConeBvhArrays`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct ConeBvhRecord {
+    /// FLOAT, 6 per node: box min, max.
+    pub node_boxes: u32,
+    /// FLOAT, 4 per node: cone axis and cull threshold.
+    pub node_cones: u32,
+    /// UNSIGNED_INT, 4 per node: first child, child count, first own candidate, end.
+    pub nodes: u32,
+    /// UNSIGNED_INT: candidate index of each stored candidate.
+    pub order: u32,
 }

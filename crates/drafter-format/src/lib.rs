@@ -15,11 +15,14 @@ mod reader;
 mod writer;
 
 pub use ext::{
-    BoxRecord, EXTENSION, FORMAT_VERSION, GradientRecord, InputInfo, NodeExtension, PartRecord, PrimitiveExtension,
-    ProjectorRecord, RootExtension,
+    BoxRecord, ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION,
+    GaussMapRecord, GradientRecord, HardEdgeClass, InputInfo, MeshExtension, NodeExtension, NormalsInfo, PartRecord,
+    PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord,
 };
 pub use reader::{BakedFile, read, read_scalars, split_container};
-pub use writer::{BakeOutput, Container, Written, write};
+pub use writer::{
+    BakeOutput, ConeBvhData, Container, GaussMapData, MeshSilhouettes, PrimitiveEdges, VertexData, Written, write,
+};
 
 /// `drafter <version>`, written as the generator.
 pub const GENERATOR: &str = concat!("drafter ", env!("CARGO_PKG_VERSION"));

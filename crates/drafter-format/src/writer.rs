@@ -10,8 +10,11 @@ use drafter_core::{Mesh, Scene, TriangleGroup};
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
-use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER};
-use crate::ext::{EXTENSION, NodeExtension, PartRecord, PrimitiveExtension, RootExtension};
+use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER, UNSIGNED_BYTE, UNSIGNED_INT, UNSIGNED_SHORT};
+use crate::ext::{
+    ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, GaussMapRecord, MeshExtension,
+    NodeExtension, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord,
+};
 
 /// Everything a bake produced, ready to write.
 #[derive(Clone, Debug)]
@@ -22,6 +25,71 @@ pub struct BakeOutput<'a> {
     pub instance_parts: Vec<Vec<PartRecord>>,
     /// For each scene mesh, the part label of each triangle (`None`: the whole mesh is label 0).
     pub mesh_labels: Vec<Option<Vec<u32>>>,
+    /// For each scene mesh, a new vertex layout with normals (`None`: keep the mesh's own).
+    pub vertex_data: Vec<Option<VertexData>>,
+    /// For each scene mesh, for each triangle group (primitive), its encoded edges.
+    pub primitive_edges: Vec<Vec<Option<PrimitiveEdges>>>,
+    /// For each scene mesh, its silhouette candidates and hierarchies.
+    pub mesh_silhouettes: Vec<Option<MeshSilhouettes>>,
+}
+
+/// One primitive's edges: `EXT_mesh_primitive_edge_visibility` data plus the class of each hard
+/// edge.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PrimitiveEdges {
+    /// 2 bits per triangle edge (the draft's `visibility`).
+    pub visibility: Vec<u8>,
+    /// Two oct16 normals per silhouette candidate encoded as 1, in encoding order.
+    pub silhouette_normals: Vec<u16>,
+    /// [`crate::ext::HardEdgeClass`] code of each edge encoded as 2, in encoding order.
+    pub hard_edge_classes: Vec<u8>,
+}
+
+/// A mesh's silhouette candidates and hierarchies, as flat arrays.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshSilhouettes {
+    /// `3·t + k` of each candidate (edge k of mesh triangle t).
+    pub candidate_corners: Vec<u32>,
+    /// 6 floats per candidate: both face normals.
+    pub candidate_normals: Vec<f32>,
+    /// `gaussMap` or `bruteForce`.
+    pub orthographic: String,
+    /// `coneBvh` or `bruteForce`.
+    pub perspective: String,
+    pub gauss_map: Option<GaussMapData>,
+    pub cone_bvh: Option<ConeBvhData>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GaussMapData {
+    pub base: u32,
+    pub max_depth: u32,
+    pub node_caps: Vec<f32>,
+    pub nodes: Vec<u32>,
+    pub order: Vec<u32>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConeBvhData {
+    pub node_boxes: Vec<f32>,
+    pub node_cones: Vec<f32>,
+    pub nodes: Vec<u32>,
+    pub order: Vec<u32>,
+}
+
+/// A mesh's vertices re-laid out by the normal stage: every output vertex copies the attributes of
+/// one mesh vertex and carries two normals.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VertexData {
+    /// For each output vertex, a mesh vertex (index into `Mesh::positions`) it copies. Where an
+    /// output vertex spans several glTF primitives, the writer takes each primitive's own corner.
+    pub source_vertex: Vec<u32>,
+    /// The mesh's triangles in output vertex ids, same order and winding as `Mesh::triangles`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Written as `NORMAL`; unit length.
+    pub normals: Vec<[f32; 3]>,
+    /// Written as [`ENHANCED_NORMAL_ATTRIBUTE`]; unit length.
+    pub enhanced: Vec<[f32; 3]>,
 }
 
 /// The file layout to write.
@@ -40,18 +108,30 @@ pub struct Written {
     pub main: Vec<u8>,
     /// The .bin of a .gltf container.
     pub bin: Option<Vec<u8>>,
+    /// Things the writer could not do as asked (e.g. primitives whose vertices it could not re-lay
+    /// out), one line each.
+    pub notes: Vec<String>,
 }
 
 /// Serialises `out`. Deterministic: the same input gives the same bytes.
 pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatError> {
     let scene = out.scene;
-    if out.instance_parts.len() != scene.instances.len() || out.mesh_labels.len() != scene.meshes.len() {
-        return Err(FormatError::Inconsistent("instance_parts / mesh_labels do not match the scene".into()));
+    if out.instance_parts.len() != scene.instances.len()
+        || out.mesh_labels.len() != scene.meshes.len()
+        || out.vertex_data.len() != scene.meshes.len()
+        || out.primitive_edges.len() != scene.meshes.len()
+        || out.mesh_silhouettes.len() != scene.meshes.len()
+    {
+        return Err(FormatError::Inconsistent(
+            "instance_parts / mesh_labels / vertex_data do not match the scene".into(),
+        ));
     }
+    let from_source = scene.source.is_some();
     let mut doc = match &scene.source {
         Some(source) => Doc::from_source(&source.json, &source.buffers)?,
         None => synthesize(scene),
     };
+    let mut notes = Vec::new();
     // Node index of each instance: the source node, or the synthesized node i.
     let node_of = |i: usize| scene.instances[i].node.map_or(i, |n| n.index());
     for (i, parts) in out.instance_parts.iter().enumerate() {
@@ -63,20 +143,73 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
         extension_slot(node).insert(EXTENSION.into(), ext);
     }
     for (m, mesh) in scene.meshes.iter().enumerate() {
-        let used = scene.source.is_some();
         for (g, group) in mesh.groups.iter().enumerate() {
-            let primitive = if used { group.primitive.map_or(g, |p| p as usize) } else { g };
-            if used {
-                rewrite_if_faces_dropped(&mut doc, mesh, m, primitive, group)?;
+            let primitive = if from_source { group.primitive.map_or(g, |p| p as usize) } else { g };
+            let mut enhanced_normal = None;
+            let relaid = match &out.vertex_data[m] {
+                Some(vd) => match write_vertex_data(&mut doc, mesh, m, primitive, group, vd, from_source) {
+                    Ok(()) => {
+                        enhanced_normal = Some(ENHANCED_NORMAL_ATTRIBUTE.to_owned());
+                        true
+                    }
+                    Err(reason) => {
+                        notes.push(format!("mesh {m} primitive {primitive}: normals not written ({reason})"));
+                        false
+                    }
+                },
+                None => false,
+            };
+            if !relaid {
+                if from_source {
+                    rewrite_if_faces_dropped(&mut doc, mesh, m, primitive, group)?;
+                } else {
+                    write_mesh_vertices(&mut doc, mesh, m, primitive, group)?;
+                }
             }
-            let Some(labels) = &out.mesh_labels[m] else { continue };
-            let range = group.start as usize..(group.start + group.count) as usize;
-            let slice =
-                labels.get(range).ok_or_else(|| FormatError::Inconsistent(format!("mesh {m}: too few labels")))?;
-            let accessor = doc.push_scalars(slice, None) as u32;
-            let ext = serde_json::to_value(PrimitiveExtension { part_labels: Some(accessor) })?;
+            let part_labels = match &out.mesh_labels[m] {
+                Some(labels) => {
+                    let range = group.start as usize..(group.start + group.count) as usize;
+                    let slice = labels
+                        .get(range)
+                        .ok_or_else(|| FormatError::Inconsistent(format!("mesh {m}: too few labels")))?;
+                    Some(doc.push_scalars(slice, None) as u32)
+                }
+                None => None,
+            };
+            let edges = out.primitive_edges[m].get(g).and_then(Option::as_ref);
+            let mut hard_edge_classes = None;
+            if let Some(edges) = edges {
+                let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
+                let mut ext = json!({"visibility": visibility});
+                if !edges.silhouette_normals.is_empty() {
+                    let bytes: Vec<u8> = edges.silhouette_normals.iter().flat_map(|v| v.to_le_bytes()).collect();
+                    ext["silhouetteNormals"] =
+                        doc.push_typed_scalars(UNSIGNED_SHORT, &bytes, edges.silhouette_normals.len()).into();
+                }
+                if !edges.hard_edge_classes.is_empty() {
+                    hard_edge_classes = Some(doc.push_typed_scalars(
+                        UNSIGNED_BYTE,
+                        &edges.hard_edge_classes,
+                        edges.hard_edge_classes.len(),
+                    ) as u32);
+                }
+                let prim = primitive_mut(&mut doc, m, primitive)?;
+                extension_slot(prim).insert(EDGE_VISIBILITY_EXTENSION.into(), ext);
+                doc.use_extension(EDGE_VISIBILITY_EXTENSION);
+            }
+            if part_labels.is_none() && enhanced_normal.is_none() && hard_edge_classes.is_none() {
+                continue;
+            }
+            let ext = serde_json::to_value(PrimitiveExtension { part_labels, enhanced_normal, hard_edge_classes })?;
             let prim = primitive_mut(&mut doc, m, primitive)?;
             extension_slot(prim).insert(EXTENSION.into(), ext);
+        }
+        if let Some(sil) = &out.mesh_silhouettes[m] {
+            let record = silhouettes_record(&mut doc, sil);
+            let ext = serde_json::to_value(MeshExtension { silhouettes: Some(record) })?;
+            let mesh_json =
+                doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
+            extension_slot(mesh_json).insert(EXTENSION.into(), ext);
         }
     }
     let root_ext = serde_json::to_value(&out.root)?;
@@ -85,12 +218,141 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
         map.insert(EXTENSION.into(), root_ext);
     }
     doc.use_extension(EXTENSION);
+    if from_source && !doc.compact(EXTENSION) {
+        notes
+            .push("the input uses extensions drafter does not know; replaced vertex data is kept in the buffer".into());
+    }
     match container {
-        Container::Glb => Ok(Written { main: doc.into_glb()?, bin: None }),
+        Container::Glb => Ok(Written { main: doc.into_glb()?, bin: None, notes }),
         Container::Gltf { bin_uri } => {
             let (main, bin) = doc.into_gltf(bin_uri)?;
-            Ok(Written { main, bin: Some(bin) })
+            Ok(Written { main, bin: Some(bin), notes })
         }
+    }
+}
+
+/// Replaces a primitive's vertex attributes and indices by the new layout of `vd`, restricted to
+/// the primitive's triangles and renumbered in order of first use. Attributes the scene model does
+/// not hold (colours, tangents, `_` attributes, more texture coordinates) are gathered from the
+/// source bytes. Fails, changing nothing, for primitives with morph targets or sparse attributes.
+fn write_vertex_data(
+    doc: &mut Doc,
+    mesh: &Mesh,
+    m: usize,
+    primitive: usize,
+    group: &TriangleGroup,
+    vd: &VertexData,
+    from_source: bool,
+) -> Result<(), String> {
+    let range = group.start as usize..(group.start + group.count) as usize;
+    let mut local_of = vec![u32::MAX; vd.source_vertex.len()];
+    // Output vertex and the mesh vertex it copies here: the corner where it is first used in this
+    // primitive (an output vertex may merge corners of several primitives; each keeps its own).
+    let mut picks: Vec<(u32, u32)> = Vec::new();
+    let mut triangles: Vec<u32> = Vec::with_capacity(range.len() * 3);
+    for (t, mesh_triangle) in vd.triangles[range.clone()].iter().zip(&mesh.triangles[range]) {
+        for (&o, &v) in t.iter().zip(mesh_triangle) {
+            if local_of[o as usize] == u32::MAX {
+                local_of[o as usize] = picks.len() as u32;
+                picks.push((o, v));
+            }
+            triangles.push(local_of[o as usize]);
+        }
+    }
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?.clone();
+    if prim.get("targets").is_some() {
+        return Err("the primitive has morph targets".into());
+    }
+    let source_local: Vec<u32> = picks.iter().map(|&(_, v)| v - group.first_vertex).collect();
+    let mut attributes = Map::new();
+    if from_source {
+        let source = prim.get("attributes").and_then(Value::as_object).cloned().unwrap_or_default();
+        for (name, accessor) in &source {
+            if matches!(name.as_str(), "POSITION" | "NORMAL") || name == ENHANCED_NORMAL_ATTRIBUTE {
+                continue;
+            }
+            let accessor = accessor.as_u64().ok_or("attribute is not an accessor index")? as usize;
+            let gathered = doc.gather_attribute(accessor, &source_local).map_err(|e| e.to_string())?;
+            attributes.insert(name.clone(), gathered.into());
+        }
+    } else if let Some(uvs) = &mesh.uvs {
+        let uv: Vec<[f32; 2]> = picks.iter().map(|&(_, v)| uvs[v as usize].to_array()).collect();
+        attributes.insert("TEXCOORD_0".into(), doc.push_vec2(&uv).into());
+    }
+    let positions: Vec<[f32; 3]> = picks.iter().map(|&(_, v)| mesh.positions[v as usize].to_array()).collect();
+    let normals: Vec<[f32; 3]> = picks.iter().map(|&(o, _)| vd.normals[o as usize]).collect();
+    let enhanced: Vec<[f32; 3]> = picks.iter().map(|&(o, _)| vd.enhanced[o as usize]).collect();
+    attributes.insert("POSITION".into(), doc.push_vec3(&positions, true).into());
+    attributes.insert("NORMAL".into(), doc.push_vec3(&normals, false).into());
+    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_vec3(&enhanced, false).into());
+    let indices = doc.push_scalars(&triangles, Some(ELEMENT_ARRAY_BUFFER));
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
+    prim["attributes"] = Value::Object(attributes);
+    prim["indices"] = indices.into();
+    if let Value::Object(map) = prim {
+        map.remove("mode");
+    }
+    Ok(())
+}
+
+/// The mesh's own vertices for a synthesized primitive (no new layout).
+fn write_mesh_vertices(
+    doc: &mut Doc,
+    mesh: &Mesh,
+    m: usize,
+    primitive: usize,
+    group: &TriangleGroup,
+) -> Result<(), FormatError> {
+    let vertices = group.first_vertex as usize..(group.first_vertex + group.vertex_count) as usize;
+    let positions: Vec<[f32; 3]> = mesh.positions[vertices.clone()].iter().map(|p| p.to_array()).collect();
+    let mut attributes = json!({"POSITION": doc.push_vec3(&positions, true)});
+    if let Some(normals) = &mesh.normals {
+        // The spec requires unit normals; skip the attribute if any cannot be normalised.
+        let unit: Option<Vec<[f32; 3]>> =
+            normals[vertices.clone()].iter().map(|n| n.try_normalize().map(|n| n.to_array())).collect();
+        if let Some(unit) = unit {
+            attributes["NORMAL"] = doc.push_vec3(&unit, false).into();
+        }
+    }
+    if let Some(uvs) = &mesh.uvs {
+        let uv: Vec<[f32; 2]> = uvs[vertices].iter().map(|t| t.to_array()).collect();
+        attributes["TEXCOORD_0"] = doc.push_vec2(&uv).into();
+    }
+    let range = group.start as usize..(group.start + group.count) as usize;
+    let local: Vec<u32> = mesh.triangles[range].iter().flatten().map(|&v| v - group.first_vertex).collect();
+    let indices = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
+    let prim = primitive_mut(doc, m, primitive)?;
+    prim["attributes"] = attributes;
+    prim["indices"] = indices.into();
+    Ok(())
+}
+
+fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord {
+    let u32_bytes = |v: &[u32]| -> Vec<u8> { v.iter().flat_map(|x| x.to_le_bytes()).collect() };
+    let candidate_corners =
+        doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&sil.candidate_corners), sil.candidate_corners.len()) as u32;
+    let candidate_normals = doc.push_f32_scalars(&sil.candidate_normals) as u32;
+    let gauss_map = sil.gauss_map.as_ref().map(|g| GaussMapRecord {
+        base: g.base,
+        max_depth: g.max_depth,
+        node_caps: doc.push_f32_scalars(&g.node_caps) as u32,
+        nodes: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&g.nodes), g.nodes.len()) as u32,
+        order: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&g.order), g.order.len()) as u32,
+    });
+    let cone_bvh = sil.cone_bvh.as_ref().map(|b| ConeBvhRecord {
+        node_boxes: doc.push_f32_scalars(&b.node_boxes) as u32,
+        node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
+        nodes: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&b.nodes), b.nodes.len()) as u32,
+        order: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&b.order), b.order.len()) as u32,
+    });
+    SilhouettesRecord {
+        candidates: sil.candidate_corners.len() as u32,
+        candidate_corners,
+        candidate_normals,
+        orthographic: sil.orthographic.clone(),
+        perspective: sil.perspective.clone(),
+        gauss_map,
+        cone_bvh,
     }
 }
 
@@ -173,34 +435,20 @@ fn synthesize(scene: &Scene) -> Doc {
     if !materials.is_empty() {
         doc.json.insert("materials".into(), Value::Array(materials));
     }
+    // Primitives get their attributes and indices from `write`, with or without a new layout.
     let mut meshes = Vec::with_capacity(scene.meshes.len());
     for mesh in &scene.meshes {
-        let mut primitives = Vec::new();
-        for group in &mesh.groups {
-            let vertices = group.first_vertex as usize..(group.first_vertex + group.vertex_count) as usize;
-            let positions: Vec<[f32; 3]> = mesh.positions[vertices.clone()].iter().map(|p| p.to_array()).collect();
-            let mut attributes = json!({"POSITION": doc.push_vec3(&positions, true)});
-            if let Some(normals) = &mesh.normals {
-                // The spec requires unit normals; skip the attribute if any cannot be normalised.
-                let unit: Option<Vec<[f32; 3]>> =
-                    normals[vertices.clone()].iter().map(|n| n.try_normalize().map(|n| n.to_array())).collect();
-                if let Some(unit) = unit {
-                    attributes["NORMAL"] = doc.push_vec3(&unit, false).into();
+        let primitives: Vec<Value> = mesh
+            .groups
+            .iter()
+            .map(|group| {
+                let mut primitive = json!({"attributes": {}});
+                if let Some(material) = group.material {
+                    primitive["material"] = material.0.into();
                 }
-            }
-            if let Some(uvs) = &mesh.uvs {
-                let uv: Vec<[f32; 2]> = uvs[vertices].iter().map(|t| t.to_array()).collect();
-                attributes["TEXCOORD_0"] = doc.push_vec2(&uv).into();
-            }
-            let range = group.start as usize..(group.start + group.count) as usize;
-            let local: Vec<u32> = mesh.triangles[range].iter().flatten().map(|&v| v - group.first_vertex).collect();
-            let mut primitive =
-                json!({"attributes": attributes, "indices": doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER))});
-            if let Some(material) = group.material {
-                primitive["material"] = material.0.into();
-            }
-            primitives.push(primitive);
-        }
+                primitive
+            })
+            .collect();
         let mut m = json!({"primitives": primitives});
         if !mesh.name.is_empty() {
             m["name"] = mesh.name.clone().into();

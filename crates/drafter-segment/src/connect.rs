@@ -45,8 +45,8 @@ impl Orientation {
 
 /// Edges along which a face has no partner.
 pub(crate) struct FreeEdges {
-    /// Non-manifold edges whose faces could not be paired.
-    pub(crate) unpaired: usize,
+    /// Non-manifold edges whose faces could not be paired, increasing.
+    pub(crate) unpaired: Vec<u32>,
     /// Faces with a boundary edge or an unpaired non-manifold edge.
     pub(crate) open_faces: Vec<bool>,
 }
@@ -57,11 +57,11 @@ pub(crate) struct FreeEdges {
 /// could not be paired (left unjoined).
 fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
     let orientation = Orientation::new(topo);
-    let (unpaired, open) = (0..topo.edge_count())
+    let (mut unpaired, open) = (0..topo.edge_count())
         .into_par_iter()
         .with_min_len(1 << 14)
         .fold(
-            || (0usize, Vec::new(), Vec::new()),
+            || (Vec::new(), Vec::new(), Vec::new()),
             |(mut unpaired, mut open, mut fan), e| {
                 let faces = topo.faces_of_edge(e);
                 match faces.len() {
@@ -70,7 +70,7 @@ fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
                     2 => link(faces[0], faces[1]),
                     _ => {
                         if !radial_pairs(topo, &orientation, e, faces, &mut fan, &link) {
-                            unpaired += 1;
+                            unpaired.push(e as u32);
                             open.extend_from_slice(faces);
                         }
                     }
@@ -80,12 +80,14 @@ fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
         )
         .map(|(unpaired, open, _)| (unpaired, open))
         .reduce(
-            || (0, Vec::new()),
-            |(u1, mut o1), (u2, mut o2)| {
+            || (Vec::new(), Vec::new()),
+            |(mut u1, mut o1), (mut u2, mut o2)| {
+                u1.append(&mut u2);
                 o1.append(&mut o2);
-                (u1 + u2, o1)
+                (u1, o1)
             },
         );
+    unpaired.sort_unstable();
     let mut open_faces = vec![false; topo.faces.len()];
     for f in open {
         open_faces[f as usize] = true;
@@ -124,7 +126,8 @@ fn radial_pairs(
             return false;
         };
         let forward = tri[k] == a;
-        let forward = forward != orientation.inside_out[topo.face_component[f as usize] as usize];
+        let inside_out = orientation.inside_out.get(topo.face_component[f as usize] as usize).copied();
+        let forward = forward != inside_out.unwrap_or(false);
         let c = topo.welded_positions[tri[(k + 2) % 3] as usize].as_dvec3() - pa;
         let angle = c.dot(v).atan2(c.dot(u));
         fan.push((angle, if forward { CLOSES } else { OPENS }, f));
@@ -159,7 +162,7 @@ const ANGLE_TIE: f64 = 1e-3;
 /// sheet between two wedges).
 fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
     let n = fan.len();
-    if n % 2 != 0 {
+    if !n.is_multiple_of(2) {
         return false;
     }
     let gap = |fan: &[(f64, i8, u32)], i: usize| {
@@ -211,8 +214,8 @@ fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
             same.sort_by_key(|x| x.2);
             other.sort_by_key(|x| x.2);
             let mut k = run.start;
-            for i in 0..same.len() {
-                fan[k] = same[i];
+            for (i, &entry) in same.iter().enumerate() {
+                fan[k] = entry;
                 k += 1;
                 if let Some(&o) = other.get(i) {
                     fan[k] = o;
@@ -248,8 +251,8 @@ fn attach_collapsed(topo: &Topology, uf: &mut UnionFind) {
 pub(crate) struct Labelling {
     pub(crate) labels: Vec<u32>,
     pub(crate) count: u32,
-    /// Non-manifold edges whose faces could not be paired.
-    pub(crate) unpaired_edges: usize,
+    /// Non-manifold edges whose faces could not be paired, increasing.
+    pub(crate) unpaired_edges: Vec<u32>,
     /// Per label: true when one of its faces has a free edge (the label is not a closed surface).
     pub(crate) open: Vec<bool>,
 }
@@ -338,4 +341,64 @@ fn same_direction(topo: &Topology, f: u32, g: u32) -> bool {
     let (tf, tg) = (topo.faces[f as usize], topo.faces[g as usize]);
     let directed = |t: [u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
     directed(tf).iter().any(|d| directed(tg).contains(d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fan(entries: &[(f64, i8)]) -> Vec<(f64, i8, u32)> {
+        let mut fan: Vec<_> =
+            entries.iter().enumerate().map(|(i, &(deg, s))| (deg.to_radians(), s, i as u32)).collect();
+        fan.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+        fan
+    }
+
+    /// The pairs (opening face, next face) after ordering, as face ids.
+    fn pairs(entries: &[(f64, i8)]) -> Option<Vec<(u32, u32)>> {
+        let mut fan = fan(entries);
+        if !alternate(&mut fan) {
+            return None;
+        }
+        let n = fan.len();
+        let mut out: Vec<_> = (0..n).filter(|&i| fan[i].1 == OPENS).map(|i| (fan[i].2, fan[(i + 1) % n].2)).collect();
+        out.sort_unstable();
+        Some(out)
+    }
+
+    #[test]
+    fn two_solids_sharing_an_edge() {
+        // Solid A fills 0°..90° (opens at 0, closes at 90); solid B fills 180°..270°.
+        assert_eq!(pairs(&[(0.0, OPENS), (90.0, CLOSES), (180.0, OPENS), (270.0, CLOSES)]), Some(vec![(0, 1), (2, 3)]));
+    }
+
+    #[test]
+    fn coincident_faces_of_touching_solids() {
+        // A fills 0°..180°, B fills 180°..300°: at 180° A closes and B opens with equal angles.
+        // Listing B's face first must not matter.
+        let a = [(0.0, OPENS), (180.0, OPENS), (180.0, CLOSES), (300.0, CLOSES)];
+        assert_eq!(pairs(&a), Some(vec![(0, 2), (1, 3)]));
+        // Rounding: the coincident faces differ in the last digits.
+        let b = [(0.0, OPENS), (180.0 + 1e-9, OPENS), (180.0, CLOSES), (300.0, CLOSES)];
+        assert_eq!(pairs(&b), Some(vec![(0, 2), (1, 3)]));
+    }
+
+    #[test]
+    fn ties_across_the_wrap_around() {
+        // A closes at 180°, B opens at -180° + 1e-9: the same half-plane.
+        let f = [(-179.999_999_9, OPENS), (-90.0, CLOSES), (0.0, OPENS), (180.0, CLOSES)];
+        assert_eq!(pairs(&f), Some(vec![(0, 1), (2, 3)]));
+    }
+
+    #[test]
+    fn zero_thickness_sheet_between_wedges() {
+        // A fills 0°..90°; a double-sided sheet (two faces) stands at 200°.
+        assert_eq!(pairs(&[(0.0, OPENS), (90.0, CLOSES), (200.0, CLOSES), (200.0, OPENS)]), Some(vec![(0, 1), (3, 2)]));
+    }
+
+    #[test]
+    fn fans_that_cannot_pair() {
+        assert_eq!(pairs(&[(0.0, OPENS), (90.0, CLOSES), (180.0, OPENS)]), None, "odd count");
+        assert_eq!(pairs(&[(0.0, OPENS), (90.0, OPENS), (180.0, CLOSES), (270.0, CLOSES)]), None, "overlapping");
+    }
 }

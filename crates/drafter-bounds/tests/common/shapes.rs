@@ -99,7 +99,8 @@ fn holes(rng: &mut Rng, size: DVec3, count: usize) -> Vec<DVec3> {
 
 /// An L-shaped bracket (two boxes), non-convex.
 pub fn l_bracket(a: f64, b: f64, t: f64, w: f64) -> Vec<DVec3> {
-    let mut pts: Vec<DVec3> = box_surface(DVec3::new(a, t, w), 6).into_iter().map(|p| p + DVec3::new(a / 2.0, t / 2.0, 0.0)).collect();
+    let mut pts: Vec<DVec3> =
+        box_surface(DVec3::new(a, t, w), 6).into_iter().map(|p| p + DVec3::new(a / 2.0, t / 2.0, 0.0)).collect();
     pts.extend(box_surface(DVec3::new(t, b, w), 6).into_iter().map(|p| p + DVec3::new(t / 2.0, b / 2.0, 0.0)));
     pts
 }
@@ -183,33 +184,42 @@ pub struct Shape {
 
 /// The `index`-th generated part (names say the family), placed with a random rotation and offset.
 pub fn cad_like(seed: u64, index: usize) -> Shape {
+    cad_like_with(seed, index, 1.0)
+}
+
+/// Number of families [`cad_like`] cycles through.
+pub const FAMILIES: usize = 11;
+
+/// [`cad_like`] with tessellation density scaled by `detail` (1 = bench size; tests use less).
+pub fn cad_like_with(seed: u64, index: usize, detail: f64) -> Shape {
     let mut rng = Rng::new(seed.wrapping_mul(1_000_003).wrapping_add(index as u64));
-    let kind = index % 11;
+    let kind = index % FAMILIES;
+    let count = |n: usize| ((n as f64 * detail).round() as usize).max(8);
     let s = |rng: &mut Rng| rng.range(0.2, 3.0);
     let (name, pts) = match kind {
         0 => {
             let size = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
-            let mut p = box_surface(size, 10);
+            let mut p = box_surface(size, count(10).min(10));
             p.extend(holes(&mut rng, size, 3));
             ("box_with_holes", p)
         }
-        1 => ("cylinder", cylinder(rng.range(0.1, 1.0), rng.range(0.1, 4.0), 8 * (2 + rng.below(16)), 4)),
+        1 => ("cylinder", cylinder(rng.range(0.1, 1.0), rng.range(0.1, 4.0), count(8 * (2 + rng.below(16))), 4)),
         2 => ("l_bracket", l_bracket(s(&mut rng), s(&mut rng), rng.range(0.05, 0.3), s(&mut rng))),
         3 => {
             let size = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
             let r = 0.2 * size.min_element();
-            ("rounded_box", rounded_box(size, r, 600))
+            ("rounded_box", rounded_box(size, r, count(600)))
         }
         4 => ("hex_nut", prism(6, rng.range(0.2, 1.0), rng.range(0.1, 0.6))),
-        5 => ("gear", gear(10 + rng.below(30), 1.0, 1.15, rng.range(0.1, 0.8))),
-        6 => ("frustum", frustum(rng.range(0.2, 1.0), rng.range(0.05, 1.0), rng.range(0.2, 2.0), 48)),
+        5 => ("gear", gear(count(10 + rng.below(30)), 1.0, 1.15, rng.range(0.1, 0.8))),
+        6 => ("frustum", frustum(rng.range(0.2, 1.0), rng.range(0.05, 1.0), rng.range(0.2, 2.0), count(48))),
         7 => {
             let sigma = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
-            ("noisy_cloud", noisy_cloud(&mut rng, 800, sigma))
+            ("noisy_cloud", noisy_cloud(&mut rng, count(800), sigma))
         }
         8 => {
             let radii = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
-            ("ellipsoid", ellipsoid(&mut rng, 400, radii))
+            ("ellipsoid", ellipsoid(&mut rng, count(400), radii))
         }
         9 => {
             let size = DVec3::new(s(&mut rng), s(&mut rng), rng.range(0.005, 0.05));

@@ -1,0 +1,370 @@
+//! Edge classes on the welded topology.
+//!
+//! Every undirected edge of a [`Topology`] gets one [`EdgeClass`], decided in this order (the first
+//! rule that applies wins):
+//!
+//! 1. one incident face: [`EdgeClass::Boundary`];
+//! 2. three or more: [`EdgeClass::NonManifold`];
+//! 3. two faces of different parts (when part ids are given): [`EdgeClass::PartBorder`];
+//! 4. a degenerate incident face (zero area or a repeated welded vertex, so no normal):
+//!    [`EdgeClass::Degenerate`] — neither a crease nor a silhouette candidate, encoded hidden. Such
+//!    faces are slivers that close T-junctions of CAD tessellations; drawing their edges would draw
+//!    seams, and their missing normal makes the front/back test meaningless;
+//! 5. dihedral angle (the angle between the two face normals) above
+//!    [`LineOptions::crease_angle_deg`]: [`EdgeClass::Crease`];
+//! 6. dihedral angle at or below [`LineOptions::coplanar_angle_deg`]: [`EdgeClass::Coplanar`]
+//!    (hidden: a silhouette between coplanar faces is invisible);
+//! 7. otherwise: [`EdgeClass::SilhouetteCandidate`].
+//!
+//! Face normals are computed in `f64` from the welded `f32` positions ((b − a) × (c − a), normalised),
+//! so the dihedral angles do not depend on the weld representative's rounding. Candidates keep their
+//! two normals rounded to `f32` (face with the smaller index first): these `f32` vectors are what
+//! every silhouette query of this crate evaluates, bit for bit.
+//!
+//! The orientation of the two faces is not repaired: if they traverse their shared edge in the same
+//! direction (inconsistent winding) the dihedral angle is measured between the normals as they are,
+//! which usually makes the edge a crease. Such edges are counted in
+//! [`EdgeClassCounts::inconsistent_orientation`].
+
+use drafter_core::{Diagnostic, DiagnosticKind, Diagnostics, PartId, Topology};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::LinesError;
+
+/// Default dihedral angle, in degrees, above which a manifold edge is a crease (Gooch et al. 1999
+/// leave it to the user; 30° is the common CAD default and what trimesh-based checks use).
+pub const DEFAULT_CREASE_ANGLE_DEG: f32 = 30.0;
+
+/// Default dihedral angle, in degrees, at or below which two faces count as coplanar. It absorbs the
+/// `f32` rounding of positions on planar CAD faces (normals of a 1/1000-of-the-model triangle move
+/// by about 1e-5 rad ≈ 6e-4°) while keeping the finest real tessellation (≥ 0.01°) as candidates.
+pub const DEFAULT_COPLANAR_ANGLE_DEG: f32 = 1e-3;
+
+/// Options of [`classify_edges`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LineOptions {
+    /// Dihedral angle in degrees above which a manifold edge is a crease.
+    /// Default [`DEFAULT_CREASE_ANGLE_DEG`]; range `[0, 180]` (180 turns creases off).
+    pub crease_angle_deg: f32,
+    /// Dihedral angle in degrees at or below which the two faces count as coplanar (hidden edge).
+    /// Default [`DEFAULT_COPLANAR_ANGLE_DEG`]; range `[0, crease_angle_deg]`; a negative value makes
+    /// even exactly coplanar faces candidates.
+    pub coplanar_angle_deg: f32,
+}
+
+impl Default for LineOptions {
+    fn default() -> Self {
+        Self { crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG, coplanar_angle_deg: DEFAULT_COPLANAR_ANGLE_DEG }
+    }
+}
+
+/// The class of one welded edge. See the module docs for the order in which rules apply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[repr(u8)]
+pub enum EdgeClass {
+    /// Exactly one incident face. Hard edge.
+    Boundary = 0,
+    /// Three or more incident faces. Hard edge.
+    NonManifold = 1,
+    /// Two faces of different parts. Hard edge.
+    PartBorder = 2,
+    /// Dihedral angle above the crease threshold. Hard edge.
+    Crease = 3,
+    /// A manifold edge whose faces are not coplanar: a silhouette from some views.
+    SilhouetteCandidate = 4,
+    /// Coplanar faces: never drawn.
+    Coplanar = 5,
+    /// A degenerate incident face (no normal): never drawn.
+    Degenerate = 6,
+}
+
+impl EdgeClass {
+    /// All classes, in code order.
+    pub const ALL: [EdgeClass; 7] = [
+        EdgeClass::Boundary,
+        EdgeClass::NonManifold,
+        EdgeClass::PartBorder,
+        EdgeClass::Crease,
+        EdgeClass::SilhouetteCandidate,
+        EdgeClass::Coplanar,
+        EdgeClass::Degenerate,
+    ];
+
+    /// Hard edges are always drawn (value 2/3 of `EXT_mesh_primitive_edge_visibility`).
+    pub fn is_hard(self) -> bool {
+        matches!(self, Self::Boundary | Self::NonManifold | Self::PartBorder | Self::Crease)
+    }
+
+    /// The stable numeric code (the `repr(u8)` value), as written to files.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    pub fn from_code(code: u8) -> Option<Self> {
+        Self::ALL.get(code as usize).copied()
+    }
+}
+
+/// How many edges fell in each class, plus data problems met on the way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EdgeClassCounts {
+    pub boundary: usize,
+    pub non_manifold: usize,
+    pub part_border: usize,
+    pub crease: usize,
+    pub silhouette_candidate: usize,
+    pub coplanar: usize,
+    pub degenerate: usize,
+    /// Manifold edges whose two faces traverse them in the same direction (any class).
+    pub inconsistent_orientation: usize,
+}
+
+impl EdgeClassCounts {
+    pub fn of(&self, class: EdgeClass) -> usize {
+        match class {
+            EdgeClass::Boundary => self.boundary,
+            EdgeClass::NonManifold => self.non_manifold,
+            EdgeClass::PartBorder => self.part_border,
+            EdgeClass::Crease => self.crease,
+            EdgeClass::SilhouetteCandidate => self.silhouette_candidate,
+            EdgeClass::Coplanar => self.coplanar,
+            EdgeClass::Degenerate => self.degenerate,
+        }
+    }
+
+    /// Hard edges: boundary + non-manifold + part border + crease.
+    pub fn hard(&self) -> usize {
+        self.boundary + self.non_manifold + self.part_border + self.crease
+    }
+
+    fn add(&mut self, class: EdgeClass) {
+        match class {
+            EdgeClass::Boundary => self.boundary += 1,
+            EdgeClass::NonManifold => self.non_manifold += 1,
+            EdgeClass::PartBorder => self.part_border += 1,
+            EdgeClass::Crease => self.crease += 1,
+            EdgeClass::SilhouetteCandidate => self.silhouette_candidate += 1,
+            EdgeClass::Coplanar => self.coplanar += 1,
+            EdgeClass::Degenerate => self.degenerate += 1,
+        }
+    }
+}
+
+/// The classified edges of one mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FeatureEdges {
+    /// Class of every edge of the topology, indexed like `Topology::edges`.
+    pub classes: Vec<EdgeClass>,
+    /// Dihedral angle in degrees of every edge with two non-degenerate faces; NaN for the others.
+    pub dihedral_deg: Vec<f32>,
+    /// Unit normal of every face in `f64`; `None` for degenerate faces.
+    pub face_normals: Vec<Option<DVec3>>,
+    /// Edge id of each silhouette candidate, increasing. A [`crate::SilhouetteIndex`] may renumber
+    /// its candidates; its answers are indices into [`crate::SilhouetteIndex::candidate_edges`].
+    pub candidates: Vec<u32>,
+    /// The two face normals of each candidate, rounded to `f32` (face with the smaller index first).
+    pub candidate_normals: Vec<[Vec3; 2]>,
+    /// The point `v` of each candidate used by the perspective test: its first welded vertex
+    /// (`Topology::edges[e][0]`).
+    pub candidate_points: Vec<Vec3>,
+    pub counts: EdgeClassCounts,
+}
+
+impl FeatureEdges {
+    /// Data problems as diagnostics (degenerate neighbours, inconsistent orientation).
+    pub fn diagnostics(&self) -> Vec<Diagnostic> {
+        let mut d = Diagnostics::new();
+        d.push(DiagnosticKind::Other, self.counts.degenerate, || {
+            format!("{} edges border a degenerate face and are never drawn", self.counts.degenerate)
+        });
+        d.push(DiagnosticKind::Other, self.counts.inconsistent_orientation, || {
+            format!(
+                "{} manifold edges join faces of inconsistent winding; their dihedral angle uses the normals as given",
+                self.counts.inconsistent_orientation
+            )
+        });
+        d.into_vec()
+    }
+
+    /// Edge ids of every edge of `class`, increasing.
+    pub fn edges_of_class(&self, class: EdgeClass) -> Vec<u32> {
+        (0..self.classes.len() as u32).filter(|&e| self.classes[e as usize] == class).collect()
+    }
+}
+
+/// Unit face normals in `f64`; `None` where the face is degenerate.
+pub fn face_normals(topology: &Topology) -> Vec<Option<DVec3>> {
+    topology
+        .faces
+        .par_iter()
+        .enumerate()
+        .map(|(f, &[a, b, c])| {
+            if topology.face_degenerate.get(f).copied().unwrap_or(false) {
+                return None;
+            }
+            let p = |v: u32| topology.welded_positions[v as usize].as_dvec3();
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            let len = n.length();
+            (len > 0.0 && len.is_finite()).then(|| n / len)
+        })
+        .collect()
+}
+
+/// Angle between two unit vectors in degrees, accurate near 0° and 180°.
+fn angle_deg(n1: DVec3, n2: DVec3) -> f64 {
+    n1.cross(n2).length().atan2(n1.dot(n2)).to_degrees()
+}
+
+/// Classifies every edge of `topology`. `face_parts`, when given, holds one part id per face.
+pub fn classify_edges(
+    topology: &Topology,
+    face_parts: Option<&[PartId]>,
+    options: &LineOptions,
+) -> Result<FeatureEdges, LinesError> {
+    if let Some(parts) = face_parts
+        && parts.len() != topology.faces.len()
+    {
+        return Err(LinesError::PartCount { parts: parts.len(), faces: topology.faces.len() });
+    }
+    let face_normals = face_normals(topology);
+    let crease = f64::from(options.crease_angle_deg);
+    let coplanar = f64::from(options.coplanar_angle_deg);
+    let per_edge: Vec<(EdgeClass, f32, bool)> = (0..topology.edges.len())
+        .into_par_iter()
+        .map(|e| {
+            let faces = topology.faces_of_edge(e);
+            match faces.len() {
+                0 | 1 => return (EdgeClass::Boundary, f32::NAN, false),
+                2 => {}
+                _ => return (EdgeClass::NonManifold, f32::NAN, false),
+            }
+            let (f1, f2) = (faces[0] as usize, faces[1] as usize);
+            let consistent = runs_forward(topology, f1, e) != runs_forward(topology, f2, e);
+            let dihedral = match (face_normals[f1], face_normals[f2]) {
+                (Some(n1), Some(n2)) => angle_deg(n1, n2),
+                _ => f64::NAN,
+            };
+            let class = if face_parts.is_some_and(|p| p[f1] != p[f2]) {
+                EdgeClass::PartBorder
+            } else if dihedral.is_nan() {
+                EdgeClass::Degenerate
+            } else if dihedral > crease {
+                EdgeClass::Crease
+            } else if dihedral <= coplanar {
+                EdgeClass::Coplanar
+            } else {
+                EdgeClass::SilhouetteCandidate
+            };
+            (class, dihedral as f32, !consistent)
+        })
+        .collect();
+
+    let mut counts = EdgeClassCounts::default();
+    let mut classes = Vec::with_capacity(per_edge.len());
+    let mut dihedral_deg = Vec::with_capacity(per_edge.len());
+    let mut candidates = Vec::new();
+    let mut candidate_normals = Vec::new();
+    let mut candidate_points = Vec::new();
+    for (e, &(class, dihedral, inconsistent)) in per_edge.iter().enumerate() {
+        counts.add(class);
+        counts.inconsistent_orientation += usize::from(inconsistent);
+        classes.push(class);
+        dihedral_deg.push(dihedral);
+        if class == EdgeClass::SilhouetteCandidate {
+            let faces = topology.faces_of_edge(e);
+            let normal = |f: u32| face_normals[f as usize].map_or(Vec3::ZERO, |n| n.as_vec3());
+            candidates.push(e as u32);
+            candidate_normals.push([normal(faces[0]), normal(faces[1])]);
+            candidate_points.push(topology.welded_positions[topology.edges[e][0] as usize]);
+        }
+    }
+    Ok(FeatureEdges { classes, dihedral_deg, face_normals, candidates, candidate_normals, candidate_points, counts })
+}
+
+/// Whether face `f` traverses edge `e` from its smaller to its larger welded vertex.
+fn runs_forward(topology: &Topology, f: usize, e: usize) -> bool {
+    let tri = topology.faces[f];
+    let k = topology.face_edges[f].iter().position(|&x| x as usize == e).unwrap_or(0);
+    tri[k] < tri[(k + 1) % 3]
+}
+
+#[cfg(test)]
+mod tests {
+    use drafter_core::Weld;
+
+    use super::*;
+
+    /// A unit cube with a ridge: the top face split into two triangles that fold up by `tilt`.
+    fn tent(height: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, height),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        // Two triangles sharing the diagonal 0-2.
+        (p, vec![[0, 1, 2], [0, 2, 3]])
+    }
+
+    #[test]
+    fn classes_follow_dihedral_angle() {
+        let flat = Topology::from_triangles(&tent(0.0).0, &tent(0.0).1, Weld::Exact);
+        let lines = classify_edges(&flat, None, &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.boundary, 4);
+        assert_eq!(lines.counts.coplanar, 1);
+        let bent = tent(0.2);
+        let topo = Topology::from_triangles(&bent.0, &bent.1, Weld::Exact);
+        let lines = classify_edges(&topo, None, &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.silhouette_candidate, 1);
+        assert_eq!(lines.candidates.len(), 1);
+        let e = lines.candidates[0] as usize;
+        assert_eq!(topo.edges[e], [0, 2]);
+        assert_eq!(lines.candidate_points[0], Vec3::ZERO);
+        let steep = tent(2.0);
+        let topo = Topology::from_triangles(&steep.0, &steep.1, Weld::Exact);
+        let lines = classify_edges(&topo, None, &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.crease, 1);
+        // The dihedral angle of the steep tent, computed by hand from the normals.
+        let n1 = Vec3::new(1.0, 0.0, 0.0).cross(Vec3::new(1.0, 1.0, 2.0)).normalize();
+        let n2 = Vec3::new(1.0, 1.0, 2.0).cross(Vec3::new(0.0, 1.0, 0.0)).normalize();
+        let expected = n1.dot(n2).acos().to_degrees();
+        assert!((lines.dihedral_deg[e] - expected).abs() < 1e-3);
+    }
+
+    #[test]
+    fn part_borders_and_degenerate_neighbours() {
+        let (p, t) = tent(0.2);
+        let topo = Topology::from_triangles(&p, &t, Weld::Exact);
+        let parts = [PartId(0), PartId(1)];
+        let lines = classify_edges(&topo, Some(&parts), &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.part_border, 1);
+        assert!(classify_edges(&topo, Some(&parts[..1]), &LineOptions::default()).is_err());
+        // A zero-area triangle glued to a good one along 0-1.
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.5, 0.0, 0.0)];
+        let t = vec![[0, 1, 2], [1, 0, 3]];
+        let topo = Topology::from_triangles(&p, &t, Weld::Exact);
+        let lines = classify_edges(&topo, None, &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.degenerate, 1);
+        assert_eq!(lines.diagnostics().len(), 1);
+    }
+
+    #[test]
+    fn inconsistent_winding_is_counted() {
+        let (p, _) = tent(0.2);
+        let topo = Topology::from_triangles(&p, &[[0, 1, 2], [0, 3, 2]], Weld::Exact);
+        let lines = classify_edges(&topo, None, &LineOptions::default()).unwrap();
+        assert_eq!(lines.counts.inconsistent_orientation, 1);
+        assert_eq!(lines.counts.crease, 1);
+    }
+
+    #[test]
+    fn class_codes_round_trip() {
+        for c in EdgeClass::ALL {
+            assert_eq!(EdgeClass::from_code(c.code()), Some(c));
+        }
+        assert_eq!(EdgeClass::from_code(7), None);
+    }
+}

@@ -1,0 +1,831 @@
+//! A normal-cone BVH for perspective silhouettes.
+//!
+//! Gooch et al. (1999, §5.1.4) leave perspective open: "some form of bounding volume hierarchy would
+//! have to be employed". This is a spatialised normal-cone hierarchy (Johnson & Cohen 2001,
+//! "Spatialized normal cone hierarchies", I3D) with the anchored-cone test of Sander et al. (2000,
+//! "Silhouette clipping", SIGGRAPH):
+//!
+//! * candidates are first split by normal: by the icosahedral Gauss-map cell (see
+//!   [`NormalSplit`]; about 5°–20° wide, chosen by count) of their arc midpoint, following the
+//!   cell hierarchy, so that the cones below stay narrow even on noisy scans;
+//! * within each normal cell an [`obvhs`] BVH2 (PLOC) is built over the candidates' points `v`,
+//!   and any subtree of at most [`ConeBvhOptions::leaf_size`] candidates becomes a leaf;
+//! * every node stores the tight box `B` of the points `v` below it and a cone (unit axis `c`,
+//!   half-angle `α`) holding every face normal of those candidates (both `n1` and `n2`);
+//! * subtrees that the cost model finds cheaper as one leaf are collapsed, binary nodes absorb
+//!   inner children up to 4 children, and the tree is laid out breadth-first (see `tree.rs`), so a
+//!   query tests up to 4 children's boxes and cones in one SIMD pass and reads each level's nodes
+//!   with overlapping memory accesses.
+//!
+//! # The cull test, and why it is exact
+//!
+//! For the eye `e`, write `w = e − p` with `p ∈ B`, so `w` ranges over the box `W = e − B`. Every
+//! normal `n` of the cone faces the eye (`n·w > 0`) for every `w ∈ W` iff `c·w > sin α · |w|` on all
+//! of `W`; facing away for all is `c·w < −sin α · |w|`. The function `c·w − s|w|` is concave (linear
+//! minus a norm), so its minimum over the box is at one of the 8 corners; `c·w + s|w|` is convex,
+//! so its maximum is too. Testing the 8 corners is therefore exact, not just conservative. When all
+//! normals of a node agree, `a = n1·w` and `b = n2·w` of every candidate below have the same sign and
+//! the predicate rejects it, so the node is skipped.
+//!
+//! Rounding: the cone's `sin α` is stored rounded up with a margin of [`CONE_MARGIN`] = 1e-5, and
+//! all comparisons are relative to each corner's `|w|`. The corner test in `f32` errs by at most a
+//! few 1e-7·|w|, so a passing corner is really inside the cone's dual with a margin ~1e-5·|w|;
+//! concavity carries that margin to every `w` of the box, which is far above the ~1e-6·|w| error of
+//! the predicate's own `f32` dot products. NaN or infinite values (eyes at infinity, overflow of
+//! `|w|²`) fail the comparisons and the node is entered. An eye inside a node's box is never culled
+//! there (`w = 0` is in `W`). Entered leaves are tested in blocks of 4 with the brute-force
+//! arithmetic (`w = e − v`, same operations, same order): results are bit-identical to
+//! [`crate::BruteForce`].
+//!
+//! # How deep
+//!
+//! Queries from [`ConeBvhOptions::sample_eyes`] deterministic eyes outside the bounding box (1.2 to
+//! 4 half-diagonals from its centre) measure how often each node is tested and passes; a
+//! bottom-up pass with the [`CostModel`] collapses subtrees that are cheaper as one leaf. The
+//! final tree is priced by counting the work of the same sampled queries.
+
+use std::time::Duration;
+
+use glam::{DVec3, Vec3, Vec3A, Vec4};
+use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::brute::Stream;
+use crate::gauss::{BaseSolid, QueryCounts, base_cells, cell_key};
+use crate::tree::{
+    breadth_first, check_breadth_first, check_permutation, for_each_in_subtrees, lanes, widest_level, with_levels,
+};
+use crate::{ArraysError, CostModel, EdgeSet};
+
+/// Margin added to the sine of every cone's half-angle.
+pub const CONE_MARGIN: f64 = 1e-5;
+
+/// Default largest leaf, in candidates.
+pub const DEFAULT_LEAF_SIZE: u32 = 16;
+
+/// Default number of eyes sampled to estimate visit frequencies.
+pub const DEFAULT_SAMPLE_EYES: u32 = 96;
+
+const NEVER_CULL: f32 = 2.0;
+
+/// How candidates are split by normal before the spatial BVH.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", content = "level", rename_all = "snake_case")]
+pub enum NormalSplit {
+    /// Spatial BVH over all candidates.
+    Off,
+    /// First by the icosahedral Gauss-map cell (this many 4:1 splits) of the arc midpoint, then
+    /// a spatial BVH per cell.
+    Level(u8),
+    /// [`NormalSplit::Level`] chosen by [`normal_level_for_count`] (default).
+    Auto,
+}
+
+/// The Gauss-map level used by [`NormalSplit::Auto`]: cells of about 20° (level 1) for small
+/// meshes, 10° (level 2) from 20k candidates, 5° (level 3) from 300k.
+pub fn normal_level_for_count(candidates: usize) -> u8 {
+    match candidates {
+        0..20_000 => 1,
+        20_000..300_000 => 2,
+        _ => 3,
+    }
+}
+
+/// Options of [`ConeBvh::build`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ConeBvhOptions {
+    /// Subtrees with at most this many candidates become one leaf before pruning.
+    /// Default [`DEFAULT_LEAF_SIZE`]; range 1..=4096.
+    pub leaf_size: u32,
+    /// Split by normal first. Default [`NormalSplit::Auto`].
+    pub normal_split: NormalSplit,
+    /// Collapse subtrees that the cost model says are cheaper as one leaf. Default `true`.
+    pub prune: bool,
+    /// Eyes outside the bounding box used to estimate visit frequencies and the cost of a query.
+    /// 0 disables pruning and the estimate (a [`crate::SilhouetteIndex`] then keeps the BVH only
+    /// with `min_speedup` 0). Default [`DEFAULT_SAMPLE_EYES`].
+    pub sample_eyes: u32,
+}
+
+impl Default for ConeBvhOptions {
+    fn default() -> Self {
+        Self {
+            leaf_size: DEFAULT_LEAF_SIZE,
+            normal_split: NormalSplit::Auto,
+            prune: true,
+            sample_eyes: DEFAULT_SAMPLE_EYES,
+        }
+    }
+}
+
+/// The flat arrays of a [`ConeBvh`], ready for glTF buffer views.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ConeBvhArrays {
+    /// 6 `f32` per node: box min x, y, z, max x, y, z of the candidate points below.
+    pub node_boxes: Vec<f32>,
+    /// 4 `f32` per node: cone axis x, y, z and `sin α + margin` (≥ 1: never culled).
+    pub node_cones: Vec<f32>,
+    /// 4 `u32` per node, nodes breadth-first from the root: first child, child count, first own
+    /// candidate and end of own candidates (into `order`; only leaves own candidates).
+    pub nodes: Vec<u32>,
+    /// Candidate index of each stored candidate.
+    pub order: Vec<u32>,
+}
+
+/// See the module docs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConeBvh {
+    /// What a query reads about nodes.
+    nodes: Vec<BvhNode>,
+    /// Boxes and cones as structure of arrays (min x, y, z, max x, y, z, axis x, y, z, sin α +
+    /// margin), padded with 4 entries, so that up to 4 children are tested in one SIMD pass.
+    bound_soa: [Vec<f32>; 10],
+    /// The most nodes at one depth (sizes the walk's level buffers).
+    widest: usize,
+    /// The leaves' candidates in blocks, leaf after leaf.
+    stream: Stream,
+    /// The serialised form: `[first_child, child_count, arc_start, arc_end]` per node.
+    flat: Vec<[u32; 4]>,
+    boxes: Vec<[f32; 6]>,
+    cones: Vec<[f32; 4]>,
+    order: Vec<u32>,
+    leaf_size: u32,
+    normal_level: Option<u8>,
+    predicted_ns: f64,
+}
+
+/// A node as the query reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
+struct BvhNode {
+    first_child: u32,
+    child_count: u32,
+    /// First quad of the own candidates' blocks in the stream, and their number.
+    quad: u32,
+    blocks: u32,
+}
+
+/// What a query reads, built from the serialised form.
+struct Assembled {
+    nodes: Vec<BvhNode>,
+    bound_soa: [Vec<f32>; 10],
+    widest: usize,
+    stream: Stream,
+}
+
+/// Query records, bound arrays and blocks of a breadth-first tree.
+fn assemble(
+    flat: &[[u32; 4]],
+    boxes: &[[f32; 6]],
+    cones: &[[f32; 4]],
+    order: &[u32],
+    normals: &[[Vec3; 2]],
+    points: &[Vec3],
+) -> Assembled {
+    let mut stream = Stream::new();
+    let nodes = flat
+        .iter()
+        .map(|&[first_child, child_count, start, end]| {
+            let quad = stream.len() as u32;
+            let blocks = stream.push_blocks(&order[start as usize..end as usize], normals, points);
+            BvhNode { first_child, child_count, quad, blocks }
+        })
+        .collect();
+    let mut bound_soa: [Vec<f32>; 10] = Default::default();
+    for (k, a) in bound_soa.iter_mut().enumerate() {
+        a.extend((0..flat.len()).map(|i| if k < 6 { boxes[i][k] } else { cones[i][k - 6] }));
+        // Padding lanes are masked off by the child count.
+        a.extend(std::iter::repeat_n(0.0, 4));
+    }
+    Assembled { nodes, bound_soa, widest: widest_level(flat), stream }
+}
+
+/// The exact anchored-cone test of the module docs.
+#[inline(always)]
+fn culls(b: &[f32; 6], c: &[f32; 4], e: Vec3) -> bool {
+    let s = c[3];
+    let wx = [e.x - b[0], e.x - b[3]];
+    let wy = [e.y - b[1], e.y - b[4]];
+    let wz = [e.z - b[2], e.z - b[5]];
+    let mut front = true;
+    let mut back = true;
+    for k in 0..8 {
+        let (x, y, z) = (wx[k & 1], wy[(k >> 1) & 1], wz[k >> 2]);
+        let t = c[0] * x + c[1] * y + c[2] * z;
+        let r = s * (x * x + y * y + z * z).sqrt();
+        front &= t > r;
+        back &= t < -r;
+    }
+    front | back
+}
+
+/// The tree as built, in preorder with skip pointers and subtree ranges into `order` (used to
+/// estimate visit frequencies and choose collapses before the breadth-first layout).
+#[derive(Default)]
+struct Tree {
+    /// start, end, skip, leaf flag.
+    nodes: Vec<[u32; 4]>,
+    children: Vec<Vec<u32>>,
+    order: Vec<u32>,
+}
+
+impl Tree {
+    fn open(&mut self) -> usize {
+        let at = self.nodes.len();
+        let start = self.order.len() as u32;
+        self.nodes.push([start, start, 0, 0]);
+        self.children.push(Vec::new());
+        at
+    }
+
+    fn close(&mut self, at: usize, leaf: bool) {
+        self.nodes[at][1] = self.order.len() as u32;
+        self.nodes[at][2] = self.nodes.len() as u32;
+        self.nodes[at][3] = u32::from(leaf);
+    }
+}
+
+impl ConeBvh {
+    /// Builds the hierarchy over candidates with `normals` and points `points` (one each).
+    pub fn build(normals: &[[Vec3; 2]], points: &[Vec3], options: &ConeBvhOptions, cost: &CostModel) -> Self {
+        let n = normals.len().min(points.len());
+        let (normals, points) = (&normals[..n], &points[..n]);
+        let leaf_size = options.leaf_size.clamp(1, 4096);
+        let unit: Vec<[DVec3; 2]> = normals
+            .par_iter()
+            .map(|&[a, b]| [a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero()])
+            .collect();
+        let normal_level = match options.normal_split {
+            NormalSplit::Off => None,
+            NormalSplit::Level(l) => Some(l.min(6)),
+            NormalSplit::Auto => Some(normal_level_for_count(n)),
+        };
+        let tree = build_tree(points, &unit, leaf_size, normal_level);
+        let (boxes, cones): (Vec<[f32; 6]>, Vec<[f32; 4]>) = tree
+            .nodes
+            .par_iter()
+            .map(|&[start, end, _, _]| {
+                let range = &tree.order[start as usize..end as usize];
+                (
+                    bounding_box(range.iter().map(|&i| points[i as usize])),
+                    bounding_cone(range.iter().flat_map(|&i| unit[i as usize])),
+                )
+            })
+            .unzip();
+        let eyes = sample_eyes(points, options.sample_eyes);
+        let mut leaf: Vec<bool> = tree.nodes.iter().map(|n| n[3] == 1).collect();
+        if !eyes.is_empty() && options.prune {
+            let (visits, passes) = visit_frequencies(&tree.nodes, &boxes, &cones, &eyes);
+            for (i, c) in collapse_by_cost(&tree.nodes, &tree.children, &visits, &passes, cost).into_iter().enumerate()
+            {
+                leaf[i] |= c;
+            }
+        }
+        // Up to 4 children per node: absorb the largest inner children into their parent.
+        let size = |i: usize| tree.nodes[i][1] - tree.nodes[i][0];
+        let wide: Vec<Vec<u32>> = (0..tree.nodes.len())
+            .map(|i| {
+                if leaf[i] {
+                    return Vec::new();
+                }
+                let mut kids = tree.children[i].clone();
+                while kids.len() < 4 {
+                    let Some((k, _)) = kids
+                        .iter()
+                        .enumerate()
+                        .filter(|&(_, &c)| !leaf[c as usize] && kids.len() - 1 + tree.children[c as usize].len() <= 4)
+                        .max_by_key(|&(_, &c)| size(c as usize))
+                    else {
+                        break;
+                    };
+                    let c = kids.remove(k) as usize;
+                    kids.splice(k..k, tree.children[c].iter().copied());
+                }
+                kids
+            })
+            .collect();
+        let (flat, order, source) = breadth_first(
+            0,
+            |i| &wide[i],
+            |i| if leaf[i] { &tree.order[tree.nodes[i][0] as usize..tree.nodes[i][1] as usize] } else { &[] },
+        );
+        let boxes: Vec<[f32; 6]> = source.iter().map(|&i| boxes[i]).collect();
+        let cones: Vec<[f32; 4]> = source.iter().map(|&i| cones[i]).collect();
+        let a = assemble(&flat, &boxes, &cones, &order, normals, points);
+        let mut bvh = ConeBvh {
+            nodes: a.nodes,
+            bound_soa: a.bound_soa,
+            widest: a.widest,
+            stream: a.stream,
+            flat,
+            boxes,
+            cones,
+            order,
+            leaf_size,
+            normal_level,
+            predicted_ns: 0.0,
+        };
+        if !eyes.is_empty() {
+            let mut out = EdgeSet::default();
+            let total: f64 = eyes.iter().map(|&e| bvh.query_counted(e, &mut out).cost_ns(cost, false)).sum();
+            bvh.predicted_ns = total / eyes.len() as f64;
+        }
+        bvh
+    }
+
+    /// Number of candidates.
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.flat.len()
+    }
+
+    pub fn leaf_count(&self) -> usize {
+        self.flat.iter().filter(|n| n[1] == 0).count()
+    }
+
+    /// The leaf size the tree was cut at before pruning.
+    pub fn leaf_size(&self) -> u32 {
+        self.leaf_size
+    }
+
+    /// The Gauss-map level of the normal split, `None` if the BVH is purely spatial (or loaded).
+    pub fn normal_level(&self) -> Option<u8> {
+        self.normal_level
+    }
+
+    /// Expected time of one query from eyes outside the box, under the cost model used to build it
+    /// (0 when loaded from arrays or built without sample eyes).
+    pub fn predicted_ns_per_query(&self) -> f64 {
+        self.predicted_ns
+    }
+
+    /// Silhouettes seen from `eye` into `out` (reset to [`ConeBvh::len`]).
+    pub fn query(&self, eye: Vec3, out: &mut EdgeSet) {
+        self.walk::<false>(eye, out);
+    }
+
+    /// [`ConeBvh::query`] that also counts its work.
+    pub fn query_counted(&self, eye: Vec3, out: &mut EdgeSet) -> QueryCounts {
+        self.walk::<true>(eye, out)
+    }
+
+    /// Bits of the nodes `first..first + 4` that the anchored-cone test culls: [`culls`] on 4
+    /// lanes, with the same operations in the same order.
+    #[inline(always)]
+    fn culls4(&self, first: usize, e: Vec3) -> u32 {
+        let r = first..first + 4;
+        let ld = |k: usize| Vec4::from_slice(&self.bound_soa[k][r.clone()]);
+        let (ex, ey, ez) = (Vec4::splat(e.x), Vec4::splat(e.y), Vec4::splat(e.z));
+        let wx = [ex - ld(0), ex - ld(3)];
+        let wy = [ey - ld(1), ey - ld(4)];
+        let wz = [ez - ld(2), ez - ld(5)];
+        let (cx, cy, cz, s) = (ld(6), ld(7), ld(8), ld(9));
+        let mut front = u32::MAX;
+        let mut back = u32::MAX;
+        for k in 0..8 {
+            let (x, y, z) = (wx[k & 1], wy[(k >> 1) & 1], wz[k >> 2]);
+            let t = cx * x + cy * y + cz * z;
+            let r = s * (x * x + y * y + z * z).sqrt();
+            front &= t.cmpgt(r).bitmask();
+            back &= t.cmplt(-r).bitmask();
+        }
+        front | back
+    }
+
+    /// Breadth-first walk, as in the Gauss map.
+    #[inline]
+    fn walk<const COUNT: bool>(&self, eye: Vec3, out: &mut EdgeSet) -> QueryCounts {
+        out.reset(self.len());
+        let mut counts = QueryCounts::default();
+        if self.nodes.is_empty() || self.culls4(0, eye) & 1 == 1 {
+            counts.bounds_tested = usize::from(COUNT);
+            return counts;
+        }
+        let words = out.words_mut();
+        with_levels(self.widest + 4, |level, next| {
+            level[0] = 0;
+            let mut width = 1;
+            counts.bounds_tested = usize::from(COUNT);
+            while width > 0 {
+                let mut next_width = 0;
+                for &i in &level[..width] {
+                    let n = &self.nodes[i as usize];
+                    let (first, end) = (n.first_child as usize, (n.first_child + n.child_count) as usize);
+                    let mut f = first;
+                    while f < end {
+                        let mask = !self.culls4(f, eye) & lanes(end - f);
+                        for lane in 0..4 {
+                            next[next_width] = (f + lane) as u32;
+                            next_width += ((mask >> lane) & 1) as usize;
+                        }
+                        f += 4;
+                    }
+                    if COUNT {
+                        counts.nodes_entered += 1;
+                        counts.bounds_tested += end - first;
+                    }
+                }
+                for &i in &level[..width] {
+                    let n = &self.nodes[i as usize];
+                    if n.blocks > 0 {
+                        self.stream.perspective(n.quad as usize, n.blocks, eye, words);
+                        if COUNT {
+                            let [_, _, start, end] = self.flat[i as usize];
+                            counts.ranges += 1;
+                            counts.blocks_tested += n.blocks as usize;
+                            counts.arcs_tested += (end - start) as usize;
+                        }
+                    }
+                }
+                std::mem::swap(level, next);
+                width = next_width;
+            }
+        });
+        counts
+    }
+
+    /// The flat arrays (see [`ConeBvhArrays`]).
+    pub fn to_arrays(&self) -> ConeBvhArrays {
+        ConeBvhArrays {
+            node_boxes: self.boxes.iter().flatten().copied().collect(),
+            node_cones: self.cones.iter().flatten().copied().collect(),
+            nodes: self.flat.iter().flatten().copied().collect(),
+            order: self.order.clone(),
+        }
+    }
+
+    /// Rebuilds a hierarchy from its arrays and the candidates, checking the tree and that every
+    /// box and cone really bounds the candidates below it.
+    pub fn from_arrays(arrays: &ConeBvhArrays, normals: &[[Vec3; 2]], points: &[Vec3]) -> Result<Self, ArraysError> {
+        if points.len() != normals.len() {
+            return Err(ArraysError::Length { array: "points", expected: normals.len(), found: points.len() });
+        }
+        check_permutation(&arrays.order, normals.len())?;
+        let count = arrays.nodes.len() / 4;
+        if count == 0 || arrays.nodes.len() != 4 * count {
+            return Err(ArraysError::Length { array: "nodes", expected: 4 * count.max(1), found: arrays.nodes.len() });
+        }
+        if arrays.node_boxes.len() != 6 * count {
+            return Err(ArraysError::Length {
+                array: "node_boxes",
+                expected: 6 * count,
+                found: arrays.node_boxes.len(),
+            });
+        }
+        if arrays.node_cones.len() != 4 * count {
+            return Err(ArraysError::Length {
+                array: "node_cones",
+                expected: 4 * count,
+                found: arrays.node_cones.len(),
+            });
+        }
+        let flat: Vec<[u32; 4]> = arrays.nodes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let boxes: Vec<[f32; 6]> =
+            arrays.node_boxes.chunks_exact(6).map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]]).collect();
+        let cones: Vec<[f32; 4]> = arrays.node_cones.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let parent = check_breadth_first(&flat, normals.len())?;
+        let mut axes = Vec::with_capacity(count);
+        for (i, c) in cones.iter().enumerate() {
+            if c.iter().any(|x| !x.is_finite()) {
+                return Err(ArraysError::Value { array: "node_cones", index: 4 * i, value: f64::NAN });
+            }
+            let axis = Vec3::new(c[0], c[1], c[2]).as_dvec3();
+            if c[3] < 1.0 && (axis.length() - 1.0).abs() > 1e-6 {
+                return Err(ArraysError::Value { array: "node_cones", index: 4 * i, value: axis.length() });
+            }
+            axes.push(axis.normalize_or_zero());
+        }
+        for_each_in_subtrees(&flat, &parent, &arrays.order, |node, k| {
+            let b = boxes[node];
+            let p = points[k as usize];
+            let inside = b[0] <= p.x && p.x <= b[3] && b[1] <= p.y && p.y <= b[4] && b[2] <= p.z && p.z <= b[5];
+            let s = f64::from(cones[node][3]);
+            let in_cone = s >= 1.0
+                || normals[k as usize].iter().all(|nrm| {
+                    let nrm = nrm.as_dvec3().normalize_or_zero();
+                    let angle = axes[node].cross(nrm).length().atan2(axes[node].dot(nrm));
+                    nrm != DVec3::ZERO && angle < std::f64::consts::FRAC_PI_2 && angle.sin() + CONE_MARGIN * 0.5 <= s
+                });
+            if inside && in_cone { Ok(()) } else { Err(ArraysError::NotConservative { node, candidate: k }) }
+        })?;
+        let a = assemble(&flat, &boxes, &cones, &arrays.order, normals, points);
+        Ok(ConeBvh {
+            nodes: a.nodes,
+            bound_soa: a.bound_soa,
+            widest: a.widest,
+            stream: a.stream,
+            flat,
+            boxes,
+            cones,
+            order: arrays.order.clone(),
+            leaf_size: 0,
+            normal_level: None,
+            predicted_ns: 0.0,
+        })
+    }
+}
+
+/// For each node, the fraction of `eyes` that test its bound and the fraction for which it is not
+/// culled.
+fn visit_frequencies(flat: &[[u32; 4]], boxes: &[[f32; 6]], cones: &[[f32; 4]], eyes: &[Vec3]) -> (Vec<f64>, Vec<f64>) {
+    let n = flat.len();
+    let counts = eyes
+        .par_iter()
+        .fold(
+            || vec![[0u32; 2]; n],
+            |mut acc, &eye| {
+                let mut i = 0;
+                while i < n {
+                    let [_, _, skip, leaf] = flat[i];
+                    acc[i][0] += 1;
+                    if culls(&boxes[i], &cones[i], eye) {
+                        i = skip as usize;
+                        continue;
+                    }
+                    acc[i][1] += 1;
+                    i = if leaf == 1 { skip as usize } else { i + 1 };
+                }
+                acc
+            },
+        )
+        .reduce(|| vec![[0u32; 2]; n], |a, b| a.iter().zip(&b).map(|(x, y)| [x[0] + y[0], x[1] + y[1]]).collect());
+    let k = eyes.len() as f64;
+    counts.iter().map(|c| (f64::from(c[0]) / k, f64::from(c[1]) / k)).unzip()
+}
+
+/// Bottom-up choice of the nodes to turn into leaves, by expected cost over the sampled eyes
+/// (on the preorder tree, before it is widened).
+fn collapse_by_cost(
+    nodes: &[[u32; 4]],
+    children: &[Vec<u32>],
+    visits: &[f64],
+    passes: &[f64],
+    cost: &CostModel,
+) -> Vec<bool> {
+    let n = nodes.len();
+    let enter = f64::from(cost.bvh_enter_ns);
+    let test = f64::from(cost.bvh_test_ns);
+    let range = f64::from(cost.bvh_range_ns);
+    let block = f64::from(cost.bvh_block_ns);
+    let mut best = vec![0.0f64; n];
+    let mut collapse = vec![false; n];
+    for i in (0..n).rev() {
+        let [start, end, _, leaf] = nodes[i];
+        let blocks = f64::from((end - start).div_ceil(4));
+        // Tested by the parent on every visit; entered and its range read when it passes.
+        let leaf_cost = visits[i] * test + passes[i] * (enter + range + block * blocks);
+        if leaf == 1 {
+            best[i] = leaf_cost;
+            continue;
+        }
+        let split = visits[i] * test + passes[i] * enter + children[i].iter().map(|&c| best[c as usize]).sum::<f64>();
+        if leaf_cost < split {
+            collapse[i] = true;
+            best[i] = leaf_cost;
+        } else {
+            best[i] = split;
+        }
+    }
+    collapse
+}
+
+/// The whole tree: normal cells (if any) on top, a spatial BVH below each.
+fn build_tree(points: &[Vec3], unit: &[[DVec3; 2]], leaf_size: u32, normal_level: Option<u8>) -> Tree {
+    let mut tree = Tree::default();
+    let mut ids: Vec<u32> = (0..points.len() as u32).collect();
+    match normal_level {
+        None => spatial(&mut tree, &ids, points, leaf_size),
+        Some(level) => {
+            let base = base_cells(BaseSolid::Icosahedron);
+            let keys: Vec<u32> = unit
+                .par_iter()
+                .map(|&[a, b]| {
+                    let mid = a + b;
+                    if a == DVec3::ZERO || b == DVec3::ZERO || mid.length() <= 1e-9 {
+                        u32::MAX
+                    } else {
+                        cell_key(mid.normalize(), &base, level)
+                    }
+                })
+                .collect();
+            ids.sort_by_key(|&i| keys[i as usize]);
+            let sorted: Vec<u32> = ids.iter().map(|&i| keys[i as usize]).collect();
+            normal_node(&mut tree, &ids, &sorted, 0, level, points, leaf_size);
+        }
+    }
+    tree
+}
+
+/// Emits the subtree for candidates `ids` whose cell keys `keys` (sorted, same order) share their
+/// prefix above `depth`; children split on the digit at `depth` (0 = base face).
+fn normal_node(tree: &mut Tree, ids: &[u32], keys: &[u32], depth: u8, level: u8, points: &[Vec3], leaf_size: u32) {
+    if depth > level || ids.len() <= leaf_size as usize {
+        spatial(tree, ids, points, leaf_size);
+        return;
+    }
+    let shift = 4u32.pow(u32::from(level - depth));
+    let prefix = |k: u32| if k == u32::MAX { u32::MAX } else { k / shift };
+    let mut groups = Vec::new();
+    let mut s = 0;
+    while s < ids.len() {
+        let p = prefix(keys[s]);
+        let mut e = s;
+        while e < ids.len() && prefix(keys[e]) == p {
+            e += 1;
+        }
+        groups.push(s..e);
+        s = e;
+    }
+    if groups.len() == 1 {
+        normal_node(tree, ids, keys, depth + 1, level, points, leaf_size);
+        return;
+    }
+    let at = tree.open();
+    for g in groups {
+        let child = tree.nodes.len() as u32;
+        normal_node(tree, &ids[g.clone()], &keys[g], depth + 1, level, points, leaf_size);
+        tree.children[at].push(child);
+    }
+    tree.close(at, false);
+}
+
+/// Emits an obvhs BVH2 (PLOC) over the points of `ids`, cut at `leaf_size`.
+fn spatial(tree: &mut Tree, ids: &[u32], points: &[Vec3], leaf_size: u32) {
+    if ids.len() <= leaf_size as usize || ids.len() < 2 {
+        let at = tree.open();
+        tree.order.extend_from_slice(ids);
+        tree.close(at, true);
+        return;
+    }
+    let aabbs: Vec<Aabb> = ids.iter().map(|&i| Aabb::from_point(Vec3A::from(points[i as usize]))).collect();
+    let params = BvhBuildParams { max_prims_per_leaf: 1, ..BvhBuildParams::fast_build() };
+    let bvh = build_bvh2(&aabbs, params, &mut Duration::default());
+    // Subtree sizes, children before parents: obvhs places children after their parent.
+    let mut size = vec![0u32; bvh.nodes.len()];
+    for i in (0..bvh.nodes.len()).rev() {
+        let node = &bvh.nodes[i];
+        size[i] = if node.is_leaf() {
+            node.prim_count
+        } else {
+            let c = node.first_index as usize;
+            size.get(c).copied().unwrap_or(0) + size.get(c + 1).copied().unwrap_or(0)
+        };
+    }
+    emit_bvh_node(tree, &bvh, 0, &size, ids, leaf_size);
+}
+
+fn emit_bvh_node(tree: &mut Tree, bvh: &obvhs::bvh2::Bvh2, i: usize, size: &[u32], ids: &[u32], leaf_size: u32) {
+    let at = tree.open();
+    let node = &bvh.nodes[i];
+    let leaf = node.is_leaf() || size[i] <= leaf_size;
+    if leaf {
+        gather(bvh, i, ids, &mut tree.order);
+    } else {
+        let c = node.first_index as usize;
+        for child in [c, c + 1] {
+            let k = tree.nodes.len() as u32;
+            emit_bvh_node(tree, bvh, child, size, ids, leaf_size);
+            tree.children[at].push(k);
+        }
+    }
+    tree.close(at, leaf);
+}
+
+fn gather(bvh: &obvhs::bvh2::Bvh2, i: usize, ids: &[u32], order: &mut Vec<u32>) {
+    let node = &bvh.nodes[i];
+    if node.is_leaf() {
+        let first = node.first_index as usize;
+        order.extend(bvh.primitive_indices[first..first + node.prim_count as usize].iter().map(|&p| ids[p as usize]));
+    } else {
+        gather(bvh, node.first_index as usize, ids, order);
+        gather(bvh, node.first_index as usize + 1, ids, order);
+    }
+}
+
+fn bounding_box(points: impl Iterator<Item = Vec3>) -> [f32; 6] {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in points {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
+}
+
+/// Cone around the normalised mean of unit `normals`: `[axis, sin α + margin]` with α measured from
+/// the `f32` axis, or a never-culled cone.
+fn bounding_cone(normals: impl Iterator<Item = DVec3> + Clone) -> [f32; 4] {
+    let sum = normals.clone().fold(DVec3::ZERO, |s, n| s + n);
+    if sum.length().is_nan() || sum.length() <= 1e-12 {
+        return [0.0, 0.0, 1.0, NEVER_CULL];
+    }
+    let axis32 = sum.normalize().as_vec3();
+    let axis = axis32.as_dvec3().normalize();
+    let mut cos_min = 1.0f64;
+    let mut max_angle = 0.0f64;
+    for n in normals {
+        if n == DVec3::ZERO {
+            return [axis32.x, axis32.y, axis32.z, NEVER_CULL];
+        }
+        let d = axis.dot(n);
+        // Exact angle only where it matters (the widest normal so far).
+        if d <= cos_min {
+            cos_min = d;
+            max_angle = max_angle.max(axis.cross(n).length().atan2(d));
+        }
+    }
+    let alpha = max_angle + 1e-9;
+    if alpha >= std::f64::consts::FRAC_PI_2 - 1e-3 {
+        return [axis32.x, axis32.y, axis32.z, NEVER_CULL];
+    }
+    let s = alpha.sin() + CONE_MARGIN;
+    let s32 = s as f32;
+    let s32 = if f64::from(s32) < s { s32.next_up() } else { s32 };
+    [axis32.x, axis32.y, axis32.z, s32]
+}
+
+/// Deterministic eyes on spheres around the points' bounding box, 1.2 to 4 half-diagonals from its
+/// centre (always outside the box).
+pub(crate) fn sample_eyes(points: &[Vec3], count: u32) -> Vec<Vec3> {
+    if points.is_empty() || count == 0 {
+        return Vec::new();
+    }
+    let b = bounding_box(points.iter().copied());
+    let (lo, hi) = (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]));
+    let center = (lo + hi) * 0.5;
+    let half = ((hi - lo) * 0.5).length().max(1e-6);
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..count)
+        .map(|k| {
+            // Fibonacci sphere directions, radii cycling through [1.2, 4].
+            let z = 1.0 - 2.0 * (k as f32 + 0.5) / count as f32;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = golden * k as f32;
+            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let dist = half * (1.2 + 2.8 * ((k as f32 * 0.618_034) % 1.0));
+            center + dir * dist
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The corner test agrees with dense sampling of the box and the cone.
+    #[test]
+    fn cull_test_is_conservative_on_samples() {
+        let mut s = 99u64;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut culled = 0;
+        for _ in 0..3000 {
+            let axis = Vec3::new(r(), r(), r()).normalize();
+            let alpha = (r() * 0.5 + 0.5) * 1.2;
+            let lo = Vec3::new(r(), r(), r());
+            let hi = lo + Vec3::new(r().abs(), r().abs(), r().abs()) * 0.5;
+            let b = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z];
+            let c = [axis.x, axis.y, axis.z, alpha.sin() + 1e-5];
+            let e = Vec3::new(r(), r(), r()) * 3.0;
+            if !culls(&b, &c, e) {
+                continue;
+            }
+            culled += 1;
+            // Any normal inside the cone and any point in the box give the same sign.
+            let mut sign = 0.0f32;
+            for _ in 0..200 {
+                let p = lo + (hi - lo) * Vec3::new(r() * 0.5 + 0.5, r() * 0.5 + 0.5, r() * 0.5 + 0.5);
+                let tangent = axis.any_orthonormal_vector();
+                let n = (axis * alpha.cos() * 1.0001
+                    + tangent.rotate_towards(axis.cross(tangent), r() * 3.2) * alpha.sin())
+                .normalize();
+                let v = n.dot(e - p);
+                assert!(v != 0.0);
+                if sign == 0.0 {
+                    sign = v.signum();
+                }
+                assert_eq!(sign, v.signum());
+            }
+        }
+        assert!(culled > 100, "only {culled} culled");
+    }
+
+    #[test]
+    fn eyes_are_outside_the_box() {
+        let pts = [Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0)];
+        for e in sample_eyes(&pts, 50) {
+            assert!(!(e.cmpge(Vec3::ZERO).all() && e.cmple(Vec3::new(1.0, 2.0, 3.0)).all()));
+        }
+    }
+}

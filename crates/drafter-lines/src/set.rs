@@ -1,0 +1,132 @@
+//! [`EdgeSet`]: the answer of a silhouette query, a bitset over candidate indices.
+
+use serde::{Deserialize, Serialize};
+
+/// A set of candidate indices (`0..len`), stored as a bitset so that every query method can fill it
+/// in any order and two answers compare in `len / 64` word comparisons.
+///
+/// Invariant: bits at or above `len` are zero.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct EdgeSet {
+    words: Vec<u64>,
+    len: usize,
+}
+
+impl EdgeSet {
+    /// An empty set over `len` candidates.
+    pub fn new(len: usize) -> Self {
+        Self { words: vec![0; len.div_ceil(64)], len }
+    }
+
+    /// Empties the set and makes it range over `len` candidates, keeping the allocation.
+    pub fn reset(&mut self, len: usize) {
+        self.words.clear();
+        self.words.resize(len.div_ceil(64), 0);
+        self.len = len;
+    }
+
+    /// The number of candidates the set ranges over (not the number of members: see [`EdgeSet::count`]).
+    pub fn universe(&self) -> usize {
+        self.len
+    }
+
+    /// Number of members.
+    pub fn count(&self) -> usize {
+        self.words.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.words.iter().all(|&w| w == 0)
+    }
+
+    /// Whether candidate `i` is a member (`false` outside the universe).
+    #[inline]
+    pub fn contains(&self, i: usize) -> bool {
+        i < self.len && self.words[i / 64] >> (i % 64) & 1 == 1
+    }
+
+    /// Adds candidate `i`. Panics if `i` is outside the universe (an internal bug).
+    #[inline]
+    pub fn insert(&mut self, i: usize) {
+        assert!(i < self.len, "candidate {i} outside a set of {}", self.len);
+        self.words[i / 64] |= 1 << (i % 64);
+    }
+
+    /// Members in increasing order.
+    pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        self.words.iter().enumerate().flat_map(|(w, &word)| BitIter { word, base: (w * 64) as u32 })
+    }
+
+    /// Members in increasing order, collected.
+    pub fn to_vec(&self) -> Vec<u32> {
+        let mut out = Vec::with_capacity(self.count());
+        out.extend(self.iter());
+        out
+    }
+
+    /// The 64-bit words, least significant bit first (candidate `i` is bit `i % 64` of word `i / 64`).
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
+    /// Mutable words for the query kernels; callers keep bits at or above `len` zero.
+    #[inline]
+    pub(crate) fn words_mut(&mut self) -> &mut [u64] {
+        &mut self.words
+    }
+
+    /// Members of `self` that are not in `other`, and members of `other` not in `self`
+    /// (for reports of mismatches).
+    pub fn symmetric_difference(&self, other: &EdgeSet) -> Vec<u32> {
+        let n = self.words.len().max(other.words.len());
+        let mut out = Vec::new();
+        for w in 0..n {
+            let a = self.words.get(w).copied().unwrap_or(0);
+            let b = other.words.get(w).copied().unwrap_or(0);
+            out.extend(BitIter { word: a ^ b, base: (w * 64) as u32 });
+        }
+        out
+    }
+}
+
+struct BitIter {
+    word: u64,
+    base: u32,
+}
+
+impl Iterator for BitIter {
+    type Item = u32;
+
+    #[inline]
+    fn next(&mut self) -> Option<u32> {
+        if self.word == 0 {
+            return None;
+        }
+        let bit = self.word.trailing_zeros();
+        self.word &= self.word - 1;
+        Some(self.base + bit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn insert_iterate_reset() {
+        let mut s = EdgeSet::new(130);
+        for i in [0, 5, 63, 64, 129] {
+            s.insert(i);
+        }
+        assert_eq!(s.to_vec(), vec![0, 5, 63, 64, 129]);
+        assert_eq!(s.count(), 5);
+        assert!(s.contains(64) && !s.contains(65) && !s.contains(1000));
+        let mut t = EdgeSet::new(130);
+        t.insert(5);
+        t.insert(7);
+        assert_eq!(s.symmetric_difference(&t), vec![0, 7, 63, 64, 129]);
+        s.reset(10);
+        assert!(s.is_empty());
+        assert_eq!(s.universe(), 10);
+    }
+}

@@ -1,0 +1,197 @@
+//! The breadth-first layout shared by both hierarchies, and its validation.
+//!
+//! Node `i` is `[first_child, child_count, arc_start, arc_end]`: its children are the nodes
+//! `first_child..first_child + child_count` (all after `i`, so children of consecutive nodes are
+//! consecutive), and it owns the candidates `order[arc_start..arc_end]`; the own ranges of the
+//! nodes follow one another in node order. Node 0 is the root.
+//!
+//! Why breadth-first: on the 2-core machines this was tuned on, a dependent cache miss costs 50 ns
+//! (2 MB working set) to 350 ns (32 MB), while streaming brute force reads a candidate every 0.7 ns.
+//! A query therefore walks one level at a time: every node of the level is known before any of
+//! them is read, so their memory accesses overlap instead of waiting on one another, and the caps
+//! of a node's children sit side by side.
+
+use std::cell::RefCell;
+
+use crate::ArraysError;
+
+thread_local! {
+    /// The current and next level of a breadth-first walk, reused across queries on a thread.
+    static LEVELS: RefCell<(Vec<u32>, Vec<u32>)> = RefCell::new(Default::default());
+}
+
+/// Runs `walk` with two level buffers of at least `len` entries each.
+pub(crate) fn with_levels<R>(len: usize, walk: impl FnOnce(&mut Vec<u32>, &mut Vec<u32>) -> R) -> R {
+    let grow = |v: &mut Vec<u32>| {
+        if v.len() < len {
+            v.resize(len, 0);
+        }
+    };
+    LEVELS.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut pair) => {
+            let (a, b) = &mut *pair;
+            grow(a);
+            grow(b);
+            walk(a, b)
+        }
+        Err(_) => walk(&mut vec![0; len], &mut vec![0; len]),
+    })
+}
+
+/// Bits `0..k` set (k ≤ 4).
+#[inline(always)]
+pub(crate) fn lanes(k: usize) -> u32 {
+    if k >= 4 { 0xF } else { (1u32 << k) - 1 }
+}
+
+/// The largest number of nodes at one depth.
+pub(crate) fn widest_level(nodes: &[[u32; 4]]) -> usize {
+    let depth = depths(nodes);
+    let mut count = vec![0usize; depth.iter().map(|&d| d as usize + 1).max().unwrap_or(0)];
+    for d in depth {
+        count[d as usize] += 1;
+    }
+    count.into_iter().max().unwrap_or(0)
+}
+
+/// Builds the breadth-first layout of a tree given as children lists and own candidates; returns
+/// the nodes, the new `order`, and for each new node the index of the node it came from.
+pub(crate) fn breadth_first<'a>(
+    root: usize,
+    children: impl Fn(usize) -> &'a [u32],
+    own: impl Fn(usize) -> &'a [u32],
+) -> (Vec<[u32; 4]>, Vec<u32>, Vec<usize>) {
+    let mut source = vec![root];
+    let mut nodes = Vec::new();
+    let mut order = Vec::new();
+    let mut i = 0;
+    while i < source.len() {
+        let old = source[i];
+        let kids = children(old);
+        let first = source.len() as u32;
+        source.extend(kids.iter().map(|&k| k as usize));
+        let start = order.len() as u32;
+        order.extend_from_slice(own(old));
+        nodes.push([if kids.is_empty() { 0 } else { first }, kids.len() as u32, start, order.len() as u32]);
+        i += 1;
+    }
+    (nodes, order, source)
+}
+
+/// Checks the layout over `len` candidates and returns each node's parent (`u32::MAX` for the root).
+pub(crate) fn check_breadth_first(nodes: &[[u32; 4]], len: usize) -> Result<Vec<u32>, ArraysError> {
+    let n = nodes.len();
+    if n == 0 {
+        return Err(ArraysError::Length { array: "nodes", expected: 4, found: 0 });
+    }
+    let mut parent = vec![u32::MAX; n];
+    let mut next_child = 1usize;
+    let mut next_arc = 0u32;
+    for (i, &[first, count, start, end]) in nodes.iter().enumerate() {
+        let bad = ArraysError::Tree { node: i };
+        if count > 0 {
+            if first as usize != next_child || first as usize <= i {
+                return Err(bad);
+            }
+            let stop = next_child.checked_add(count as usize).filter(|&s| s <= n).ok_or(bad.clone())?;
+            for p in &mut parent[next_child..stop] {
+                *p = i as u32;
+            }
+            next_child = stop;
+        }
+        if start != next_arc || end < start || end as usize > len {
+            return Err(bad);
+        }
+        next_arc = end;
+        if i > 0 && parent[i] == u32::MAX {
+            return Err(bad);
+        }
+    }
+    if next_child != n || next_arc as usize != len {
+        return Err(ArraysError::Tree { node: n - 1 });
+    }
+    Ok(parent)
+}
+
+/// Depth of every node (root 0).
+pub(crate) fn depths(nodes: &[[u32; 4]]) -> Vec<u32> {
+    let mut depth = vec![0u32; nodes.len()];
+    for (i, &[first, count, _, _]) in nodes.iter().enumerate() {
+        let below = depth[i] + 1;
+        for c in first..first + count {
+            if let Some(d) = depth.get_mut(c as usize) {
+                *d = below;
+            }
+        }
+    }
+    depth
+}
+
+/// `order` must hold each of `0..len` exactly once.
+pub(crate) fn check_permutation(order: &[u32], len: usize) -> Result<(), ArraysError> {
+    if order.len() != len {
+        return Err(ArraysError::Length { array: "order", expected: len, found: order.len() });
+    }
+    let mut seen = vec![false; len];
+    for (k, &i) in order.iter().enumerate() {
+        match seen.get_mut(i as usize) {
+            Some(s) if !*s => *s = true,
+            _ => return Err(ArraysError::Value { array: "order", index: k, value: f64::from(i) }),
+        }
+    }
+    Ok(())
+}
+
+/// For every node, the candidates of its whole subtree (itself and all descendants), for checking
+/// that a bound holds everything below it: each candidate is listed under each of its ancestors.
+pub(crate) fn for_each_in_subtrees(
+    nodes: &[[u32; 4]],
+    parent: &[u32],
+    order: &[u32],
+    mut visit: impl FnMut(usize, u32) -> Result<(), ArraysError>,
+) -> Result<(), ArraysError> {
+    for (j, &[_, _, start, end]) in nodes.iter().enumerate() {
+        for &c in &order[start as usize..end as usize] {
+            let mut k = j as u32;
+            while k != u32::MAX {
+                visit(k as usize, c)?;
+                k = parent[k as usize];
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_and_checks() {
+        // 0 -> {1, 2}, 1 -> {3}; own candidates: 0: [5], 1: [], 2: [0, 1], 3: [2, 3, 4].
+        let children: Vec<Vec<u32>> = vec![vec![1, 2], vec![3], vec![], vec![]];
+        let own: Vec<Vec<u32>> = vec![vec![5], vec![], vec![0, 1], vec![2, 3, 4]];
+        let (nodes, order, source) = breadth_first(0, |i| &children[i], |i| &own[i]);
+        assert_eq!(source, vec![0, 1, 2, 3]);
+        assert_eq!(nodes, vec![[1, 2, 0, 1], [3, 1, 1, 1], [0, 0, 1, 3], [0, 0, 3, 6]]);
+        assert_eq!(order, vec![5, 0, 1, 2, 3, 4]);
+        let parent = check_breadth_first(&nodes, 6).unwrap();
+        assert_eq!(parent, vec![u32::MAX, 0, 0, 1]);
+        assert_eq!(depths(&nodes), vec![0, 1, 1, 2]);
+        let mut bad = nodes.clone();
+        bad[1][0] = 2;
+        assert!(check_breadth_first(&bad, 6).is_err());
+        let mut bad = nodes.clone();
+        bad[2][3] = 2;
+        assert!(check_breadth_first(&bad, 6).is_err());
+        assert!(check_permutation(&order, 6).is_ok());
+        assert!(check_permutation(&[0, 0, 1, 2, 3, 4], 6).is_err());
+        let mut seen = vec![];
+        for_each_in_subtrees(&nodes, &parent, &order, |node, c| {
+            seen.push((node, c));
+            Ok(())
+        })
+        .unwrap();
+        assert!(seen.contains(&(0, 4)) && seen.contains(&(1, 4)) && !seen.contains(&(2, 4)));
+    }
+}

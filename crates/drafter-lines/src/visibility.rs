@@ -1,0 +1,356 @@
+//! Writing and reading the draft Khronos extension `EXT_mesh_primitive_edge_visibility`
+//! (rules restated in ../shared/specs/EXT_mesh_primitive_edge_visibility.md).
+//!
+//! `visibility` holds 2 bits per triangle edge, edges `v0:v1, v1:v2, v2:v0` of each triangle in glTF
+//! order, packed from the least significant bits of each byte; `ceil(6·N/8)` bytes with the unused
+//! high bits zero. Values: 0 hidden, 1 silhouette candidate, 2 hard edge, 3 hard edge already
+//! encoded as 2.
+//!
+//! The encoder walks the primitive's own triangles (its original, unwelded indices) and identifies
+//! edges through the welded topology, so the two sides of a CAD seam, which use different vertex
+//! indices, are one edge: a hard edge is written 2 on the first triangle edge that meets it and 3 on
+//! every other; a silhouette candidate is written 1 once and 0 elsewhere, and its two face normals
+//! (smaller face index first) go to `silhouetteNormals` as "oct16" in the order the 1s appear.
+//! Coplanar and degenerate-neighbour edges are 0, and so are all three edges of a triangle that
+//! collapsed in the weld (a repeated welded vertex: the topology gives it no edges); the decoder
+//! requires those zeros and otherwise ignores such triangles.
+//! The encode-once rules hold per call: encode each primitive with its own triangles.
+//!
+//! "oct16" is the octahedral encoding of Cigolle et al. (2014, "A Survey of Efficient
+//! Representations for Independent Unit Vectors", JCGT 3(2)) with 8 bits per axis, as in iTwin.js
+//! (Bentley's reference client of the draft): `x` in the low byte, `y` in the high byte, each
+//! quantised as `floor(0.5 + (v·0.5 + 0.5)·255)`.
+
+use std::collections::HashMap;
+
+use drafter_core::Topology;
+use glam::{DVec2, DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::{EdgeClass, FeatureEdges};
+
+/// Values of one triangle edge.
+pub const HIDDEN: u8 = 0;
+pub const SILHOUETTE: u8 = 1;
+pub const HARD: u8 = 2;
+pub const HARD_REPEATED: u8 = 3;
+
+/// Problems found by [`encode_edge_visibility`] (caller bugs) or [`decode_edge_visibility`] (a
+/// file that breaks the draft's rules).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum VisibilityError {
+    #[error("triangle {triangle} uses vertex {vertex}, but the topology has {vertices} vertices")]
+    VertexOutOfRange { triangle: usize, vertex: u32, vertices: usize },
+    #[error("edge {corner} of triangle {triangle} is not an edge of the topology")]
+    UnknownEdge { triangle: usize, corner: usize },
+    #[error("visibility has {found} bytes, {expected} expected for {triangles} triangles")]
+    Length { expected: usize, found: usize, triangles: usize },
+    #[error("unused high bits of the last visibility byte are not zero")]
+    TrailingBits,
+    #[error("triangle {triangle} collapsed in the weld but its edge {corner} is encoded {value}")]
+    CollapsedEdge { triangle: usize, corner: usize, value: u8 },
+    #[error("edge {a}-{b}: {twos} occurrences encoded 2, {threes} encoded 3, {ones} encoded 1 and {zeros} encoded 0")]
+    EncodeOnce { a: u32, b: u32, zeros: u32, ones: u32, twos: u32, threes: u32 },
+    #[error("silhouetteNormals has {found} entries, 2 × {ones} expected")]
+    NormalCount { expected: usize, found: usize, ones: usize },
+    #[error("every visibility value is zero")]
+    AllHidden,
+}
+
+/// The extension's payload for one primitive.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EdgeVisibility {
+    /// The `visibility` accessor's bytes.
+    pub visibility: Vec<u8>,
+    /// The `silhouetteNormals` accessor's values: two oct16 normals per 1-edge, in encoding order.
+    pub silhouette_normals: Vec<u16>,
+    /// Topology edge id of each 1-edge, in encoding order (links `silhouette_normals` to the
+    /// full-precision normals of our own extension).
+    pub silhouette_edges: Vec<u32>,
+    /// Topology edge id of each 2-edge, in encoding order.
+    pub hard_edges: Vec<u32>,
+}
+
+impl EdgeVisibility {
+    /// The draft requires at least one non-zero value: write the extension only when this holds.
+    pub fn has_visible_edges(&self) -> bool {
+        !self.hard_edges.is_empty() || !self.silhouette_edges.is_empty()
+    }
+}
+
+/// Encodes `triangles` (original vertex indices, glTF order, all of them mapped by
+/// `topology.welded_of_vertex`) with the classes of `lines` (computed on `topology`).
+pub fn encode_edge_visibility(
+    triangles: &[[u32; 3]],
+    topology: &Topology,
+    lines: &FeatureEdges,
+) -> Result<EdgeVisibility, VisibilityError> {
+    let lookup = EdgeLookup::new(topology);
+    let mut out = EdgeVisibility { visibility: vec![0; (6 * triangles.len()).div_ceil(8)], ..Default::default() };
+    let mut written = vec![false; topology.edges.len()];
+    for (t, tri) in triangles.iter().enumerate() {
+        let welded = welded_triangle(tri, t, &topology.welded_of_vertex)?;
+        if collapsed(&welded) {
+            continue;
+        }
+        for k in 0..3 {
+            let (a, b) = (welded[k], welded[(k + 1) % 3]);
+            let e = lookup.find(a, b).ok_or(VisibilityError::UnknownEdge { triangle: t, corner: k })?;
+            let class = lines.classes[e];
+            let value = if class.is_hard() {
+                if written[e] {
+                    HARD_REPEATED
+                } else {
+                    out.hard_edges.push(e as u32);
+                    HARD
+                }
+            } else if class == EdgeClass::SilhouetteCandidate && !written[e] {
+                let c = lines
+                    .candidates
+                    .binary_search(&(e as u32))
+                    .map_err(|_| VisibilityError::UnknownEdge { triangle: t, corner: k })?;
+                let [n1, n2] = lines.candidate_normals[c];
+                out.silhouette_normals.push(oct16_encode(n1));
+                out.silhouette_normals.push(oct16_encode(n2));
+                out.silhouette_edges.push(e as u32);
+                SILHOUETTE
+            } else {
+                HIDDEN
+            };
+            written[e] = true;
+            let slot = 3 * t + k;
+            out.visibility[slot / 4] |= value << (2 * (slot % 4));
+        }
+    }
+    Ok(out)
+}
+
+/// A triangle with a repeated welded vertex: the topology gives it no edges, it is encoded 0.
+fn collapsed(w: &[u32; 3]) -> bool {
+    w[0] == w[1] || w[1] == w[2] || w[2] == w[0]
+}
+
+fn welded_triangle(tri: &[u32; 3], t: usize, welded_of_vertex: &[u32]) -> Result<[u32; 3], VisibilityError> {
+    let mut w = [0u32; 3];
+    for k in 0..3 {
+        w[k] = *welded_of_vertex.get(tri[k] as usize).ok_or(VisibilityError::VertexOutOfRange {
+            triangle: t,
+            vertex: tri[k],
+            vertices: welded_of_vertex.len(),
+        })?;
+    }
+    Ok(w)
+}
+
+/// Edge id by welded vertex pair: edges are sorted by `(a, b)`, so a CSR offset per `a` and a
+/// binary search per bucket.
+struct EdgeLookup<'a> {
+    edges: &'a [[u32; 2]],
+    first: Vec<u32>,
+}
+
+impl<'a> EdgeLookup<'a> {
+    fn new(topology: &'a Topology) -> Self {
+        let n = topology.welded_positions.len();
+        let mut first = vec![0u32; n + 2];
+        for &[a, _] in &topology.edges {
+            if (a as usize) < n {
+                first[a as usize + 1] += 1;
+            }
+        }
+        for v in 0..=n {
+            first[v + 1] += first[v];
+        }
+        Self { edges: &topology.edges, first }
+    }
+
+    fn find(&self, u: u32, w: u32) -> Option<usize> {
+        let (a, b) = (u.min(w), u.max(w));
+        let lo = *self.first.get(a as usize)? as usize;
+        let hi = *self.first.get(a as usize + 1)? as usize;
+        self.edges[lo..hi].binary_search_by_key(&b, |e| e[1]).ok().map(|k| lo + k)
+    }
+}
+
+/// What a file's `visibility` and `silhouetteNormals` say, per welded edge.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DecodedEdgeVisibility {
+    /// Welded vertex pairs `[a, b]`, `a < b`, of the hard edges, sorted.
+    pub hard: Vec<[u32; 2]>,
+    /// Silhouette edges with their two decoded normals, sorted by pair.
+    pub silhouettes: Vec<([u32; 2], [Vec3; 2])>,
+}
+
+/// Decodes one primitive's payload and checks the draft's rules by recounting every edge
+/// independently of [`Topology`]: edges are identified by welded vertex pairs (`welded_of_vertex`;
+/// pass the identity to identify them by index as a plain client would).
+pub fn decode_edge_visibility(
+    triangles: &[[u32; 3]],
+    welded_of_vertex: &[u32],
+    visibility: &[u8],
+    silhouette_normals: &[u16],
+) -> Result<DecodedEdgeVisibility, VisibilityError> {
+    let slots = 3 * triangles.len();
+    let expected = (2 * slots).div_ceil(8);
+    if visibility.len() != expected {
+        return Err(VisibilityError::Length { expected, found: visibility.len(), triangles: triangles.len() });
+    }
+    if !slots.is_multiple_of(4) && visibility.last().is_some_and(|&last| last >> (2 * (slots % 4)) != 0) {
+        return Err(VisibilityError::TrailingBits);
+    }
+    // Per pair: how often each value occurs, and the normals of its 1.
+    type Tally = ([u32; 4], Option<[Vec3; 2]>);
+    let mut edges: HashMap<[u32; 2], Tally> = HashMap::new();
+    let mut ones = 0usize;
+    let mut any = false;
+    for (t, tri) in triangles.iter().enumerate() {
+        let w = welded_triangle(tri, t, welded_of_vertex)?;
+        for k in 0..3 {
+            let slot = 3 * t + k;
+            let value = (visibility[slot / 4] >> (2 * (slot % 4))) & 3;
+            any |= value != 0;
+            if collapsed(&w) {
+                if value != 0 {
+                    return Err(VisibilityError::CollapsedEdge { triangle: t, corner: k, value });
+                }
+                continue;
+            }
+            let (a, b) = (w[k], w[(k + 1) % 3]);
+            let entry = edges.entry([a.min(b), a.max(b)]).or_default();
+            entry.0[value as usize] += 1;
+            if value == SILHOUETTE {
+                if let (Some(&x), Some(&y)) = (silhouette_normals.get(2 * ones), silhouette_normals.get(2 * ones + 1)) {
+                    entry.1 = Some([oct16_decode(x), oct16_decode(y)]);
+                }
+                ones += 1;
+            }
+        }
+    }
+    if silhouette_normals.len() != 2 * ones {
+        return Err(VisibilityError::NormalCount { expected: 2 * ones, found: silhouette_normals.len(), ones });
+    }
+    if !any {
+        return Err(VisibilityError::AllHidden);
+    }
+    let mut out = DecodedEdgeVisibility::default();
+    for (&[a, b], &([zeros, ones, twos, threes], normals)) in &edges {
+        let hard = twos + threes > 0;
+        let broken = if hard { twos != 1 || zeros != 0 || ones != 0 } else { ones > 1 };
+        if broken {
+            return Err(VisibilityError::EncodeOnce { a, b, zeros, ones, twos, threes });
+        }
+        if hard {
+            out.hard.push([a, b]);
+        } else if let (1, Some(n)) = (ones, normals) {
+            out.silhouettes.push(([a, b], n));
+        }
+    }
+    out.hard.sort_unstable();
+    out.silhouettes.sort_unstable_by_key(|s| s.0);
+    Ok(out)
+}
+
+fn sign_not_zero(v: f64) -> f64 {
+    if v < 0.0 { -1.0 } else { 1.0 }
+}
+
+/// Octahedral encoding, 8 bits per axis (see the module docs). A zero or non-finite vector
+/// encodes +Z.
+pub fn oct16_encode(n: Vec3) -> u16 {
+    let n = n.as_dvec3();
+    let denom = n.x.abs() + n.y.abs() + n.z.abs();
+    if denom.is_nan() || denom <= 0.0 || denom.is_infinite() {
+        return oct16_pack(DVec2::ZERO);
+    }
+    let mut p = DVec2::new(n.x / denom, n.y / denom);
+    if n.z < 0.0 {
+        p = DVec2::new((1.0 - p.y.abs()) * sign_not_zero(p.x), (1.0 - p.x.abs()) * sign_not_zero(p.y));
+    }
+    oct16_pack(p)
+}
+
+fn oct16_pack(p: DVec2) -> u16 {
+    let q = |v: f64| (0.5 + (v.clamp(-1.0, 1.0) * 0.5 + 0.5) * 255.0).floor() as u16;
+    (q(p.y) << 8) | q(p.x)
+}
+
+/// Inverse of [`oct16_encode`], a unit vector.
+pub fn oct16_decode(v: u16) -> Vec3 {
+    let x = f64::from(v & 0xff) / 255.0 * 2.0 - 1.0;
+    let y = f64::from(v >> 8) / 255.0 * 2.0 - 1.0;
+    let z = 1.0 - (x.abs() + y.abs());
+    let n = if z < 0.0 {
+        DVec3::new((1.0 - y.abs()) * sign_not_zero(x), (1.0 - x.abs()) * sign_not_zero(y), z)
+    } else {
+        DVec3::new(x, y, z)
+    };
+    n.normalize().as_vec3()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oct16_round_trip_within_a_degree() {
+        let mut s = 3u64;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut worst = 0.0f32;
+        for k in 0..20000 {
+            let n = match k {
+                0 => Vec3::X,
+                1 => Vec3::NEG_Z,
+                2 => Vec3::new(-1.0, 0.0, -1.0).normalize(),
+                _ => Vec3::new(r(), r(), r()).normalize(),
+            };
+            let back = oct16_decode(oct16_encode(n));
+            worst = worst.max(n.dot(back).clamp(-1.0, 1.0).acos().to_degrees());
+        }
+        assert!(worst < 1.0, "worst oct16 error {worst}°");
+        // The conventions: +Z is the centre of the square, x in the low byte.
+        assert_eq!(oct16_encode(Vec3::Z), 0x8080);
+        assert_eq!(oct16_encode(Vec3::X) & 0xff, 255);
+        assert_eq!(oct16_encode(Vec3::Y) >> 8, 255);
+    }
+
+    #[test]
+    fn decoder_rejects_broken_rules() {
+        // Two triangles sharing edge 0-2 (slots 2 of t0, 0 of t1).
+        let tris = [[0u32, 1, 2], [0, 2, 3]];
+        let ident = [0u32, 1, 2, 3];
+        let pack = |v: [u8; 6]| -> Vec<u8> {
+            let mut b = vec![0u8; 2];
+            for (s, x) in v.iter().enumerate() {
+                b[s / 4] |= x << (2 * (s % 4));
+            }
+            b
+        };
+        // Shared edge written 2 twice.
+        let err = decode_edge_visibility(&tris, &ident, &pack([0, 0, 2, 2, 0, 0]), &[]).unwrap_err();
+        assert!(matches!(err, VisibilityError::EncodeOnce { a: 0, b: 2, twos: 2, .. }));
+        // 3 without 2.
+        assert!(decode_edge_visibility(&tris, &ident, &pack([0, 0, 3, 3, 0, 0]), &[]).is_err());
+        // Silhouette twice.
+        assert!(decode_edge_visibility(&tris, &ident, &pack([0, 0, 1, 1, 0, 0]), &[1, 2, 3, 4]).is_err());
+        // Missing normals.
+        assert!(matches!(
+            decode_edge_visibility(&tris, &ident, &pack([0, 0, 1, 0, 0, 0]), &[]),
+            Err(VisibilityError::NormalCount { .. })
+        ));
+        assert_eq!(decode_edge_visibility(&tris, &ident, &pack([0; 6]), &[]), Err(VisibilityError::AllHidden));
+        assert!(matches!(decode_edge_visibility(&tris, &ident, &[0], &[]), Err(VisibilityError::Length { .. })));
+        let mut bytes = pack([2, 2, 2, 3, 2, 2]);
+        bytes[1] |= 0b1000_0000;
+        assert_eq!(decode_edge_visibility(&tris, &ident, &bytes, &[]), Err(VisibilityError::TrailingBits));
+        // A valid one.
+        let ok = decode_edge_visibility(&tris, &ident, &pack([2, 2, 1, 0, 2, 2]), &[0x8080, 0x80ff]).unwrap();
+        assert_eq!(ok.hard.len(), 4);
+        assert_eq!(ok.silhouettes.len(), 1);
+        assert_eq!(ok.silhouettes[0].0, [0, 2]);
+    }
+}

@@ -1,0 +1,100 @@
+//! The `EXT_mesh_primitive_edge_visibility` encoder against a decoder that recounts every edge.
+
+// Helpers outside #[test] functions unwrap too: this whole file is test code.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+
+use common::*;
+use drafter_core::{Topology, Weld};
+use drafter_lines::*;
+
+fn round_trip(mesh: &TestMesh) {
+    let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+    let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+    let encoded = encode_edge_visibility(&mesh.triangles, &topology, &lines).unwrap();
+    assert_eq!(encoded.visibility.len(), (6 * mesh.triangles.len()).div_ceil(8));
+    assert_eq!(encoded.silhouette_normals.len(), 2 * encoded.silhouette_edges.len());
+    assert_eq!(encoded.hard_edges.len(), lines.counts.hard(), "{}", mesh.name);
+    assert_eq!(encoded.silhouette_edges.len(), lines.counts.silhouette_candidate);
+
+    let decoded = decode_edge_visibility(
+        &mesh.triangles,
+        &topology.welded_of_vertex,
+        &encoded.visibility,
+        &encoded.silhouette_normals,
+    )
+    .unwrap();
+    let mut hard: Vec<[u32; 2]> =
+        (0..lines.classes.len()).filter(|&e| lines.classes[e].is_hard()).map(|e| topology.edges[e]).collect();
+    hard.sort_unstable();
+    assert_eq!(decoded.hard, hard, "{}", mesh.name);
+    let pairs: Vec<[u32; 2]> = decoded.silhouettes.iter().map(|s| s.0).collect();
+    let expected: Vec<[u32; 2]> = lines.candidates.iter().map(|&e| topology.edges[e as usize]).collect();
+    assert_eq!(pairs, expected);
+    // Normals survive oct16 within a degree, in the edge's face order.
+    for ((_, [d1, d2]), [n1, n2]) in decoded.silhouettes.iter().zip(&lines.candidate_normals) {
+        assert!(d1.angle_between(*n1).to_degrees() < 1.0);
+        assert!(d2.angle_between(*n2).to_degrees() < 1.0);
+    }
+    // The encoding order of the 1s is triangle order: the decoder's normals match the encoder's
+    // edge list one to one.
+    for (k, &e) in encoded.silhouette_edges.iter().enumerate() {
+        let c = lines.candidates.binary_search(&e).unwrap();
+        assert_eq!(encoded.silhouette_normals[2 * k], oct16_encode(lines.candidate_normals[c][0]));
+    }
+}
+
+#[test]
+fn sphere_round_trips() {
+    round_trip(&uv_sphere(64, 40));
+}
+
+#[test]
+fn unwelded_cad_plate_round_trips() {
+    // Every CAD face is its own patch: the seams are found through the weld, so each crease is
+    // encoded 2 on one side and 3 on the other, never 2 twice.
+    let plate = plate_with_holes(12, 16);
+    round_trip(&plate);
+    let topology = Topology::from_triangles(&plate.positions, &plate.triangles, Weld::Exact);
+    let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+    let encoded = encode_edge_visibility(&plate.triangles, &topology, &lines).unwrap();
+    let values: Vec<u8> =
+        (0..3 * plate.triangles.len()).map(|s| (encoded.visibility[s / 4] >> (2 * (s % 4))) & 3).collect();
+    assert!(values.contains(&HARD_REPEATED) && values.contains(&HARD) && values.contains(&SILHOUETTE));
+}
+
+#[test]
+fn random_soups_round_trip() {
+    for seed in 0..30 {
+        let mesh = random_lattice_mesh(20, 60, seed);
+        let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+        let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+        let encoded = encode_edge_visibility(&mesh.triangles, &topology, &lines).unwrap();
+        if encoded.has_visible_edges() {
+            round_trip(&mesh);
+        }
+    }
+}
+
+#[test]
+fn per_primitive_encoding_holds_the_rules() {
+    // Two "primitives": the halves of a sphere's triangle list, encoded separately.
+    let mesh = uv_sphere(32, 20);
+    let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+    let lines = classify_edges(&topology, None, &LineOptions { crease_angle_deg: 5.0, ..Default::default() }).unwrap();
+    let half = mesh.triangles.len() / 2;
+    for part in [&mesh.triangles[..half], &mesh.triangles[half..]] {
+        let e = encode_edge_visibility(part, &topology, &lines).unwrap();
+        decode_edge_visibility(part, &topology.welded_of_vertex, &e.visibility, &e.silhouette_normals).unwrap();
+    }
+    // Triangles that are not in the topology are a caller bug.
+    assert!(matches!(
+        encode_edge_visibility(&[[0, 5, 300]], &topology, &lines),
+        Err(VisibilityError::UnknownEdge { .. })
+    ));
+    assert!(matches!(
+        encode_edge_visibility(&[[0, 1, 1_000_000]], &topology, &lines),
+        Err(VisibilityError::VertexOutOfRange { .. })
+    ));
+}

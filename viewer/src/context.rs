@@ -1,0 +1,85 @@
+//! The wgpu instance, adapter, device and queue.
+//!
+//! Headless rendering needs no window: on a machine without a GPU, Mesa's lavapipe (`apt-get
+//! install mesa-vulkan-drivers libvulkan1`) provides a Vulkan CPU device that wgpu picks up with no
+//! configuration. `WGPU_BACKEND` (e.g. `vulkan`, `gl`) and `WGPU_ADAPTER_NAME` choose explicitly.
+
+/// Why rendering could not start or finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No adapter: no GPU and no software Vulkan/GL driver.
+    #[error(
+        "no GPU adapter found ({0}); headless rendering needs a Vulkan or GL driver: on Debian/Ubuntu \
+         `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe, a CPU Vulkan device), or set \
+         WGPU_BACKEND=gl with Mesa's EGL installed"
+    )]
+    NoAdapter(String),
+    #[error("the GPU adapter refused a device: {0}")]
+    Device(String),
+    /// Options outside their documented ranges (the caller's fault).
+    #[error("invalid render options: {0}")]
+    Options(String),
+    /// A GPU operation failed (validation, out of memory, lost device).
+    #[error("GPU error: {0}")]
+    Gpu(String),
+    /// No model has been given to the renderer yet.
+    #[error("no model loaded")]
+    NoModel,
+}
+
+/// The device every pass is created on.
+#[derive(Debug)]
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+impl Gpu {
+    /// A device for offscreen rendering (environment variables respected, see the module docs).
+    ///
+    /// Mesa 22's lavapipe crashes in `vkCmdBeginDebugUtilsLabelEXT`, which wgpu calls for debug
+    /// groups when the instance has [`wgpu::InstanceFlags::DEBUG`] (the default of debug builds). On
+    /// lavapipe the instance is therefore made again without that flag, unless `WGPU_DEBUG` asks
+    /// for it explicitly; debug groups are then no-ops.
+    pub fn headless() -> Result<Gpu, RenderError> {
+        let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let debug = descriptor.flags.contains(wgpu::InstanceFlags::DEBUG);
+        let (instance, adapter) = Self::adapter(descriptor)?;
+        let info = adapter.get_info();
+        if debug && info.driver == "llvmpipe" && std::env::var_os("WGPU_DEBUG").is_none() {
+            drop((adapter, instance));
+            let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            descriptor.flags.remove(wgpu::InstanceFlags::DEBUG);
+            let (instance, adapter) = Self::adapter(descriptor)?;
+            return Self::with_adapter(instance, adapter);
+        }
+        Self::with_adapter(instance, adapter)
+    }
+
+    fn adapter(descriptor: wgpu::InstanceDescriptor) -> Result<(wgpu::Instance, wgpu::Adapter), RenderError> {
+        let instance = wgpu::Instance::new(descriptor);
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
+            .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        Ok((instance, adapter))
+    }
+
+    /// A device on `adapter` (the window chooses one compatible with its surface).
+    pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("drafter device"),
+            required_features: wgpu::Features::empty(),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+        Ok(Gpu { instance, adapter, device, queue })
+    }
+
+    /// "name (backend, device type)", e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
+    pub fn description(&self) -> String {
+        let info = self.adapter.get_info();
+        format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+    }
+}

@@ -1,0 +1,174 @@
+//! Every struct the shaders read, laid out for WGSL (`#[repr(C)]`, 16-byte aligned members).
+//!
+//! Keep in sync with the declarations of the same names in `passes/gbuffer.wgsl`,
+//! `passes/shadow.wgsl`, `passes/enhance.wgsl` and `passes/display.wgsl`; the size assertions at the
+//! bottom catch a field added on one side only.
+
+use bytemuck::{Pod, Zeroable};
+
+/// One vertex of a draw batch (`gbuffer.wgsl`, `shadow.wgsl`: `VertexIn`).
+///
+/// Vertices are split where a position is used by triangles of different part labels or
+/// materials, so both are per vertex (flat-interpolated).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Vertex {
+    pub position_in_object: [f32; 3],
+    /// Zero when the mesh has no normals: the fragment shader then uses the face normal
+    /// (screen-space derivatives of the position).
+    pub normal_in_object: [f32; 3],
+    /// Part label of the triangles using this vertex (index into the instance's part list).
+    pub label: u32,
+    /// Index into the material table.
+    pub material: u32,
+}
+
+/// One mesh instance (`gbuffer.wgsl`, `shadow.wgsl`: `Instance`), in a storage buffer indexed by
+/// `instance_index`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct InstanceGpu {
+    /// Object → render space (world translated so that the scene centre is the origin, which keeps
+    /// f32 precision for CAD coordinates far from the world origin). Column-major.
+    pub render_from_object: [[f32; 4]; 4],
+    /// Inverse transpose of the upper 3×3 of `render_from_object`, as three padded columns.
+    pub normal_from_object: [[f32; 4]; 3],
+    /// Where this instance's label → part table starts in the `label_to_part` buffer.
+    pub label_base: u32,
+    /// 1 when the transform mirrors (negative determinant): front faces are clockwise.
+    pub mirrored: u32,
+    pub label_count: u32,
+    pub _pad: u32,
+}
+
+/// Per-part parameters (`gbuffer.wgsl`: `Part`), a storage buffer indexed by scene-wide part id.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PartGpu {
+    /// Row 0 of the projector matrix, for render-space positions: `p = dot(row, (x, 1))`.
+    pub projector_row: [f32; 4],
+    /// The oriented box's axes (longest first), w unused. Metal bands run along `axes[0]`.
+    pub axes: [[f32; 4]; 3],
+    /// Gradient `q`, `f`, `p` and the transfer curve's index in the transfer tables.
+    pub gradient: [f32; 4],
+    /// Style hint ([`crate::Style::index`]) or [`NO_STYLE`].
+    pub style_hint: u32,
+    pub _pad: [u32; 3],
+}
+
+/// `PartGpu::style_hint` of a part without a hint: it takes the scene's style.
+pub const NO_STYLE: u32 = u32::MAX;
+
+/// A material (`gbuffer.wgsl`: `Material`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MaterialGpu {
+    /// Base colour, in display (non-linear) values: styles mix it as an illustrator would.
+    pub base_color: [f32; 4],
+    pub metallic: f32,
+    pub roughness: f32,
+    pub _pad: [f32; 2],
+}
+
+/// Per-frame uniforms of the geometry passes (`gbuffer.wgsl`, `shadow.wgsl`: `Frame`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub clip_from_render: [[f32; 4]; 4],
+    pub view_from_render: [[f32; 4]; 4],
+    /// Camera position in render space; w = 1 for an orthographic camera.
+    pub camera_position: [f32; 4],
+    /// Unit vector towards the key light, in view space (fixed to the viewer: the object turns,
+    /// not the light; Gooch et al. 1999, §4.1).
+    pub light_in_view: [f32; 4],
+    /// Width, height, 1/width, 1/height of the render target in pixels.
+    pub viewport: [f32; 4],
+    /// Scene style ([`crate::Style::index`]).
+    pub scene_style: u32,
+    /// 1: part style hints apply; 0: every part takes the scene style.
+    pub use_part_styles: u32,
+    /// Cel / Goochel steps (2–4).
+    pub cel_steps: u32,
+    /// Bit 0: cel specular band; bit 1: Gooch splash-back; bit 2: object-space hatching.
+    pub flags: u32,
+    /// Gooch splash-back α, β; hatch stroke period in pixels; hatch sharpness c.
+    pub style_params: [f32; 4],
+}
+
+/// `FrameUniforms::flags` bit: a specular band on cel shading.
+pub const FLAG_CEL_SPECULAR: u32 = 1;
+/// `FrameUniforms::flags` bit: Gooch's splash-back multiplier.
+pub const FLAG_SPLASH_BACK: u32 = 2;
+/// `FrameUniforms::flags` bit: hatch strokes fixed to the object instead of the screen.
+pub const FLAG_HATCH_OBJECT_SPACE: u32 = 4;
+
+/// One shadow layer (`shadow.wgsl`: `ShadowLayer`), bound with a dynamic offset.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ShadowLayerGpu {
+    /// Point light position, render space; w unused.
+    pub light_position: [f32; 4],
+    /// x: height of the plane the shadow is projected onto; y: height of the ground it is moved
+    /// to; z: weight added per covered pixel.
+    pub plane: [f32; 4],
+}
+
+/// Uniforms of the enhancement pass (`enhance.wgsl`: `Enhance`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EnhanceUniforms {
+    /// Blur direction in pixels (1,0) or (0,1); z: Gaussian sigma in pixels; w: kernel radius.
+    pub blur: [f32; 4],
+    /// Depth value given to background pixels (beyond the farthest model point), in view units.
+    pub far_depth: f32,
+    /// Relative threshold of the depth second difference that counts as an edge.
+    pub depth_threshold: f32,
+    /// Cosine of the normal angle that counts as a crease.
+    pub crease_cos: f32,
+    /// Line half-width in pixels (1 at 1× supersampling).
+    pub line_radius: f32,
+    /// Scale of the depth unsharp mask (Luft et al. 2006), per unit of scene radius.
+    pub unsharp_strength: f32,
+    /// 1 for an orthographic camera (depth affine on planes), 0 for perspective (1/depth affine).
+    pub ortho: f32,
+    /// Scene radius in view units (normalises the depth difference).
+    pub scene_radius: f32,
+    /// 1: background pixels read as `far_depth` (the first blur direction).
+    pub background_fill: f32,
+}
+
+/// Uniforms of the display pass (`display.wgsl`: `Display`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DisplayUniforms {
+    pub background: [f32; 4],
+    pub shadow_color: [f32; 4],
+    pub line_color: [f32; 4],
+    pub crease_color: [f32; 4],
+    pub highlight_color: [f32; 4],
+    /// Part id + 1 of the selected part, 0 for none.
+    pub selected: u32,
+    /// Bit 0: outlines; bit 1: creases; bit 2: depth unsharp mask; bit 3: shadow.
+    pub flags: u32,
+    pub _pad: [u32; 2],
+}
+
+/// `DisplayUniforms::flags` bit: draw outlines (part borders, silhouettes).
+pub const DISPLAY_OUTLINES: u32 = 1;
+/// `DisplayUniforms::flags` bit: draw creases.
+pub const DISPLAY_CREASES: u32 = 2;
+/// `DisplayUniforms::flags` bit: apply the depth unsharp mask.
+pub const DISPLAY_UNSHARP: u32 = 4;
+/// `DisplayUniforms::flags` bit: composite the drop shadow.
+pub const DISPLAY_SHADOW: u32 = 8;
+
+const _: () = {
+    assert!(size_of::<Vertex>() == 32);
+    assert!(size_of::<InstanceGpu>() == 128);
+    assert!(size_of::<PartGpu>() == 96);
+    assert!(size_of::<MaterialGpu>() == 32);
+    assert!(size_of::<FrameUniforms>() == 128 + 48 + 16 + 16);
+    assert!(size_of::<ShadowLayerGpu>() == 32);
+    assert!(size_of::<EnhanceUniforms>() == 48);
+    assert!(size_of::<DisplayUniforms>() == 96);
+};

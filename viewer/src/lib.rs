@@ -1,0 +1,48 @@
+//! drafter-viewer: renders baked files (and any model drafter-io reads) for non-photorealistic
+//! technical illustration with wgpu, in a window or headless to PNG.
+//!
+//! # The frame
+//! A multi-pass pipeline after Lux et al. 2013, §5, Algorithm 1 (../shared/papers/000_*), with the
+//! line, shading and shadow conventions of Gooch et al. 1999 (../shared/papers/001_*):
+//!
+//! 1. [`passes::gbuffer`]: every mesh drawn once, instanced; per-part projector, gradient and style
+//!    from a storage buffer indexed by part id; writes colour, normal, linear depth and part id.
+//!    Styles: [`Style`] (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`, `hatch`).
+//! 2. [`passes::shadow`]: optional drop shadow on the ground plane (hard, umbra + penumbra, soft).
+//! 3. [`passes::enhance`]: image-space edges from part-id, depth and normal discontinuities and the
+//!    depth unsharp mask.
+//! 4. [`passes::lines`]: the hook for baked edges (not in files yet).
+//! 5. [`passes::display`]: composite, background, shadow colour, selection highlight.
+//!
+//! # Use
+//! ```no_run
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let model = drafter_viewer::Model::load(std::path::Path::new("sample.baked.glb"))?;
+//! let mut renderer = drafter_viewer::Renderer::new()?; // lavapipe works: no GPU needed
+//! renderer.set_model(&model)?;
+//! let options = drafter_viewer::RenderOptions { style: drafter_viewer::Style::Gooch, ..Default::default() };
+//! std::fs::write("out.png", renderer.render(&options)?.to_png()?)?;
+//! # Ok(()) }
+//! ```
+//!
+//! Invariant: the viewer renders what drafter-io and drafter-format read; it never runs a bake
+//! stage. A file without `DRAFTER_illustration` data renders with one part per instance and a
+//! bounding-box projector, and [`Model::notices`] says so.
+
+pub mod camera;
+pub mod context;
+pub mod gpu_types;
+pub mod image;
+pub mod model;
+pub mod passes;
+pub mod renderer;
+pub mod scene;
+pub mod style;
+pub mod targets;
+
+pub use camera::Camera;
+pub use context::{Gpu, RenderError};
+pub use image::{Image, ImageDiff, PngError};
+pub use model::{LoadError, Model, Part};
+pub use renderer::{FrameInfo, Renderer};
+pub use style::{Enhancements, RenderOptions, ShadowMode, Style, UnknownStyle, View};

@@ -1,0 +1,546 @@
+//! What the renderer draws, prepared on the CPU: one draw batch per mesh, its instances, and the
+//! per-part parameters the shaders index by part id.
+//!
+//! # From a baked file
+//! A mesh stores one part label per triangle (the primitive's `partLabels`); the node that draws
+//! the mesh lists its parts, indexed by label. So the part of a fragment is
+//! `label_to_part[instance.label_base + label]`, where each instance owns a slice of
+//! `label_to_part` holding its node's part ids. Labels are per triangle and vertices are shared
+//! between triangles, so a vertex used by triangles of two labels (or two materials) is split in
+//! two: the label then travels as a flat vertex attribute and the whole mesh is still one draw,
+//! however many parts it holds.
+//!
+//! # From any other file
+//! A file without the extension still renders: each instance is one part, its projector laid along
+//! the longest side of its world-space bounding box (facing away from the scene centre, as the
+//! bake's heuristic does) with the default gradient, and a notice says so.
+//!
+//! Positions are moved into *render space*, the world translated so that the centre of the
+//! scene's bounds is the origin: the transforms are composed in f64 and rounded once, so CAD
+//! coordinates far from the world origin keep their precision in f32.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::Path;
+
+use drafter_core::{Aabb, Diagnostic, Scene};
+use drafter_format::{BakedFile, FormatError, PartRecord};
+use glam::{DMat3, DMat4, DVec3, DVec4};
+
+use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, PartGpu, Vertex};
+use crate::style::{Style, TRANSFER_CURVES};
+
+/// Default quantisation of a part without baked gradient parameters (as drafter-bounds).
+pub const DEFAULT_Q: f32 = 10.0;
+/// Default fade step.
+pub const DEFAULT_F: f32 = 0.5;
+/// Default power.
+pub const DEFAULT_P: f32 = 1.0;
+/// Colour of triangles without a material (display values).
+pub const DEFAULT_BASE_COLOR: [f32; 4] = [0.8, 0.8, 0.8, 1.0];
+
+/// Why a file cannot be loaded for rendering.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The file cannot be read or parsed as a model (the input's fault).
+    #[error(transparent)]
+    Import(#[from] drafter_io::ImportError),
+    /// The file carries `DRAFTER_illustration` data that cannot be read (the input's fault).
+    #[error("{path}: {source}")]
+    Baked { path: String, source: FormatError },
+    /// Nothing to draw.
+    #[error("{0}: the scene has no triangles to render")]
+    Empty(String),
+}
+
+/// One draw: a mesh with split vertices, drawn once per instance in `instances`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    pub name: String,
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+    /// Range of [`Model::instances`] that draws this batch.
+    pub instances: Range<u32>,
+}
+
+/// A part as the viewer knows it: what picking reports and what the shaders read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Part {
+    pub id: u32,
+    pub name: String,
+    /// The baked style hint, if any.
+    pub style: Option<Style>,
+    /// The baked record; `None` for parts the viewer made up for an unbaked file.
+    pub record: Option<PartRecord>,
+    pub gpu: PartGpu,
+}
+
+/// A scene ready for upload.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub batches: Vec<Batch>,
+    /// Every instance, grouped by batch.
+    pub instances: Vec<InstanceGpu>,
+    /// Per instance, its part ids by label (see the module docs).
+    pub label_to_part: Vec<u32>,
+    /// Indexed by part id.
+    pub parts: Vec<Part>,
+    /// Index 0 is the default material; scene material `m` is at `m + 1`.
+    pub materials: Vec<MaterialGpu>,
+    /// World-space bounds of every drawn vertex.
+    pub bounds: Aabb,
+    /// World position of the render-space origin.
+    pub origin: DVec3,
+    /// Corners of every instance's bounding box, in render space: what the camera fit frames
+    /// (tighter than the scene's box for an assembly).
+    pub fit_points: Vec<glam::Vec3>,
+    /// Whether the file carried `DRAFTER_illustration` data.
+    pub baked: bool,
+    /// What the viewer substituted or could not use (one line each).
+    pub notices: Vec<String>,
+    /// The importer's diagnostics.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Model {
+    /// Reads `path` (any format drafter-io imports) and its `DRAFTER_illustration` data, if any.
+    pub fn load(path: &Path) -> Result<Model, LoadError> {
+        let bytes =
+            std::fs::read(path).map_err(|source| drafter_io::ImportError::Io { path: path.to_path_buf(), source })?;
+        Self::load_bytes(path, &bytes)
+    }
+
+    /// As [`Self::load`], for bytes already read from `path` (which names the file and resolves a
+    /// glTF's external buffers).
+    pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Model, LoadError> {
+        let imported = drafter_io::import_bytes(path, bytes)?;
+        let baked = read_baked(path, bytes)?;
+        let mut model = Model::from_scene(&imported.scene, baked.as_ref())
+            .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
+        model.diagnostics = imported.diagnostics;
+        Ok(model)
+    }
+
+    /// Prepares `scene` with its baked data (`None` for an unbaked file). `None` when the scene
+    /// draws no triangles.
+    pub fn from_scene(scene: &Scene, baked: Option<&BakedFile>) -> Option<Model> {
+        let bounds = scene.world_bounds();
+        if bounds.is_empty() || scene.instanced_triangle_count() == 0 {
+            return None;
+        }
+        let origin = (bounds.min + bounds.max) * 0.5;
+        let mut notices = Vec::new();
+        if baked.is_none() {
+            notices.push(
+                "no DRAFTER_illustration data: each instance is one part with a projector along its bounding \
+                 box (bake the file for parts, oriented boxes and gradients)"
+                    .to_owned(),
+            );
+        }
+
+        let triangle_labels = mesh_labels(scene, baked, &mut notices);
+        let node_parts: HashMap<u32, &[PartRecord]> = baked
+            .map(|b| b.nodes.iter().map(|(node, ext)| (*node, ext.parts.as_slice())).collect())
+            .unwrap_or_default();
+        let baked_part_count = baked.map_or(0, |b| b.root.part_count);
+
+        let mut parts: Vec<Option<Part>> = vec![None; baked_part_count as usize];
+        let mut fallback_parts = Vec::new();
+        let mut instances = Vec::new();
+        let mut label_to_part = Vec::new();
+        let mut batches = Vec::new();
+        let mut fit_points = Vec::new();
+        let mut bad_ids = 0usize;
+        let mut missing_node_parts = 0usize;
+        let mut short_part_lists = 0usize;
+        let mut unknown_transfers = 0usize;
+        let mut unknown_styles = 0usize;
+
+        for (mesh_index, mesh) in scene.meshes.iter().enumerate() {
+            let labels = &triangle_labels[mesh_index];
+            let label_count = labels.iter().copied().max().map_or(1, |m| m + 1);
+            let first_instance = instances.len() as u32;
+            for instance in scene.instances.iter().filter(|i| i.mesh.index() == mesh_index) {
+                let label_base = label_to_part.len() as u32;
+                let records = instance.node.and_then(|n| node_parts.get(&n.0).copied()).filter(|r| !r.is_empty());
+                match records {
+                    Some(records) => {
+                        if (records.len() as u32) < label_count {
+                            short_part_lists += 1;
+                        }
+                        for label in 0..label_count as usize {
+                            let record = records.get(label).unwrap_or(&records[0]);
+                            if record.id >= baked_part_count {
+                                bad_ids += 1;
+                                label_to_part.push(u32::MAX); // patched below to a fallback part
+                                continue;
+                            }
+                            label_to_part.push(record.id);
+                            let slot = &mut parts[record.id as usize];
+                            if slot.is_none() {
+                                let (part, transfer_known, style_known) = baked_part(record, origin);
+                                unknown_transfers += usize::from(!transfer_known);
+                                unknown_styles += usize::from(!style_known);
+                                *slot = Some(part);
+                            }
+                        }
+                    }
+                    None => {
+                        if baked.is_some() {
+                            missing_node_parts += 1;
+                        }
+                        let id = baked_part_count + fallback_parts.len() as u32;
+                        let world = mesh.bounds().transformed(&instance.world_from_object);
+                        fallback_parts.push(fallback_part(id, &instance.name, &world, origin));
+                        label_to_part.extend(std::iter::repeat_n(id, label_count as usize));
+                    }
+                }
+                if label_to_part[label_base as usize..].contains(&u32::MAX) {
+                    let id = baked_part_count + fallback_parts.len() as u32;
+                    let world = mesh.bounds().transformed(&instance.world_from_object);
+                    fallback_parts.push(fallback_part(id, &instance.name, &world, origin));
+                    for slot in &mut label_to_part[label_base as usize..] {
+                        if *slot == u32::MAX {
+                            *slot = id;
+                        }
+                    }
+                }
+                instances.push(instance_gpu(&instance.world_from_object, origin, label_base, label_count));
+                let object = mesh.bounds();
+                if !object.is_empty() {
+                    let render_from_object = DMat4::from_translation(-origin) * instance.world_from_object;
+                    fit_points.extend((0..8).map(|i| {
+                        let corner = DVec3::new(
+                            if i & 1 == 0 { object.min.x } else { object.max.x },
+                            if i & 2 == 0 { object.min.y } else { object.max.y },
+                            if i & 4 == 0 { object.min.z } else { object.max.z },
+                        );
+                        render_from_object.transform_point3(corner).as_vec3()
+                    }));
+                }
+            }
+            let last_instance = instances.len() as u32;
+            if last_instance > first_instance && !mesh.triangles.is_empty() {
+                let (vertices, indices) = split_vertices(mesh, labels);
+                batches.push(Batch {
+                    name: mesh.name.clone(),
+                    vertices,
+                    indices,
+                    instances: first_instance..last_instance,
+                });
+            }
+        }
+
+        if bad_ids > 0 {
+            notices.push(format!("{bad_ids} part references with an id ≥ partCount: drawn as unbaked parts"));
+        }
+        if missing_node_parts > 0 {
+            notices.push(format!(
+                "{missing_node_parts} instances have no baked parts: each drawn as one part with a bounding-box projector"
+            ));
+        }
+        if short_part_lists > 0 {
+            notices.push(format!(
+                "{short_part_lists} instances have fewer parts than their mesh has labels: extra labels use part 0 of the node"
+            ));
+        }
+        if unknown_transfers > 0 {
+            notices.push(format!("{unknown_transfers} parts name an unknown transfer curve: identity used"));
+        }
+        if unknown_styles > 0 {
+            notices.push(format!("{unknown_styles} parts name an unknown style: the scene style used"));
+        }
+
+        // Ids the file declares but no node uses get a neutral placeholder so indexing stays dense.
+        let parts: Vec<Part> = parts
+            .into_iter()
+            .enumerate()
+            .map(|(id, p)| p.unwrap_or_else(|| fallback_part(id as u32, "", &bounds, origin)))
+            .chain(fallback_parts)
+            .collect();
+
+        let mut materials =
+            vec![MaterialGpu { base_color: DEFAULT_BASE_COLOR, metallic: 0.0, roughness: 1.0, _pad: [0.0; 2] }];
+        materials.extend(scene.materials.iter().map(|m| MaterialGpu {
+            base_color: m.base_color,
+            metallic: m.metallic,
+            roughness: m.roughness,
+            _pad: [0.0; 2],
+        }));
+
+        Some(Model {
+            batches,
+            instances,
+            label_to_part,
+            parts,
+            materials,
+            bounds,
+            origin,
+            fit_points,
+            baked: baked.is_some(),
+            notices,
+            diagnostics: Vec::new(),
+        })
+    }
+
+    /// Triangles drawn (every instance counted).
+    pub fn triangle_count(&self) -> usize {
+        self.batches.iter().map(|b| b.indices.len() / 3 * b.instances.len()).sum()
+    }
+
+    /// The part with scene-wide id `id`.
+    pub fn part(&self, id: u32) -> Option<&Part> {
+        self.parts.get(id as usize)
+    }
+
+    /// Per-part GPU records, indexed by part id.
+    pub fn part_table(&self) -> Vec<PartGpu> {
+        self.parts.iter().map(|p| p.gpu).collect()
+    }
+}
+
+/// Reads the `DRAFTER_illustration` data of a glTF/GLB; `None` for other formats and plain glTF.
+fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedFile>, LoadError> {
+    let Ok((json, _)) = drafter_format::split_container(bytes) else { return Ok(None) };
+    let marker = drafter_format::EXTENSION.as_bytes();
+    if !json.windows(marker.len()).any(|w| w == marker) {
+        return Ok(None);
+    }
+    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    // drafter-io has already imported this file, which confines and checks its buffer URIs.
+    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+    match drafter_format::read(bytes, &external) {
+        Ok(baked) => Ok(Some(baked)),
+        Err(FormatError::NotBaked(_)) => Ok(None),
+        Err(source) => Err(LoadError::Baked { path: path.display().to_string(), source }),
+    }
+}
+
+/// Part label of every triangle of every mesh (0 where the file has none).
+fn mesh_labels(scene: &Scene, baked: Option<&BakedFile>, notices: &mut Vec<String>) -> Vec<Vec<u32>> {
+    let mut labels: Vec<Vec<u32>> = scene.meshes.iter().map(|m| vec![0; m.triangles.len()]).collect();
+    let Some(baked) = baked else { return labels };
+    let mut mismatched = 0usize;
+    for (mesh, primitive, values) in &baked.primitive_labels {
+        let Some(mesh_labels) = labels.get_mut(*mesh as usize) else {
+            mismatched += 1;
+            continue;
+        };
+        let group = scene.meshes[*mesh as usize].groups.iter().find(|g| g.primitive == Some(*primitive));
+        match group {
+            Some(g) if g.count as usize == values.len() => {
+                mesh_labels[g.start as usize..(g.start + g.count) as usize].copy_from_slice(values);
+            }
+            _ => mismatched += 1,
+        }
+    }
+    if mismatched > 0 {
+        notices
+            .push(format!("{mismatched} primitives' part labels do not match their triangles: label 0 used for them"));
+    }
+    labels
+}
+
+/// Splits vertices shared by triangles of different labels or materials; returns the batch's
+/// vertices and indices (triangle order kept).
+fn split_vertices(mesh: &drafter_core::Mesh, labels: &[u32]) -> (Vec<Vertex>, Vec<u32>) {
+    let mut material_of = vec![0u32; mesh.triangles.len()];
+    for g in &mesh.groups {
+        let m = g.material.map_or(0, |m| m.0 + 1);
+        let end = (g.start as usize + g.count as usize).min(material_of.len());
+        for slot in &mut material_of[(g.start as usize).min(end)..end] {
+            *slot = m;
+        }
+    }
+    // First (label, material) → new index per vertex; further combinations in a map.
+    let mut first: Vec<Option<(u32, u32, u32)>> = vec![None; mesh.positions.len()];
+    let mut extra: HashMap<(u32, u32, u32), u32> = HashMap::new();
+    let mut vertices = Vec::with_capacity(mesh.positions.len());
+    let mut indices = Vec::with_capacity(mesh.triangles.len() * 3);
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let (label, material) = (labels.get(t).copied().unwrap_or(0), material_of[t]);
+        for &v in tri {
+            let make = |vertices: &mut Vec<Vertex>| {
+                let normal = mesh.normals.as_ref().map_or([0.0; 3], |n| n[v as usize].to_array());
+                vertices.push(Vertex {
+                    position_in_object: mesh.positions[v as usize].to_array(),
+                    normal_in_object: normal,
+                    label,
+                    material,
+                });
+                vertices.len() as u32 - 1
+            };
+            let index = match first[v as usize] {
+                None => {
+                    let i = make(&mut vertices);
+                    first[v as usize] = Some((label, material, i));
+                    i
+                }
+                Some((l, m, i)) if l == label && m == material => i,
+                Some(_) => *extra.entry((v, label, material)).or_insert_with(|| make(&mut vertices)),
+            };
+            indices.push(index);
+        }
+    }
+    (vertices, indices)
+}
+
+fn instance_gpu(world_from_object: &DMat4, origin: DVec3, label_base: u32, label_count: u32) -> InstanceGpu {
+    let render_from_object = DMat4::from_translation(-origin) * *world_from_object;
+    let linear = DMat3::from_mat4(*world_from_object);
+    let normal = if linear.determinant().abs() > 1e-300 { linear.inverse().transpose() } else { DMat3::IDENTITY };
+    let col = |c: glam::DVec3| [c.x as f32, c.y as f32, c.z as f32, 0.0];
+    InstanceGpu {
+        render_from_object: render_from_object.as_mat4().to_cols_array_2d(),
+        normal_from_object: [col(normal.x_axis), col(normal.y_axis), col(normal.z_axis)],
+        label_base,
+        mirrored: u32::from(world_from_object.determinant() < 0.0),
+        label_count,
+        _pad: 0,
+    }
+}
+
+/// Row 0 of a world-space projector matrix, rewritten for render-space positions.
+fn render_row(world_row: DVec4, origin: DVec3) -> [f32; 4] {
+    let w = world_row.w + world_row.truncate().dot(origin);
+    [world_row.x as f32, world_row.y as f32, world_row.z as f32, w as f32]
+}
+
+/// The viewer's record of a baked part; also whether its transfer and style names were known.
+fn baked_part(record: &PartRecord, origin: DVec3) -> (Part, bool, bool) {
+    let m = &record.projector.matrix;
+    // Column-major: row 0 is elements 0, 4, 8, 12.
+    let row = DVec4::new(m[0], m[4], m[8], m[12]);
+    let transfer = TRANSFER_CURVES.iter().position(|c| *c == record.gradient.transfer);
+    let style = record.style.as_deref().map(str::parse::<Style>);
+    let axes = record.obb.axes.map(|a| [a[0] as f32, a[1] as f32, a[2] as f32, 0.0]);
+    let gpu = PartGpu {
+        projector_row: render_row(row, origin),
+        axes,
+        gradient: [
+            record.gradient.q as f32,
+            record.gradient.f as f32,
+            record.gradient.p as f32,
+            transfer.unwrap_or(0) as f32,
+        ],
+        style_hint: match &style {
+            Some(Ok(s)) => s.index(),
+            _ => NO_STYLE,
+        },
+        _pad: [0; 3],
+    };
+    let part = Part {
+        id: record.id,
+        name: record.name.clone(),
+        style: style.as_ref().and_then(|s| s.as_ref().ok().copied()),
+        record: Some(record.clone()),
+        gpu,
+    };
+    (part, transfer.is_some(), !matches!(style, Some(Err(_))))
+}
+
+/// A part for an instance without baked data: the projector runs along the longest side of its
+/// world bounding box, away from the scene centre (which is the render origin).
+fn fallback_part(id: u32, name: &str, world: &Aabb, origin: DVec3) -> Part {
+    let size = if world.is_empty() { DVec3::ZERO } else { world.max - world.min };
+    let center = if world.is_empty() { origin } else { (world.min + world.max) * 0.5 };
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| size[b].total_cmp(&size[a]));
+    let axis = |k: usize| {
+        let mut v = DVec3::ZERO;
+        v[k] = 1.0;
+        v
+    };
+    let long = order[0];
+    let away = center - origin;
+    let direction = if away[long] < -1e-12 * (away.length() + size[long]) { -axis(long) } else { axis(long) };
+    let scale = size[long];
+    // p = 1/2 + d·(x − a)/s, in render coordinates (x_render = x_world − origin).
+    let row = if scale > 1e-12 * (1.0 + center.length()) {
+        let d = direction / scale;
+        [d.x as f32, d.y as f32, d.z as f32, (0.5 - d.dot(center - origin)) as f32]
+    } else {
+        [0.0, 0.0, 0.0, 0.5]
+    };
+    let axes = order.map(|k| {
+        let a = axis(k);
+        [a.x as f32, a.y as f32, a.z as f32, 0.0]
+    });
+    Part {
+        id,
+        name: name.to_owned(),
+        style: None,
+        record: None,
+        gpu: PartGpu {
+            projector_row: row,
+            axes,
+            gradient: [DEFAULT_Q, DEFAULT_F, DEFAULT_P, 0.0],
+            style_hint: NO_STYLE,
+            _pad: [0; 3],
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use drafter_core::{Instance, Mesh, MeshId, SourceFormat, TriangleGroup};
+    use glam::Vec3;
+
+    fn quad_scene() -> Scene {
+        let mut scene = Scene::new(SourceFormat::Obj);
+        scene.meshes.push(Mesh {
+            name: "quad".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            normals: None,
+            uvs: None,
+            groups: vec![TriangleGroup { start: 0, count: 2, ..Default::default() }],
+        });
+        for x in [0.0, 10.0] {
+            scene.instances.push(Instance {
+                name: format!("q{x}"),
+                mesh: MeshId(0),
+                node: None,
+                world_from_object: DMat4::from_translation(DVec3::new(x, 0.0, 0.0)),
+            });
+        }
+        scene
+    }
+
+    #[test]
+    fn unbaked_scene_gets_one_part_per_instance() {
+        let model = Model::from_scene(&quad_scene(), None).unwrap();
+        assert_eq!(model.batches.len(), 1);
+        assert_eq!(model.instances.len(), 2);
+        assert_eq!(model.parts.len(), 2);
+        assert_eq!(model.label_to_part, vec![0, 1]);
+        assert_eq!(model.triangle_count(), 4);
+        assert!(!model.notices.is_empty());
+        // The scene spans x ∈ [0, 11]: origin at 5.5; instance 0's projector runs along -x (away
+        // from the centre), from p = 0 at x = 1 to p = 1 at x = 0.
+        let row = model.parts[0].gpu.projector_row;
+        let p = |x_world: f32| row[0] * (x_world - 5.5) + row[3];
+        assert!((p(1.0) - 0.0).abs() < 1e-5, "{row:?}");
+        assert!((p(0.0) - 1.0).abs() < 1e-5, "{row:?}");
+    }
+
+    #[test]
+    fn labels_split_shared_vertices() {
+        let scene = quad_scene();
+        let (vertices, indices) = split_vertices(&scene.meshes[0], &[0, 1]);
+        // Vertices 0 and 2 are shared by both triangles: split once each.
+        assert_eq!(vertices.len(), 6);
+        assert_eq!(indices.len(), 6);
+        for (t, tri) in indices.chunks(3).enumerate() {
+            assert!(tri.iter().all(|&i| vertices[i as usize].label == t as u32));
+        }
+        let (same, _) = split_vertices(&scene.meshes[0], &[3, 3]);
+        assert_eq!(same.len(), 4);
+    }
+
+    #[test]
+    fn empty_scene_is_none() {
+        assert!(Model::from_scene(&Scene::new(SourceFormat::Obj), None).is_none());
+    }
+}

@@ -1,0 +1,129 @@
+//! Display pass (Lux et al. 2013, §5 "Display Pass"; Algorithm 1, line 13): one full-screen draw that
+//! composites the G-buffer colour with the enhancement (black outlines, crease lines, depth
+//! darkening), the coloured drop shadow on the background, and the selection highlight.
+//!
+//! Colours are display values end to end (no sRGB conversion): the output is written to an
+//! `Rgba8Unorm` texture (or a non-sRGB window surface) and saved as is.
+
+use crate::gpu_types::{DISPLAY_CREASES, DISPLAY_OUTLINES, DISPLAY_SHADOW, DISPLAY_UNSHARP, DisplayUniforms};
+use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
+use crate::style::{RenderOptions, ShadowMode, Style};
+use crate::targets::Targets;
+
+pub const LABEL: &str = "display";
+
+/// Outline colour: black, as every convention draws silhouettes and part borders.
+pub const LINE_COLOR: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
+/// Creases on the Gooch styles: white (Gooch et al. 1999, §3.1, Fig. 9).
+pub const CREASE_WHITE: [f32; 4] = [1.0, 1.0, 1.0, 0.9];
+/// Creases on the other styles: dark grey, lighter than outlines ([IFH03]-style edge enhancement).
+pub const CREASE_DARK: [f32; 4] = [0.1, 0.1, 0.1, 0.6];
+/// Selection tint (orange, 45 %).
+pub const HIGHLIGHT_COLOR: [f32; 4] = [1.0, 0.55, 0.1, 0.45];
+
+/// The display uniforms of `options`.
+pub fn uniforms(options: &RenderOptions) -> DisplayUniforms {
+    let e = options.enhancements;
+    let mut flags = 0;
+    if e.outlines {
+        flags |= DISPLAY_OUTLINES;
+    }
+    if e.creases {
+        flags |= DISPLAY_CREASES;
+    }
+    if e.unsharp_mask {
+        flags |= DISPLAY_UNSHARP;
+    }
+    if options.shadow != ShadowMode::None {
+        flags |= DISPLAY_SHADOW;
+    }
+    let gooch = matches!(options.style, Style::Gooch | Style::Goochel | Style::Metal);
+    DisplayUniforms {
+        background: [options.background[0], options.background[1], options.background[2], 1.0],
+        shadow_color: [options.shadow_color[0], options.shadow_color[1], options.shadow_color[2], 1.0],
+        line_color: LINE_COLOR,
+        crease_color: if gooch { CREASE_WHITE } else { CREASE_DARK },
+        highlight_color: HIGHLIGHT_COLOR,
+        selected: options.selected_part.map_or(0, |p| p.saturating_add(1)),
+        flags,
+        _pad: [0; 2],
+    }
+}
+
+#[derive(Debug)]
+pub struct DisplayPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+}
+
+impl DisplayPass {
+    /// A display pass writing `format` (the output texture's, or a window surface's).
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> DisplayPass {
+        let module = device.create_shader_module(wgpu::include_wgsl!("display.wgsl"));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("display bind group layout"),
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::FRAGMENT, false),
+                texture_entry(1, FLOAT),
+                texture_entry(2, UINT),
+                texture_entry(3, FLOAT),
+                texture_entry(4, FLOAT),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("display pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline =
+            fullscreen_pipeline(device, "display pipeline", &pipeline_layout, &module, "fs_main", format, None);
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("display uniforms"),
+            size: size_of::<DisplayUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        DisplayPass { layout, pipeline, uniforms }
+    }
+
+    pub fn bind_group(&self, device: &wgpu::Device, targets: &Targets) -> wgpu::BindGroup {
+        fn view(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("display bind group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                view(1, &targets.color.view),
+                view(2, &targets.part_id.view),
+                view(3, &targets.enhance.view),
+                view(4, &targets.shadow_mask.view),
+            ],
+        })
+    }
+
+    pub fn prepare(&self, queue: &wgpu::Queue, uniforms: &DisplayUniforms) {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+    }
+
+    /// Composites into `output` (same size as the targets).
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, bind_group: &wgpu::BindGroup, output: &wgpu::TextureView) {
+        encoder.push_debug_group(LABEL);
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("display pass"),
+                color_attachments: &[color_attachment(output, Some(wgpu::Color::WHITE))],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        encoder.pop_debug_group();
+    }
+}

@@ -1,0 +1,326 @@
+// G-buffer pass: rasterises every mesh once (instanced) and shades it in the style of its part.
+// Outputs colour, view-space normal, linear view depth and part id + 1 (0 = background).
+// Keep the structs in sync with gpu_types.rs; style numbers with Style::index in style.rs.
+
+struct Frame {
+    clip_from_render: mat4x4<f32>,
+    view_from_render: mat4x4<f32>,
+    camera_position: vec4<f32>, // w = 1: orthographic
+    light_in_view: vec4<f32>,
+    viewport: vec4<f32>,
+    scene_style: u32,
+    use_part_styles: u32,
+    cel_steps: u32,
+    flags: u32,
+    style_params: vec4<f32>, // splash-back alpha, beta; hatch period (px); hatch sharpness c
+}
+
+struct Instance {
+    render_from_object: mat4x4<f32>,
+    normal_col0: vec4<f32>,
+    normal_col1: vec4<f32>,
+    normal_col2: vec4<f32>,
+    label_base: u32,
+    mirrored: u32,
+    label_count: u32,
+    pad: u32,
+}
+
+struct Part {
+    projector_row: vec4<f32>,
+    axis0: vec4<f32>,
+    axis1: vec4<f32>,
+    axis2: vec4<f32>,
+    gradient: vec4<f32>, // q, f, p, transfer curve index
+    style_hint: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+struct Material {
+    base_color: vec4<f32>,
+    metallic: f32,
+    roughness: f32,
+    pad0: f32,
+    pad1: f32,
+}
+
+const STYLE_PHONG: u32 = 0u;
+const STYLE_GRADIENT: u32 = 1u;
+const STYLE_CEL: u32 = 2u;
+const STYLE_GOOCH: u32 = 3u;
+const STYLE_GOOCHEL: u32 = 4u;
+const STYLE_METAL: u32 = 5u;
+const STYLE_HATCH: u32 = 6u;
+const NO_STYLE: u32 = 0xffffffffu;
+
+const FLAG_CEL_SPECULAR: u32 = 1u;
+const FLAG_SPLASH_BACK: u32 = 2u;
+
+const TRANSFER_TEXELS: u32 = 128u;
+const PI: f32 = 3.14159265358979;
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> instances: array<Instance>;
+@group(0) @binding(2) var<storage, read> label_to_part: array<u32>;
+@group(0) @binding(3) var<storage, read> parts: array<Part>;
+@group(0) @binding(4) var<storage, read> materials: array<Material>;
+@group(0) @binding(5) var<storage, read> transfer_tables: array<f32>;
+@group(0) @binding(6) var<storage, read> metal_table: array<f32>;
+
+struct VertexIn {
+    @location(0) position_in_object: vec3<f32>,
+    @location(1) normal_in_object: vec3<f32>,
+    @location(2) label: u32,
+    @location(3) material: u32,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) position_in_render: vec3<f32>,
+    @location(1) normal_in_render: vec3<f32>,
+    @location(2) @interpolate(flat) part: u32,
+    @location(3) @interpolate(flat) material: u32,
+    @location(4) @interpolate(flat) mirrored: u32,
+}
+
+@vertex
+fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
+    let inst = instances[instance_index];
+    let position = inst.render_from_object * vec4<f32>(v.position_in_object, 1.0);
+    let normal_from_object = mat3x3<f32>(inst.normal_col0.xyz, inst.normal_col1.xyz, inst.normal_col2.xyz);
+    let label = min(v.label, max(inst.label_count, 1u) - 1u);
+    var out: VertexOut;
+    out.clip = frame.clip_from_render * position;
+    out.position_in_render = position.xyz;
+    out.normal_in_render = normal_from_object * v.normal_in_object;
+    out.part = label_to_part[inst.label_base + label];
+    out.material = v.material;
+    out.mirrored = inst.mirrored;
+    return out;
+}
+
+struct GBufferOut {
+    @location(0) color: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) depth: f32,
+    @location(3) part: u32,
+}
+
+// ω(i, q, f, p) of Lux et al. 2013, Listing 1, exactly as drafter-bounds' `omega` (gradient.rs):
+// the band and the position inside it both come from one product t = i^p · q.
+fn omega(i_in: f32, q_in: f32, f_in: f32, p_in: f32) -> f32 {
+    let i = clamp(i_in, 0.0, 1.0);
+    let q = max(q_in, 1.0);
+    let f = clamp(f_in, 0.0, 1.0);
+    let p = max(p_in, 0.01);
+    let r = 0.5 / (q + 1.0);
+    let ip = select(pow(i, p), 0.0, i <= 0.0);
+    let t = ip * q;
+    let band = floor(t);
+    let iq = band / q + r;
+    let within = t - band;
+    var mf = 0.0;
+    if f < 1.0 && within >= f {
+        mf = (within - f) / (1.0 - f);
+    }
+    return (iq - r) * (1.0 - mf) + (iq + r) * mf;
+}
+
+// γ(p): the 128-texel table of curve `curve`, linearly interpolated (texel k holds γ(k / 127)).
+fn transfer(p: f32, curve: u32) -> f32 {
+    let x = clamp(p, 0.0, 1.0) * f32(TRANSFER_TEXELS - 1u);
+    let k = min(u32(floor(x)), TRANSFER_TEXELS - 1u);
+    let next = min(k + 1u, TRANSFER_TEXELS - 1u);
+    let w = x - f32(k);
+    let base = curve * TRANSFER_TEXELS;
+    return transfer_tables[base + k] * (1.0 - w) + transfer_tables[base + next] * w;
+}
+
+// The periodic metal table at u (wraps), linearly interpolated.
+fn metal(u: f32) -> f32 {
+    let n = arrayLength(&metal_table);
+    let x = fract(u) * f32(n);
+    let k = min(u32(floor(x)), n - 1u);
+    let next = (k + 1u) % n;
+    let w = x - f32(k);
+    return metal_table[k] * (1.0 - w) + metal_table[next] * w;
+}
+
+// Gooch et al. 1998 cool and warm tones: k_cool = (0, 0, b) + α k_d, k_warm = (y, y, 0) + β k_d with
+// b = y = 0.4, α = 0.2, β = 0.6.
+fn gooch_tones(base: vec3<f32>, t: f32) -> vec3<f32> {
+    let cool = vec3<f32>(0.0, 0.0, 0.4) + 0.2 * base;
+    let warm = vec3<f32>(0.4, 0.4, 0.0) + 0.6 * base;
+    return mix(cool, warm, t);
+}
+
+fn cel_level(x: f32) -> f32 {
+    let steps = f32(clamp(frame.cel_steps, 2u, 4u));
+    let k = min(floor(clamp(x, 0.0, 1.0) * steps), steps - 1.0);
+    return k / (steps - 1.0);
+}
+
+struct Surface {
+    position_in_render: vec3<f32>,
+    n: vec3<f32>, // view space, towards the viewer
+    l: vec3<f32>, // view space, towards the light
+    v: vec3<f32>, // view space, towards the viewer
+    base: vec3<f32>,
+    roughness: f32,
+    frag: vec2<f32>,
+}
+
+fn shade_phong(s: Surface) -> vec3<f32> {
+    let h = normalize(s.l + s.v);
+    let diffuse = max(dot(s.n, s.l), 0.0);
+    let shininess = mix(64.0, 8.0, clamp(s.roughness, 0.0, 1.0));
+    let specular = 0.35 * pow(max(dot(s.n, h), 0.0), shininess) * step(0.0, dot(s.n, s.l));
+    return s.base * (0.22 + 0.78 * diffuse) + vec3<f32>(specular);
+}
+
+// Lux et al.: p from the part's projector, i = γ(p), i' = ω(i, q, f, p), shown as a grey value
+// slightly tinted by the material so that parts stay apart.
+fn shade_gradient(s: Surface, part: Part) -> vec3<f32> {
+    let p = dot(part.projector_row, vec4<f32>(s.position_in_render, 1.0));
+    let i = transfer(p, u32(part.gradient.w));
+    let w = omega(i, part.gradient.x, part.gradient.y, part.gradient.z);
+    let tint = mix(vec3<f32>(1.0), s.base, 0.3);
+    return tint * mix(0.18, 1.0, w);
+}
+
+fn shade_cel(s: Surface) -> vec3<f32> {
+    let level = cel_level(max(dot(s.n, s.l), 0.0));
+    var c = s.base * mix(0.35, 1.0, level);
+    if (frame.flags & FLAG_CEL_SPECULAR) != 0u {
+        let h = normalize(s.l + s.v);
+        if pow(max(dot(s.n, h), 0.0), 40.0) > 0.5 {
+            c = mix(c, vec3<f32>(1.0), 0.8);
+        }
+    }
+    return c;
+}
+
+fn shade_gooch(s: Surface) -> vec3<f32> {
+    let nl = dot(s.n, s.l);
+    var c = gooch_tones(s.base, 0.5 * (1.0 + nl));
+    if (frame.flags & FLAG_SPLASH_BACK) != 0u {
+        // Gooch et al. 1999, §3.2: (α|cos θ| + (1 − α))^β darkens the terminator and lets light
+        // splash back opposite the key light.
+        let alpha = frame.style_params.x;
+        let beta = frame.style_params.y;
+        c = c * pow(alpha * abs(nl) + (1.0 - alpha), beta);
+    }
+    let h = normalize(s.l + s.v);
+    let highlight = pow(max(dot(s.n, h), 0.0), 48.0) * step(0.0, nl);
+    return min(c + vec3<f32>(0.5 * highlight), vec3<f32>(1.0));
+}
+
+fn shade_goochel(s: Surface) -> vec3<f32> {
+    return gooch_tones(s.base, cel_level(0.5 * (1.0 + dot(s.n, s.l))));
+}
+
+// Gooch et al. 1999, §5.2.1: bands from the random table, indexed by the angle of the normal
+// around the part's principal axis (uniform around a cylinder), plus Phong highlights from lights in
+// the directions of an icosahedron's vertices (those facing the viewer), specular power 40,
+// coefficient 0.3.
+fn shade_metal(s: Surface, part: Part, normal_in_render: vec3<f32>) -> vec3<f32> {
+    let u = atan2(dot(normal_in_render, part.axis1.xyz), dot(normal_in_render, part.axis2.xyz)) / (2.0 * PI);
+    let band = metal(u * 2.0);
+    let tint = mix(vec3<f32>(0.78, 0.80, 0.84), s.base, 0.25);
+    // A little diffuse light so that flat faces (one band each) still read apart.
+    var c = tint * mix(0.4, 1.0, band) * (0.75 + 0.25 * max(dot(s.n, s.l), 0.0));
+    let phi = 1.618034;
+    var lights = array<vec3<f32>, 6>(
+        vec3<f32>(0.0, 1.0, phi), vec3<f32>(0.0, -1.0, phi), vec3<f32>(phi, 0.0, 1.0),
+        vec3<f32>(-phi, 0.0, 1.0), vec3<f32>(1.0, phi, 0.0), vec3<f32>(-1.0, phi, 0.0));
+    var highlight = 0.0;
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        let h = normalize(normalize(lights[k]) + s.v);
+        highlight = highlight + 0.3 * pow(max(dot(s.n, h), 0.0), 40.0);
+    }
+    return min(c + vec3<f32>(highlight), vec3<f32>(1.0));
+}
+
+// Freudenberg's soft threshold: ink = clamp(c · (1 − (T + I))) of a halftone T against the
+// intensity I; a second, crossing set of strokes where the surface is darker. Screen-space strokes
+// (ten Bosch's "simple hatching").
+fn shade_hatch(s: Surface) -> vec3<f32> {
+    let intensity = 0.12 + 0.88 * max(dot(s.n, s.l), 0.0);
+    let period = frame.style_params.z;
+    let c = frame.style_params.w;
+    let a = (s.frag.x + s.frag.y) * 0.70710678 / period;
+    let b = (s.frag.x - s.frag.y) * 0.70710678 / period;
+    let t1 = abs(fract(a) - 0.5) * 2.0;
+    let t2 = abs(fract(b) - 0.5) * 2.0;
+    let ink1 = clamp(c * (1.0 - (t1 + intensity)), 0.0, 1.0);
+    let ink2 = clamp(c * (1.0 - (t2 + intensity + 0.4)), 0.0, 1.0);
+    let ink = max(ink1, ink2);
+    let paper = vec3<f32>(0.99, 0.98, 0.95);
+    return mix(paper, vec3<f32>(0.08, 0.08, 0.1), ink);
+}
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> GBufferOut {
+    // Derivatives first (uniform control flow): the face normal for meshes without normals.
+    let dpx = dpdx(in.position_in_render);
+    let dpy = dpdy(in.position_in_render);
+    let ortho = frame.camera_position.w > 0.5;
+    let backward = vec3<f32>(frame.view_from_render[0].z, frame.view_from_render[1].z, frame.view_from_render[2].z);
+    let to_camera = select(normalize(frame.camera_position.xyz - in.position_in_render), backward, ortho);
+
+    var face_normal = cross(dpx, dpy);
+    if length(face_normal) < 1e-20 {
+        face_normal = to_camera;
+    }
+    face_normal = normalize(face_normal);
+    if dot(face_normal, to_camera) < 0.0 {
+        face_normal = -face_normal;
+    }
+    var normal = in.normal_in_render;
+    if length(normal) < 1e-12 {
+        normal = face_normal;
+    } else {
+        normal = normalize(normal);
+        // Open surfaces and mirrored instances: show the side that faces the viewer.
+        let facing = front_facing != (in.mirrored != 0u);
+        if !facing {
+            normal = -normal;
+        }
+    }
+
+    let position_in_view = (frame.view_from_render * vec4<f32>(in.position_in_render, 1.0)).xyz;
+    var s: Surface;
+    s.position_in_render = in.position_in_render;
+    s.n = normalize((frame.view_from_render * vec4<f32>(normal, 0.0)).xyz);
+    s.l = normalize(frame.light_in_view.xyz);
+    s.v = select(normalize(-position_in_view), vec3<f32>(0.0, 0.0, 1.0), ortho);
+    let material = materials[in.material];
+    s.base = material.base_color.rgb;
+    s.roughness = material.roughness;
+    s.frag = in.clip.xy;
+
+    let part = parts[in.part];
+    var style = frame.scene_style;
+    if frame.use_part_styles != 0u && part.style_hint != NO_STYLE {
+        style = part.style_hint;
+    }
+    var color: vec3<f32>;
+    switch style {
+        case STYLE_GRADIENT: { color = shade_gradient(s, part); }
+        case STYLE_CEL: { color = shade_cel(s); }
+        case STYLE_GOOCH: { color = shade_gooch(s); }
+        case STYLE_GOOCHEL: { color = shade_goochel(s); }
+        case STYLE_METAL: { color = shade_metal(s, part, normal); }
+        case STYLE_HATCH: { color = shade_hatch(s); }
+        default: { color = shade_phong(s); }
+    }
+
+    var out: GBufferOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.normal = vec4<f32>(s.n, 0.0);
+    out.depth = -position_in_view.z;
+    out.part = in.part + 1u;
+    return out;
+}

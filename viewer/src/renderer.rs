@@ -1,0 +1,325 @@
+//! The frame: camera fit, uniforms, and the passes in order (Lux et al. 2013, Algorithm 1, with
+//! Gooch et al.'s drop shadow). [`Renderer::render`] draws offscreen and reads the image back;
+//! [`Renderer::encode_frame`] records the same frame into any encoder and target (the window and
+//! the benchmark use it).
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use crate::camera::{Camera, LIGHT_IN_VIEW, view_rotation};
+use crate::context::{Gpu, RenderError};
+use crate::gpu_types::{FLAG_CEL_SPECULAR, FLAG_SPLASH_BACK, FrameUniforms};
+use crate::image::Image;
+use crate::model::Model;
+use crate::passes::display::{self, DisplayPass};
+use crate::passes::enhance::{EnhanceBindings, EnhancePass, EnhanceSetup};
+use crate::passes::gbuffer::GBufferPass;
+use crate::passes::shadow::{self, ShadowPass};
+use crate::scene::SceneGpu;
+use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
+use crate::targets::{OUTPUT_FORMAT, Targets};
+
+/// A model on the GPU with what the camera fit needs.
+#[derive(Debug)]
+struct LoadedScene {
+    gpu: SceneGpu,
+    /// Render-space bounds.
+    min: Vec3,
+    max: Vec3,
+    /// See [`Model::fit_points`].
+    fit_points: Vec<Vec3>,
+}
+
+/// Targets of one size with their bind groups.
+#[derive(Debug)]
+struct FrameTargets {
+    targets: Targets,
+    enhance: EnhanceBindings,
+    display: wgpu::BindGroup,
+}
+
+/// What a recorded frame used.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInfo {
+    pub camera: Camera,
+    /// Render-target size (output size × supersampling).
+    pub target_size: (u32, u32),
+}
+
+/// The passes and the device; holds at most one model.
+#[derive(Debug)]
+pub struct Renderer {
+    gpu: Gpu,
+    frame_uniforms: wgpu::Buffer,
+    gbuffer: GBufferPass,
+    shadow: ShadowPass,
+    enhance: EnhancePass,
+    display: DisplayPass,
+    scene: Option<LoadedScene>,
+    targets: Option<FrameTargets>,
+    last_frame: Option<FrameInfo>,
+}
+
+impl Renderer {
+    /// A headless renderer on the default adapter (see [`Gpu::headless`]).
+    pub fn new() -> Result<Renderer, RenderError> {
+        Self::with_gpu(Gpu::headless()?, OUTPUT_FORMAT)
+    }
+
+    /// A renderer on `gpu` whose display pass writes `output_format`.
+    pub fn with_gpu(gpu: Gpu, output_format: wgpu::TextureFormat) -> Result<Renderer, RenderError> {
+        let device = &gpu.device;
+        let (frame_uniforms, gbuffer, shadow, enhance, display) = scoped(device, || {
+            let frame_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame uniforms"),
+                size: size_of::<FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (
+                frame_uniforms,
+                GBufferPass::new(device),
+                ShadowPass::new(device),
+                EnhancePass::new(device),
+                DisplayPass::new(device, output_format),
+            )
+        })?;
+        Ok(Renderer {
+            gpu,
+            frame_uniforms,
+            gbuffer,
+            shadow,
+            enhance,
+            display,
+            scene: None,
+            targets: None,
+            last_frame: None,
+        })
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Uploads `model`, replacing the previous one.
+    pub fn set_model(&mut self, model: &Model) -> Result<(), RenderError> {
+        let device = &self.gpu.device;
+        let gpu =
+            scoped(device, || SceneGpu::upload(device, model, &self.gbuffer, &self.shadow, &self.frame_uniforms))?;
+        let min = (model.bounds.min - model.origin).as_vec3();
+        let max = (model.bounds.max - model.origin).as_vec3();
+        self.scene = Some(LoadedScene { gpu, min, max, fit_points: model.fit_points.clone() });
+        Ok(())
+    }
+
+    /// The camera and size of the last frame recorded.
+    pub fn last_frame(&self) -> Option<FrameInfo> {
+        self.last_frame
+    }
+
+    /// The G-buffer's part-id target of the last frame (the window reads it to pick parts).
+    pub fn part_id_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.targets.part_id.texture)
+    }
+
+    /// Fits the camera for `options` and writes every pass's uniforms.
+    fn prepare(&mut self, options: &RenderOptions) -> Result<FrameInfo, RenderError> {
+        options.validate().map_err(RenderError::Options)?;
+        let scene = self.scene.as_ref().ok_or(RenderError::NoModel)?;
+        let size = options.target_size();
+        if self.targets.as_ref().is_none_or(|t| t.targets.size != size) {
+            let device = &self.gpu.device;
+            self.targets = Some(scoped(device, || {
+                let targets = Targets::new(device, size);
+                let enhance = self.enhance.bindings(device, &targets);
+                let display = self.display.bind_group(device, &targets);
+                FrameTargets { targets, enhance, display }
+            })?);
+        }
+
+        let (min, max) = (scene.min, scene.max);
+        let light_in_render = view_rotation(options.view).inverse().transform_vector3(LIGHT_IN_VIEW.normalize());
+        let layers = shadow::layers(options.shadow, min, max, light_in_render);
+        // The model's instance boxes and their shadows on the ground.
+        let mut fit_points = scene.fit_points.clone();
+        for layer in &layers {
+            fit_points.extend(scene.fit_points.iter().map(|&c| shadow::project(layer, c)));
+        }
+        let aspect = size.0 as f32 / size.1 as f32;
+        let camera = Camera::fit(&fit_points, options.view, aspect, options.orthographic, options.fov_y_deg);
+
+        let mut flags = 0;
+        if options.cel_specular {
+            flags |= FLAG_CEL_SPECULAR;
+        }
+        if options.splash_back {
+            flags |= FLAG_SPLASH_BACK;
+        }
+        let scale = options.supersample as f32;
+        let frame = FrameUniforms {
+            clip_from_render: camera.clip_from_render().to_cols_array_2d(),
+            view_from_render: camera.view_from_render.to_cols_array_2d(),
+            camera_position: camera.position_in_render.extend(if options.orthographic { 1.0 } else { 0.0 }).to_array(),
+            light_in_view: LIGHT_IN_VIEW.normalize().extend(0.0).to_array(),
+            viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
+            scene_style: options.style.index(),
+            use_part_styles: u32::from(options.use_part_styles),
+            cel_steps: options.cel_steps,
+            flags,
+            style_params: [SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, options.hatch_period_px * scale, HATCH_SHARPNESS],
+        };
+        let queue = &self.gpu.queue;
+        queue.write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&frame));
+        self.shadow.prepare(queue, &layers);
+        let radius = (max - min).length() * 0.5;
+        self.enhance.prepare(
+            queue,
+            &EnhanceSetup {
+                height: size.1,
+                pixel_scale: scale,
+                far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5,
+                scene_radius: radius,
+                orthographic: options.orthographic,
+            },
+        );
+        self.display.prepare(queue, &display::uniforms(options));
+        let info = FrameInfo { camera, target_size: size };
+        self.last_frame = Some(info);
+        Ok(info)
+    }
+
+    /// Records a whole frame for `options` into `encoder`, the display pass writing `output`
+    /// (`None`: the renderer's own output texture, of the target size).
+    pub fn encode_frame(
+        &mut self,
+        options: &RenderOptions,
+        encoder: &mut wgpu::CommandEncoder,
+        output: Option<&wgpu::TextureView>,
+    ) -> Result<FrameInfo, RenderError> {
+        let info = self.prepare(options)?;
+        let (Some(scene), Some(frame)) = (self.scene.as_ref(), self.targets.as_ref()) else {
+            return Err(RenderError::NoModel);
+        };
+        let targets = &frame.targets;
+        self.gbuffer.encode(encoder, targets, &scene.gpu);
+        if options.shadow != ShadowMode::None {
+            let layers = match options.shadow {
+                ShadowMode::None => 0,
+                ShadowMode::Hard => 1,
+                ShadowMode::Penumbra => 2,
+                ShadowMode::Soft => shadow::SOFT_LAYERS,
+            };
+            self.shadow.encode(encoder, targets, &scene.gpu, layers);
+        }
+        if options.enhancements.any() {
+            self.enhance.encode(encoder, targets, &frame.enhance);
+        }
+        // The lines pass goes here once edges are baked (see passes::lines).
+        self.display.encode(encoder, &frame.display, output.unwrap_or(&targets.output.view));
+        Ok(info)
+    }
+
+    /// Renders one frame offscreen and reads it back, down-sampled to `options.size`.
+    pub fn render(&mut self, options: &RenderOptions) -> Result<Image, RenderError> {
+        let device = self.gpu.device.clone();
+        let guard = ErrorScopes::push(&device);
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("render frame") });
+        let info = self.encode_frame(options, &mut encoder, None)?;
+        let (w, h) = info.target_size;
+        let bytes_per_row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("render readback"),
+            size: u64::from(bytes_per_row) * u64::from(h),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let Some(frame) = self.targets.as_ref() else { return Err(RenderError::NoModel) };
+        encoder.copy_texture_to_buffer(
+            frame.targets.output.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(bytes_per_row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        let rgba = read_buffer(&device, &readback, bytes_per_row, w, h)?;
+        guard.pop()?;
+        Ok(Image { width: w, height: h, rgba }.downsample(options.supersample))
+    }
+
+    /// Records, submits and waits for one frame without reading it back; the wall time from
+    /// recording to completion (the benchmark's measure).
+    pub fn time_frame(&mut self, options: &RenderOptions) -> Result<Duration, RenderError> {
+        let device = self.gpu.device.clone();
+        let start = Instant::now();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("timed frame") });
+        self.encode_frame(options, &mut encoder, None)?;
+        self.gpu.queue.submit([encoder.finish()]);
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
+        Ok(start.elapsed())
+    }
+}
+
+/// Maps `buffer` and copies `height` rows of `width × 4` bytes out of its padded rows.
+fn read_buffer(
+    device: &wgpu::Device,
+    buffer: &wgpu::Buffer,
+    bytes_per_row: u32,
+    width: u32,
+    height: u32,
+) -> Result<Vec<u8>, RenderError> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |result| {
+        let _ = sender.send(result);
+    });
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
+    receiver.recv().map_err(|e| RenderError::Gpu(e.to_string()))?.map_err(|e| RenderError::Gpu(e.to_string()))?;
+    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+    {
+        let view = buffer.get_mapped_range(..).map_err(|e| RenderError::Gpu(e.to_string()))?;
+        for row in view.chunks(bytes_per_row as usize).take(height as usize) {
+            rgba.extend_from_slice(&row[..(width * 4) as usize]);
+        }
+    }
+    buffer.unmap();
+    Ok(rgba)
+}
+
+/// Validation and out-of-memory error scopes, so GPU errors come back as [`RenderError::Gpu`]
+/// instead of the default handler's panic.
+struct ErrorScopes {
+    out_of_memory: wgpu::ErrorScopeGuard,
+    validation: wgpu::ErrorScopeGuard,
+}
+
+impl ErrorScopes {
+    fn push(device: &wgpu::Device) -> ErrorScopes {
+        let out_of_memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        ErrorScopes { out_of_memory, validation }
+    }
+
+    fn pop(self) -> Result<(), RenderError> {
+        let validation = pollster::block_on(self.validation.pop());
+        let out_of_memory = pollster::block_on(self.out_of_memory.pop());
+        match validation.or(out_of_memory) {
+            Some(e) => Err(RenderError::Gpu(e.to_string())),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Runs `f` inside error scopes.
+fn scoped<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, RenderError> {
+    let scopes = ErrorScopes::push(device);
+    let value = f();
+    scopes.pop()?;
+    Ok(value)
+}

@@ -1,0 +1,85 @@
+//! A [`Model`] uploaded to the GPU: one vertex and index buffer per batch, and the storage buffers
+//! the passes index (instances, label → part, parts, materials).
+
+use std::ops::Range;
+
+use wgpu::util::DeviceExt;
+
+use crate::gpu_types::{MaterialGpu, PartGpu};
+use crate::model::Model;
+
+/// One draw of the G-buffer and shadow passes.
+#[derive(Debug)]
+pub struct BatchGpu {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+    pub instances: Range<u32>,
+}
+
+/// The storage buffers of a scene.
+#[derive(Debug)]
+pub struct SceneBuffers {
+    pub instances: wgpu::Buffer,
+    pub label_to_part: wgpu::Buffer,
+    pub parts: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+}
+
+/// Everything of a model on the GPU, with the bind groups of the geometry passes.
+#[derive(Debug)]
+pub struct SceneGpu {
+    pub batches: Vec<BatchGpu>,
+    pub buffers: SceneBuffers,
+    pub gbuffer_bind_group: wgpu::BindGroup,
+    pub shadow_bind_group: wgpu::BindGroup,
+}
+
+impl SceneGpu {
+    pub fn upload(
+        device: &wgpu::Device,
+        model: &Model,
+        gbuffer: &crate::passes::gbuffer::GBufferPass,
+        shadow: &crate::passes::shadow::ShadowPass,
+        frame: &wgpu::Buffer,
+    ) -> SceneGpu {
+        let storage = |label: &str, contents: &[u8]| {
+            // Storage bindings must not be empty.
+            let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let parts: Vec<PartGpu> = model.part_table();
+        let materials: &[MaterialGpu] = &model.materials;
+        let buffers = SceneBuffers {
+            instances: storage("scene instances", bytemuck::cast_slice(&model.instances)),
+            label_to_part: storage("scene label to part", bytemuck::cast_slice(&model.label_to_part)),
+            parts: storage("scene parts", bytemuck::cast_slice(&parts)),
+            materials: storage("scene materials", bytemuck::cast_slice(materials)),
+        };
+        let batches = model
+            .batches
+            .iter()
+            .map(|b| BatchGpu {
+                vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(&format!("batch {} vertices", b.name)),
+                    contents: bytemuck::cast_slice(&b.vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+                indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(&format!("batch {} indices", b.name)),
+                    contents: bytemuck::cast_slice(&b.indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                }),
+                index_count: b.indices.len() as u32,
+                instances: b.instances.clone(),
+            })
+            .collect();
+        let gbuffer_bind_group = gbuffer.bind_group(device, frame, &buffers);
+        let shadow_bind_group = shadow.scene_bind_group(device, frame, &buffers);
+        SceneGpu { batches, buffers, gbuffer_bind_group, shadow_bind_group }
+    }
+}

@@ -1,0 +1,370 @@
+//! Shading styles and the options of a frame, with their documented defaults.
+//!
+//! The styles are the ones the `DRAFTER_illustration` spec names as part style hints; see
+//! `passes/gbuffer.wgsl` for the formulas and the papers they come from.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A shading style of the G-buffer pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Style {
+    /// Projective gradients (Lux et al. 2013): each part's projector gives `p`, the transfer `γ`
+    /// and the gradient function `ω(i, q, f, p)` give a grey value. Independent of light and
+    /// normals. The default.
+    #[default]
+    Gradient,
+    /// Cel shading: the clamped diffuse term in 2–4 steps, optional specular band.
+    Cel,
+    /// Cool-to-warm shading (Gooch et al. 1998/1999), optional splash-back multiplier.
+    Gooch,
+    /// Cel steps over Gooch's full-range `(1 + n·l)/2` (ten Bosch 2005).
+    Goochel,
+    /// Blinn–Phong: the photorealistic reference.
+    Phong,
+    /// Gooch metal: anisotropic bands around the part's principal axis plus highlights.
+    Metal,
+    /// Pen-and-ink hatching: Freudenberg's soft threshold of a halftone against the intensity.
+    Hatch,
+}
+
+impl Style {
+    /// Every style, in the order of the spec's list.
+    pub const ALL: [Style; 7] =
+        [Style::Gradient, Style::Cel, Style::Gooch, Style::Goochel, Style::Phong, Style::Metal, Style::Hatch];
+
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Style::Gradient => "gradient",
+            Style::Cel => "cel",
+            Style::Gooch => "gooch",
+            Style::Goochel => "goochel",
+            Style::Phong => "phong",
+            Style::Metal => "metal",
+            Style::Hatch => "hatch",
+        }
+    }
+
+    /// The value the shaders switch on (keep in sync with `STYLE_*` in `passes/gbuffer.wgsl`).
+    pub fn index(self) -> u32 {
+        match self {
+            Style::Phong => 0,
+            Style::Gradient => 1,
+            Style::Cel => 2,
+            Style::Gooch => 3,
+            Style::Goochel => 4,
+            Style::Metal => 5,
+            Style::Hatch => 6,
+        }
+    }
+}
+
+impl fmt::Display for Style {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A style name that is not one of [`Style::ALL`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown style {0:?}: expected one of gradient, cel, gooch, goochel, phong, metal, hatch")]
+pub struct UnknownStyle(pub String);
+
+impl FromStr for Style {
+    type Err = UnknownStyle;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Style::ALL.into_iter().find(|style| style.name() == s).ok_or_else(|| UnknownStyle(s.to_owned()))
+    }
+}
+
+/// The drop shadow under the model (Gooch et al. 1999, §5.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ShadowMode {
+    /// No shadow (the default).
+    #[default]
+    None,
+    /// One hard shadow from the centre of the light.
+    Hard,
+    /// A hard umbra and a hard penumbra: two hard shadows, from the back and the front of a
+    /// spherical light along its direction.
+    Penumbra,
+    /// A soft shadow: the shadow projected onto a stack of planes below the ground, each moved up
+    /// to the ground and accumulated.
+    Soft,
+}
+
+impl ShadowMode {
+    pub const ALL: [ShadowMode; 4] = [ShadowMode::None, ShadowMode::Hard, ShadowMode::Penumbra, ShadowMode::Soft];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMode::None => "none",
+            ShadowMode::Hard => "hard",
+            ShadowMode::Penumbra => "penumbra",
+            ShadowMode::Soft => "soft",
+        }
+    }
+}
+
+/// Default of [`RenderOptions::size`].
+pub const DEFAULT_SIZE: (u32, u32) = (800, 600);
+/// Default of [`View::azimuth_deg`].
+pub const DEFAULT_AZIMUTH_DEG: f32 = 35.0;
+/// Default of [`View::elevation_deg`].
+pub const DEFAULT_ELEVATION_DEG: f32 = 25.0;
+/// Default of [`RenderOptions::fov_y_deg`].
+pub const DEFAULT_FOV_Y_DEG: f32 = 30.0;
+/// Default of [`RenderOptions::cel_steps`].
+pub const DEFAULT_CEL_STEPS: u32 = 3;
+/// Splash-back α of Gooch et al. 1999, §3.2.
+pub const SPLASH_BACK_ALPHA: f32 = 0.76;
+/// Splash-back β of Gooch et al. 1999, §3.2.
+pub const SPLASH_BACK_BETA: f32 = 0.78;
+/// Default of [`RenderOptions::hatch_period_px`].
+pub const DEFAULT_HATCH_PERIOD_PX: f32 = 5.0;
+/// Freudenberg's scale `c > 1` of the soft threshold `clamp(c·(1 − (T + I)))`.
+pub const HATCH_SHARPNESS: f32 = 6.0;
+/// Default of [`RenderOptions::background`]: near-white paper.
+pub const DEFAULT_BACKGROUND: [f32; 3] = [1.0, 1.0, 1.0];
+/// Default of [`RenderOptions::shadow_color`]: a cool grey-blue, as illustrators colour shadows.
+pub const DEFAULT_SHADOW_COLOR: [f32; 3] = [0.62, 0.66, 0.74];
+
+/// Where the camera looks from: angles around the model's centre, world +y up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Rotation about +y, degrees, from +z towards +x. Default [`DEFAULT_AZIMUTH_DEG`] (35).
+    pub azimuth_deg: f32,
+    /// Angle above the horizontal plane, degrees, in (−90, 90). Default [`DEFAULT_ELEVATION_DEG`] (25).
+    pub elevation_deg: f32,
+}
+
+impl Default for View {
+    fn default() -> Self {
+        Self { azimuth_deg: DEFAULT_AZIMUTH_DEG, elevation_deg: DEFAULT_ELEVATION_DEG }
+    }
+}
+
+/// Which image-space enhancements the enhancement pass draws (Lux et al. 2013, §5: edges after
+/// [IFH03] and the depth unsharp mask of Luft et al. 2006).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Enhancements {
+    /// Black lines where the part id or depth jumps: part borders, silhouettes, and a heavier
+    /// outer outline against the background. Default off.
+    pub outlines: bool,
+    /// Lines where the normal turns by more than the crease angle inside a part (white on the Gooch
+    /// styles, as Gooch et al. draw creases; dark grey otherwise). Default off.
+    pub creases: bool,
+    /// Darken pixels that lie behind their surroundings (unsharp mask of the depth buffer).
+    /// Default off.
+    pub unsharp_mask: bool,
+}
+
+impl Enhancements {
+    /// Everything on: what `--edges` asks for.
+    pub const ALL: Enhancements = Enhancements { outlines: true, creases: true, unsharp_mask: true };
+
+    pub fn any(self) -> bool {
+        self.outlines || self.creases || self.unsharp_mask
+    }
+}
+
+/// Everything that shapes one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Output size in pixels. Default [`DEFAULT_SIZE`] (800×600); each side 1..=8192.
+    pub size: (u32, u32),
+    /// Supersampling factor: the frame is drawn at `size × supersample` and box-filtered down
+    /// (anti-aliasing for headless output). Default 1; range 1..=4.
+    pub supersample: u32,
+    /// The scene's style. Default [`Style::Gradient`].
+    pub style: Style,
+    /// Whether the parts' baked style hints override [`Self::style`]. Default true.
+    pub use_part_styles: bool,
+    pub view: View,
+    /// Orthographic instead of perspective projection. Default false.
+    pub orthographic: bool,
+    /// Vertical field of view of the perspective camera, degrees. Default [`DEFAULT_FOV_Y_DEG`] (30).
+    pub fov_y_deg: f32,
+    pub enhancements: Enhancements,
+    pub shadow: ShadowMode,
+    /// Shadow colour (display values). Default [`DEFAULT_SHADOW_COLOR`].
+    pub shadow_color: [f32; 3],
+    /// Background colour (display values). Default [`DEFAULT_BACKGROUND`] (white).
+    pub background: [f32; 3],
+    /// Steps of cel and Goochel shading. Default [`DEFAULT_CEL_STEPS`] (3); range 2..=4.
+    pub cel_steps: u32,
+    /// A white specular band on cel shading. Default true.
+    pub cel_specular: bool,
+    /// Gooch's splash-back multiplier `(α|cos θ| + (1 − α))^β` (α = 0.76, β = 0.78). Default false.
+    pub splash_back: bool,
+    /// Hatch stroke period in output pixels. Default [`DEFAULT_HATCH_PERIOD_PX`] (5).
+    pub hatch_period_px: f32,
+    /// Part id to highlight (the display pass tints it). Default none.
+    pub selected_part: Option<u32>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            size: DEFAULT_SIZE,
+            supersample: 1,
+            style: Style::default(),
+            use_part_styles: true,
+            view: View::default(),
+            orthographic: false,
+            fov_y_deg: DEFAULT_FOV_Y_DEG,
+            enhancements: Enhancements::default(),
+            shadow: ShadowMode::default(),
+            shadow_color: DEFAULT_SHADOW_COLOR,
+            background: DEFAULT_BACKGROUND,
+            cel_steps: DEFAULT_CEL_STEPS,
+            cel_specular: true,
+            splash_back: false,
+            hatch_period_px: DEFAULT_HATCH_PERIOD_PX,
+            selected_part: None,
+        }
+    }
+}
+
+/// Largest accepted side of [`RenderOptions::size`] times the supersampling factor.
+pub const MAX_TARGET_SIDE: u32 = 8192;
+
+impl RenderOptions {
+    /// Checks every field against its documented range.
+    pub fn validate(&self) -> Result<(), String> {
+        let (w, h) = self.size;
+        if w == 0 || h == 0 {
+            return Err(format!("size {w}x{h}: both sides must be at least 1"));
+        }
+        if !(1..=4).contains(&self.supersample) {
+            return Err(format!("supersample {} is out of range 1..=4", self.supersample));
+        }
+        if w.max(h).saturating_mul(self.supersample) > MAX_TARGET_SIDE {
+            return Err(format!(
+                "size {w}x{h} × supersample {} exceeds {MAX_TARGET_SIDE} pixels a side",
+                self.supersample
+            ));
+        }
+        if !(2..=4).contains(&self.cel_steps) {
+            return Err(format!("cel steps {} is out of range 2..=4", self.cel_steps));
+        }
+        let el = self.view.elevation_deg;
+        if !(el > -90.0 && el < 90.0 && self.view.azimuth_deg.is_finite()) {
+            return Err(format!(
+                "view {},{}: azimuth must be finite and elevation in (-90, 90)",
+                self.view.azimuth_deg, el
+            ));
+        }
+        if !(self.fov_y_deg > 1.0 && self.fov_y_deg < 150.0) {
+            return Err(format!("field of view {} is out of range (1, 150) degrees", self.fov_y_deg));
+        }
+        if !(self.hatch_period_px >= 1.0 && self.hatch_period_px <= 256.0) {
+            return Err(format!("hatch period {} is out of range [1, 256] pixels", self.hatch_period_px));
+        }
+        Ok(())
+    }
+
+    /// Size of the render targets: the output size times the supersampling factor.
+    pub fn target_size(&self) -> (u32, u32) {
+        (self.size.0 * self.supersample, self.size.1 * self.supersample)
+    }
+}
+
+/// The intensity transfer curves γ a baked part may name (the spec's `gradient.transfer`), in the
+/// order of the rows of the transfer table (keep in sync with drafter-bounds' `TransferCurve`,
+/// which a test checks).
+pub const TRANSFER_CURVES: [&str; 5] = ["identity", "smoothstep", "ease_in", "ease_out", "invert"];
+
+/// Texels per transfer curve (Lux et al.: "a texture resolution of 128 pixels").
+pub const TRANSFER_TEXELS: usize = 128;
+
+/// γ(x) of the named curve (index into [`TRANSFER_CURVES`]), `x` clamped to [0, 1].
+pub fn transfer(curve: usize, x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    match curve {
+        1 => x * x * (3.0 - 2.0 * x),
+        2 => x * x,
+        3 => 1.0 - (1.0 - x) * (1.0 - x),
+        4 => 1.0 - x,
+        _ => x,
+    }
+}
+
+/// Every transfer curve as 128 texels `γ(k / 127)`, one row per curve: the table the G-buffer pass
+/// samples with linear interpolation.
+pub fn transfer_tables() -> Vec<f32> {
+    (0..TRANSFER_CURVES.len())
+        .flat_map(|c| (0..TRANSFER_TEXELS).map(move |k| transfer(c, k as f64 / (TRANSFER_TEXELS - 1) as f64) as f32))
+        .collect()
+}
+
+/// Entries of the metal band table.
+pub const METAL_TABLE_LEN: usize = 32;
+
+/// Gooch et al. 1999, §5.2.1: a periodic table of random intensities `b + r^e` (b = −0.1,
+/// r uniform in [0, 1], e = 1.4), each entry filtered with its neighbours 1-5-1 and clamped to
+/// [0, 1]. The G-buffer pass wraps it around each part's principal axis. Deterministic (a fixed
+/// xorshift seed) so that images are reproducible.
+pub fn metal_table() -> Vec<f32> {
+    let mut state: u32 = 0x9e37_79b9;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        f64::from(state) / f64::from(u32::MAX)
+    };
+    let raw: Vec<f64> = (0..METAL_TABLE_LEN).map(|_| -0.1 + next().powf(1.4)).collect();
+    let n = raw.len();
+    (0..n)
+        .map(|k| {
+            let v = (raw[(k + n - 1) % n] + 5.0 * raw[k] + raw[(k + 1) % n]) / 7.0;
+            v.clamp(0.0, 1.0) as f32
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for s in Style::ALL {
+            assert_eq!(s.name().parse::<Style>(), Ok(s));
+        }
+        assert!("toon".parse::<Style>().is_err());
+        let mut indices: Vec<u32> = Style::ALL.iter().map(|s| s.index()).collect();
+        indices.sort_unstable();
+        assert_eq!(indices, (0..7).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn tables_are_in_range() {
+        let t = transfer_tables();
+        assert_eq!(t.len(), 5 * 128);
+        assert!(t.iter().all(|v| (0.0..=1.0).contains(v)));
+        let m = metal_table();
+        assert_eq!(m.len(), METAL_TABLE_LEN);
+        assert!(m.iter().all(|v| (0.0..=1.0).contains(v)));
+        // Not constant: bands are visible.
+        let (lo, hi) = m.iter().fold((1.0f32, 0.0f32), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        assert!(hi - lo > 0.3, "{lo}..{hi}");
+    }
+
+    #[test]
+    fn options_validate() {
+        assert!(RenderOptions::default().validate().is_ok());
+        let bad = [
+            RenderOptions { size: (0, 10), ..Default::default() },
+            RenderOptions { supersample: 0, ..Default::default() },
+            RenderOptions { size: (5000, 10), supersample: 2, ..Default::default() },
+            RenderOptions { cel_steps: 5, ..Default::default() },
+            RenderOptions { view: View { azimuth_deg: 0.0, elevation_deg: 90.0 }, ..Default::default() },
+        ];
+        for o in bad {
+            assert!(o.validate().is_err(), "{o:?}");
+        }
+    }
+}

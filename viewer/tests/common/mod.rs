@@ -1,0 +1,95 @@
+//! Shared by the viewer's integration tests: the renderer (which must exist: no GPU adapter is a
+//! failure, not a skip), the baked sample, and golden-image comparison.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use drafter_viewer::{Image, Model, Renderer};
+
+/// Mean absolute difference (RGB, in [0, 1]) a golden image may show.
+pub const MAX_MEAN_ABS: f64 = 0.02;
+/// Fraction of pixels allowed to differ by more than [`LEVEL_THRESHOLD`] levels.
+pub const MAX_FRACTION_OVER: f64 = 0.01;
+pub const LEVEL_THRESHOLD: u8 = 8;
+
+/// Set to `1` to rewrite the reference images instead of comparing with them.
+pub const UPDATE_ENV: &str = "DRAFTER_UPDATE_GOLDEN";
+
+pub fn renderer() -> Renderer {
+    match Renderer::new() {
+        Ok(r) => r,
+        Err(e) => panic!(
+            "the viewer tests need a GPU adapter and found none: {e}\n\
+             (CI installs lavapipe: apt-get install -y mesa-vulkan-drivers libvulkan1)"
+        ),
+    }
+}
+
+pub fn repo_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(relative)
+}
+
+/// A model from ../shared/models, failing loudly when the corpus is missing.
+pub fn corpus_path(relative: &str) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models").join(relative);
+    assert!(
+        path.is_file(),
+        "test model {} is missing: the tests need ../shared/models beside the repository",
+        path.display()
+    );
+    path
+}
+
+/// Imports `path`, bakes it in memory with the default config and loads the result as the viewer
+/// would load the file `drafter bake` writes.
+pub fn baked(path: &Path) -> Model {
+    let imported = drafter_io::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let baked = drafter_bake::bake(&imported.scene, &drafter_bake::BakeConfig::default())
+        .unwrap_or_else(|e| panic!("{}: bake failed: {e}", path.display()));
+    assert!(baked.written.bin.is_none(), "the default container is .glb");
+    let name = format!("{}.baked.glb", path.file_stem().map(|s| s.to_string_lossy()).unwrap_or_default());
+    let model = Model::load_bytes(Path::new(&name), &baked.written.main).expect("baked file loads");
+    assert!(model.baked, "{name}: the extension was read");
+    model
+}
+
+/// The sample assembly, baked.
+pub fn sample() -> Model {
+    baked(&repo_path("samples/assembly.glb"))
+}
+
+/// Compares `image` with `golden/<name>.png` (or rewrites it when [`UPDATE_ENV`] is 1). Returns a
+/// description of the failure, if any; the actual image is then saved beside the test's temp dir.
+pub fn check_golden(name: &str, image: &Image) -> Option<String> {
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden").join(format!("{name}.png"));
+    let png = image.to_png().expect("PNG encoding");
+    if std::env::var(UPDATE_ENV).is_ok_and(|v| v == "1") {
+        std::fs::write(&golden, &png).expect("write golden image");
+        return None;
+    }
+    let Ok(bytes) = std::fs::read(&golden) else {
+        return Some(format!("{name}: no reference image {} (run with {UPDATE_ENV}=1)", golden.display()));
+    };
+    let reference = Image::from_png(&bytes).expect("reference PNG decodes");
+    let verdict = match image.diff(&reference, LEVEL_THRESHOLD) {
+        None => Some(format!(
+            "{name}: size {}x{} differs from the reference's {}x{}",
+            image.width, image.height, reference.width, reference.height
+        )),
+        Some(d) if d.mean_abs > MAX_MEAN_ABS || d.fraction_over > MAX_FRACTION_OVER => Some(format!(
+            "{name}: mean |Δ| {:.4} (max {MAX_MEAN_ABS}), {:.2} % of pixels off by > {LEVEL_THRESHOLD} levels (max {:.0} %), max Δ {}",
+            d.mean_abs,
+            d.fraction_over * 100.0,
+            MAX_FRACTION_OVER * 100.0,
+            d.max_levels
+        )),
+        Some(_) => None,
+    };
+    if verdict.is_some() {
+        let actual = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.actual.png"));
+        let _ = std::fs::write(&actual, &png);
+        return verdict.map(|v| format!("{v}; actual image: {}", actual.display()));
+    }
+    None
+}

@@ -1,0 +1,95 @@
+//! Golden images: the baked sample assembly in every style (with edges and a shadow), a few option
+//! variants, and models from ../shared/models, compared with the committed references in
+//! `tests/golden/` within the tolerance of `common` (mean |Δ| ≤ 0.02, ≤ 1 % of pixels off by more
+//! than 8 levels). `DRAFTER_UPDATE_GOLDEN=1 cargo test -p drafter-viewer --test golden` rewrites
+//! them; look at every one before committing.
+
+mod common;
+
+use drafter_viewer::{Enhancements, RenderOptions, ShadowMode, Style, View};
+
+/// Small images keep the suite fast on lavapipe.
+const SIZE: (u32, u32) = (256, 192);
+
+fn options(style: Style) -> RenderOptions {
+    RenderOptions {
+        size: SIZE,
+        supersample: 1,
+        style,
+        enhancements: Enhancements::ALL,
+        shadow: ShadowMode::Hard,
+        ..RenderOptions::default()
+    }
+}
+
+fn run_cases(model: &drafter_viewer::Model, cases: &[(String, RenderOptions)]) {
+    let mut renderer = common::renderer();
+    renderer.set_model(model).expect("upload");
+    let mut failures = Vec::new();
+    for (name, options) in cases {
+        let image = renderer.render(options).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!((image.width, image.height), options.size, "{name}");
+        // Something was drawn: not a blank background.
+        let background = image.pixel(0, 0);
+        let drawn = image.rgba.chunks_exact(4).filter(|p| p[..3] != background).count();
+        assert!(drawn > (SIZE.0 * SIZE.1 / 20) as usize, "{name}: only {drawn} pixels differ from the background");
+        failures.extend(common::check_golden(name, &image));
+    }
+    assert!(failures.is_empty(), "golden images differ:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn sample_assembly_in_every_style() {
+    let model = common::sample();
+    assert_eq!(model.parts.len(), 15);
+    let mut cases: Vec<(String, RenderOptions)> =
+        Style::ALL.iter().map(|&s| (format!("assembly_{s}"), options(s))).collect();
+    cases.push((
+        "assembly_phong_plain".into(),
+        RenderOptions { enhancements: Enhancements::default(), shadow: ShadowMode::None, ..options(Style::Phong) },
+    ));
+    cases.push((
+        "assembly_gradient_plain".into(),
+        RenderOptions { enhancements: Enhancements::default(), shadow: ShadowMode::None, ..options(Style::Gradient) },
+    ));
+    cases.push((
+        "assembly_gooch_penumbra".into(),
+        RenderOptions { shadow: ShadowMode::Penumbra, ..options(Style::Gooch) },
+    ));
+    cases.push((
+        "assembly_gooch_soft_splash".into(),
+        RenderOptions { shadow: ShadowMode::Soft, splash_back: true, ..options(Style::Gooch) },
+    ));
+    cases.push((
+        "assembly_cel_ortho_top".into(),
+        RenderOptions {
+            orthographic: true,
+            view: View { azimuth_deg: -60.0, elevation_deg: 60.0 },
+            cel_steps: 4,
+            selected_part: Some(12),
+            ..options(Style::Cel)
+        },
+    ));
+    run_cases(&model, &cases);
+}
+
+#[test]
+fn corpus_models() {
+    // A real assembly (no normals in the file: face normals), baked in memory.
+    let rod = common::baked(&common::corpus_path("gltf/RodAssembly/rod.glb"));
+    run_cases(
+        &rod,
+        &[
+            ("rod_gradient".into(), options(Style::Gradient)),
+            (
+                "rod_gooch".into(),
+                RenderOptions { view: View { azimuth_deg: 120.0, elevation_deg: 20.0 }, ..options(Style::Gooch) },
+            ),
+        ],
+    );
+    // A single-mesh CAD part, unbaked: one part, a bounding-box projector, and a notice.
+    let fandisk = drafter_viewer::Model::load(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"))
+        .expect("fandisk loads");
+    assert!(!fandisk.baked && !fandisk.notices.is_empty());
+    run_cases(&fandisk, &[("fandisk_unbaked_metal".into(), options(Style::Metal))]);
+}
