@@ -170,9 +170,10 @@ pub fn run(args: Args) -> Result<()> {
             eprintln!("  note: {notice}");
         }
         if args.lines
-            && let Some(notice) = drafter_viewer::passes::lines::notice(&model) {
-                eprintln!("  note: {notice}");
-            }
+            && let Some(notice) = drafter_viewer::passes::lines::notice(&model)
+        {
+            eprintln!("  note: {notice}");
+        }
     }
     Ok(())
 }
