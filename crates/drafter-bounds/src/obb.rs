@@ -90,6 +90,8 @@ use crate::search::{self, Candidate, Frame};
 pub const DEFAULT_OBB_METHOD: ObbMethod = ObbMethod::Default;
 /// Default of [`ObbOptions::default_face_normals`].
 pub const DEFAULT_FACE_NORMALS: usize = 48;
+/// `Default` runs the exhaustive `Optimal` search on hulls with at most this many triangles.
+pub const DEFAULT_EXHAUSTIVE_HULL_FACES: usize = 64;
 /// Default of [`ObbOptions::optimal_budget`].
 pub const DEFAULT_OPTIMAL_BUDGET: u64 = 100_000_000;
 
@@ -329,6 +331,12 @@ pub fn oriented_box_with_stats(points: &[DVec3], options: &ObbOptions) -> Result
         },
         HullDimension::Solid => match method {
             ObbMethod::Hull => hull_covariance_axes(&hull),
+            // Tiny hulls: the exhaustive search costs about what the heuristic does (a few hundred
+            // microseconds at most) and catches edge-flush minima the face heuristic misses, e.g.
+            // a tetrahedron (the corpus had one at 1.17x before this rule).
+            ObbMethod::Default if hull.triangles.len() <= DEFAULT_EXHAUSTIVE_HULL_FACES => {
+                optimal_axes(&local, &hull, options, &mut stats)
+            }
             ObbMethod::Default => default_axes(&local, &hull, options, &mut stats),
             _ => optimal_axes(&local, &hull, options, &mut stats),
         },
