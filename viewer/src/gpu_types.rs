@@ -106,6 +106,9 @@ pub const FLAG_HATCH_OBJECT_SPACE: u32 = 4;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ShadowLayerGpu {
+    /// Where the projected points go: the camera's clip space for a screen-space layer, the
+    /// ground map's for the soft shadow's map.
+    pub clip_from_render: [[f32; 4]; 4],
     /// Point light position, render space; w unused.
     pub light_position: [f32; 4],
     /// x: height of the plane the shadow is projected onto; y: height of the ground it is moved
@@ -113,28 +116,38 @@ pub struct ShadowLayerGpu {
     pub plane: [f32; 4],
 }
 
-/// Uniforms of the enhancement pass (`enhance.wgsl`: `Enhance`).
+/// Most planes of a soft shadow ([`ShadowResolveGpu::inverse_scales`]).
+pub const MAX_SOFT_PLANES: usize = 16;
+
+/// The soft shadow's resolve (`shadow.wgsl`: `Resolve`): every plane of the stack is the ground
+/// shadow scaled about the light's foot point, so the mask is an average of map lookups.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ShadowResolveGpu {
+    pub render_from_clip: [[f32; 4]; 4],
+    /// The ground rectangle the map covers: min x, min z, width, depth (render space).
+    pub map_rect: [f32; 4],
+    /// The light's foot point (x, z), the ground height, and the number of planes.
+    pub foot_ground_count: [f32; 4],
+    /// Width and height of the mask being written.
+    pub target_size: [f32; 4],
+    /// 1 / scale of each plane's shadow about the foot point, four per vector.
+    pub inverse_scales: [[f32; 4]; 4],
+}
+
+/// Uniforms of one blur direction of the enhancement pass (`enhance.wgsl`: `Enhance`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct EnhanceUniforms {
-    /// Blur direction in pixels (1,0) or (0,1); z: Gaussian sigma in pixels; w: kernel radius.
+    /// Blur direction (1,0) or (0,1); z: Gaussian sigma and w: kernel radius, in target texels.
     pub blur: [f32; 4],
-    /// Depth value given to background pixels (beyond the farthest model point), in view units.
+    /// Depth given to background pixels (beyond the farthest model point), in view units.
     pub far_depth: f32,
-    /// Relative threshold of the depth second difference that counts as an edge.
-    pub depth_threshold: f32,
-    /// Cosine of the normal angle that counts as a crease.
-    pub crease_cos: f32,
-    /// Line half-width in pixels (1 at 1× supersampling).
-    pub line_radius: f32,
-    /// Scale of the depth unsharp mask (Luft et al. 2006), per unit of scene radius.
-    pub unsharp_strength: f32,
-    /// 1 for an orthographic camera (depth affine on planes), 0 for perspective (1/depth affine).
-    pub ortho: f32,
-    /// Scene radius in view units (normalises the depth difference).
-    pub scene_radius: f32,
-    /// 1: background pixels read as `far_depth` (the first blur direction).
+    /// 1: read the full-resolution depth (every `source_step` texels) and fill the background.
     pub background_fill: f32,
+    /// Full-resolution texels per blur texel when reading the source (first direction), else 1.
+    pub source_step: f32,
+    pub _pad: f32,
 }
 
 /// Uniforms of the display pass (`display.wgsl`: `Display`).
@@ -151,6 +164,19 @@ pub struct DisplayUniforms {
     /// Bit 0: outlines; bit 1: creases; bit 2: depth unsharp mask; bit 3: shadow.
     pub flags: u32,
     pub _pad: [u32; 2],
+    /// Relative second difference of the affine depth that counts as a depth edge.
+    pub depth_threshold: f32,
+    /// Cosine of the normal angle that counts as a crease.
+    pub crease_cos: f32,
+    /// Line half-width in pixels (1 at 1× supersampling).
+    pub line_radius: f32,
+    /// Scale of the depth unsharp mask (Luft et al. 2006), per unit of scene radius.
+    pub unsharp_strength: f32,
+    /// 1 for an orthographic camera (depth affine on planes), 0 for perspective (1/depth affine).
+    pub ortho: f32,
+    /// Scene radius in view units (normalises depth differences).
+    pub scene_radius: f32,
+    pub _pad2: [f32; 2],
 }
 
 /// `DisplayUniforms::flags` bit: draw outlines (part borders, silhouettes).
@@ -168,7 +194,8 @@ const _: () = {
     assert!(size_of::<PartGpu>() == 96);
     assert!(size_of::<MaterialGpu>() == 32);
     assert!(size_of::<FrameUniforms>() == 128 + 48 + 16 + 16);
-    assert!(size_of::<ShadowLayerGpu>() == 32);
-    assert!(size_of::<EnhanceUniforms>() == 48);
-    assert!(size_of::<DisplayUniforms>() == 96);
+    assert!(size_of::<ShadowLayerGpu>() == 96);
+    assert!(size_of::<ShadowResolveGpu>() == 176);
+    assert!(size_of::<EnhanceUniforms>() == 32);
+    assert!(size_of::<DisplayUniforms>() == 128);
 };

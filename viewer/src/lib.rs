@@ -9,10 +9,16 @@
 //!    from a storage buffer indexed by part id; writes colour, normal, linear depth and part id.
 //!    Styles: [`Style`] (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`, `hatch`).
 //! 2. [`passes::shadow`]: optional drop shadow on the ground plane (hard, umbra + penumbra, soft).
-//! 3. [`passes::enhance`]: image-space edges from part-id, depth and normal discontinuities and the
-//!    depth unsharp mask.
-//! 4. [`passes::lines`]: the hook for baked edges (not in files yet).
-//! 5. [`passes::display`]: composite, background, shadow colour, selection highlight.
+//! 3. [`passes::enhance`]: the depth unsharp mask's blur; the image-space edges (part-id, depth and
+//!    normal discontinuities) it specifies are detected in the display pass, which reads the same
+//!    texels (measured on lavapipe: a separate full-screen pass cost half a Phong frame).
+//! 4. [`passes::lines`]: the hook for baked edges (not drawn yet).
+//! 5. [`passes::display`]: edges, depth darkening, composite, background, coloured shadow,
+//!    selection highlight.
+//!
+//! Frame times (`drafter bench render`, lavapipe, 1600×1200, ratio to Phong in the same run): every
+//! style 1.00–1.03×; edges 1.4×; soft shadow 1.1×; full illustration (gradient, edges, soft shadow)
+//! 1.5× on the sample assembly and on GearboxAssy (646k triangles).
 //!
 //! # Use
 //! ```no_run

@@ -23,19 +23,14 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::Path;
 
+use drafter_core::gradient::{DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZATION};
 use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
 use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, PartGpu, Vertex};
-use crate::style::{Style, TRANSFER_CURVES};
+use crate::style::{Style, transfer_index};
 
-/// Default quantisation of a part without baked gradient parameters (as drafter-bounds).
-pub const DEFAULT_Q: f32 = 10.0;
-/// Default fade step.
-pub const DEFAULT_F: f32 = 0.5;
-/// Default power.
-pub const DEFAULT_P: f32 = 1.0;
 /// Colour of triangles without a material (display values).
 pub const DEFAULT_BASE_COLOR: [f32; 4] = [0.8, 0.8, 0.8, 1.0];
 
@@ -411,7 +406,7 @@ fn baked_part(record: &PartRecord, origin: DVec3) -> (Part, bool, bool) {
     let m = &record.projector.matrix;
     // Column-major: row 0 is elements 0, 4, 8, 12.
     let row = DVec4::new(m[0], m[4], m[8], m[12]);
-    let transfer = TRANSFER_CURVES.iter().position(|c| *c == record.gradient.transfer);
+    let transfer = transfer_index(&record.gradient.transfer);
     let style = record.style.as_deref().map(str::parse::<Style>);
     let axes = record.obb.axes.map(|a| [a[0] as f32, a[1] as f32, a[2] as f32, 0.0]);
     let gpu = PartGpu {
@@ -474,7 +469,7 @@ fn fallback_part(id: u32, name: &str, world: &Aabb, origin: DVec3) -> Part {
         gpu: PartGpu {
             projector_row: row,
             axes,
-            gradient: [DEFAULT_Q, DEFAULT_F, DEFAULT_P, 0.0],
+            gradient: [DEFAULT_QUANTIZATION as f32, DEFAULT_FADE_STEP, DEFAULT_POWER, 0.0],
             style_hint: NO_STYLE,
             _pad: [0; 3],
         },

@@ -18,7 +18,7 @@ use crate::passes::gbuffer::GBufferPass;
 use crate::passes::shadow::{self, ShadowPass};
 use crate::scene::SceneGpu;
 use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
-use crate::targets::{OUTPUT_FORMAT, Targets};
+use crate::targets::{OUTPUT_FORMAT, SHADOW_REDUCTION, Targets};
 
 /// A model on the GPU with what the camera fit needs.
 #[derive(Debug)]
@@ -59,6 +59,8 @@ pub struct Renderer {
     scene: Option<LoadedScene>,
     targets: Option<FrameTargets>,
     last_frame: Option<FrameInfo>,
+    /// The shadow of the frame being recorded.
+    shadow_plan: shadow::ShadowPlan,
 }
 
 impl Renderer {
@@ -95,6 +97,7 @@ impl Renderer {
             scene: None,
             targets: None,
             last_frame: None,
+            shadow_plan: shadow::ShadowPlan { layers: Vec::new(), resolve: None },
         })
     }
 
@@ -171,21 +174,16 @@ impl Renderer {
         };
         let queue = &self.gpu.queue;
         queue.write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&frame));
-        self.shadow.prepare(queue, &layers);
+        let mask_size = (size.0.div_ceil(SHADOW_REDUCTION), size.1.div_ceil(SHADOW_REDUCTION));
+        let plan = shadow::plan(options.shadow, &layers, camera.clip_from_render(), &scene.fit_points, mask_size);
+        self.shadow.prepare(queue, &plan);
         let radius = (max - min).length() * 0.5;
-        self.enhance.prepare(
-            queue,
-            &EnhanceSetup {
-                height: size.1,
-                pixel_scale: scale,
-                far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5,
-                scene_radius: radius,
-                orthographic: options.orthographic,
-            },
-        );
-        self.display.prepare(queue, &display::uniforms(options));
+        self.enhance
+            .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
+        self.display.prepare(queue, &display::uniforms(options, radius, options.orthographic));
         let info = FrameInfo { camera, target_size: size };
         self.last_frame = Some(info);
+        self.shadow_plan = plan;
         Ok(info)
     }
 
@@ -204,15 +202,9 @@ impl Renderer {
         let targets = &frame.targets;
         self.gbuffer.encode(encoder, targets, &scene.gpu);
         if options.shadow != ShadowMode::None {
-            let layers = match options.shadow {
-                ShadowMode::None => 0,
-                ShadowMode::Hard => 1,
-                ShadowMode::Penumbra => 2,
-                ShadowMode::Soft => shadow::SOFT_LAYERS,
-            };
-            self.shadow.encode(encoder, targets, &scene.gpu, layers);
+            self.shadow.encode(encoder, targets, &scene.gpu, &self.shadow_plan);
         }
-        if options.enhancements.any() {
+        if options.enhancements.unsharp_mask {
             self.enhance.encode(encoder, targets, &frame.enhance);
         }
         // The lines pass goes here once edges are baked (see passes::lines).

@@ -79,7 +79,7 @@ impl SceneGpu {
             })
             .collect();
         let gbuffer_bind_group = gbuffer.bind_group(device, frame, &buffers);
-        let shadow_bind_group = shadow.scene_bind_group(device, frame, &buffers);
+        let shadow_bind_group = shadow.scene_bind_group(device, &buffers);
         SceneGpu { batches, buffers, gbuffer_bind_group, shadow_bind_group }
     }
 }

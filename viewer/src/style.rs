@@ -6,6 +6,8 @@
 use std::fmt;
 use std::str::FromStr;
 
+use drafter_core::gradient::{IntensityTransfer, TransferCurve};
+
 /// A shading style of the G-buffer pass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Style {
@@ -272,32 +274,17 @@ impl RenderOptions {
     }
 }
 
-/// The intensity transfer curves γ a baked part may name (the spec's `gradient.transfer`), in the
-/// order of the rows of the transfer table (keep in sync with drafter-bounds' `TransferCurve`,
-/// which a test checks).
-pub const TRANSFER_CURVES: [&str; 5] = ["identity", "smoothstep", "ease_in", "ease_out", "invert"];
-
-/// Texels per transfer curve (Lux et al.: "a texture resolution of 128 pixels").
-pub const TRANSFER_TEXELS: usize = 128;
-
-/// γ(x) of the named curve (index into [`TRANSFER_CURVES`]), `x` clamped to [0, 1].
-pub fn transfer(curve: usize, x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    match curve {
-        1 => x * x * (3.0 - 2.0 * x),
-        2 => x * x,
-        3 => 1.0 - (1.0 - x) * (1.0 - x),
-        4 => 1.0 - x,
-        _ => x,
-    }
+/// Every transfer curve γ as 128 texels `γ(k / 127)`, one row per curve in the order of
+/// [`TransferCurve::ALL`] (a curve's row is its index there): the table the G-buffer pass samples
+/// with linear interpolation, exactly as [`drafter_core::gradient::IntensityTransfer::sample`].
+pub fn transfer_tables() -> Vec<f32> {
+    TransferCurve::ALL.iter().flat_map(|&c| IntensityTransfer::from_curve(c).texels().to_vec()).collect()
 }
 
-/// Every transfer curve as 128 texels `γ(k / 127)`, one row per curve: the table the G-buffer pass
-/// samples with linear interpolation.
-pub fn transfer_tables() -> Vec<f32> {
-    (0..TRANSFER_CURVES.len())
-        .flat_map(|c| (0..TRANSFER_TEXELS).map(move |k| transfer(c, k as f64 / (TRANSFER_TEXELS - 1) as f64) as f32))
-        .collect()
+/// The row of the named curve (the spec's `gradient.transfer` names) in [`transfer_tables`].
+pub fn transfer_index(name: &str) -> Option<usize> {
+    let curve: TransferCurve = serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()?;
+    TransferCurve::ALL.iter().position(|&c| c == curve)
 }
 
 /// Entries of the metal band table.
@@ -328,6 +315,7 @@ pub fn metal_table() -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use drafter_core::gradient::INTENSITY_TABLE_LEN;
 
     #[test]
     fn names_round_trip() {
@@ -343,8 +331,15 @@ mod tests {
     #[test]
     fn tables_are_in_range() {
         let t = transfer_tables();
-        assert_eq!(t.len(), 5 * 128);
+        assert_eq!(t.len(), TransferCurve::ALL.len() * INTENSITY_TABLE_LEN);
         assert!(t.iter().all(|v| (0.0..=1.0).contains(v)));
+        // The spec's names, in table order.
+        for (k, name) in ["identity", "smoothstep", "ease_in", "ease_out", "invert"].iter().enumerate() {
+            assert_eq!(transfer_index(name), Some(k));
+            let row = &t[k * INTENSITY_TABLE_LEN..(k + 1) * INTENSITY_TABLE_LEN];
+            assert!((f64::from(row[64]) - TransferCurve::ALL[k].eval(64.0 / 127.0)).abs() < 1e-6);
+        }
+        assert_eq!(transfer_index("sigmoid"), None);
         let m = metal_table();
         assert_eq!(m.len(), METAL_TABLE_LEN);
         assert!(m.iter().all(|v| (0.0..=1.0).contains(v)));

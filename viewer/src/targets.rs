@@ -13,8 +13,11 @@ pub const PART_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The blurred linear depth of the unsharp mask.
 pub const BLUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-/// Enhancement result: r outline, g crease, b depth darkening.
-pub const ENHANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// The blur targets are this many times smaller than the frame on each side.
+pub const BLUR_REDUCTION: u32 = 4;
+/// The shadow mask and stencil are this many times smaller than the frame on each side (the
+/// display pass samples the mask with bilinear filtering).
+pub const SHADOW_REDUCTION: u32 = 2;
 /// Accumulated shadow coverage in [0, 1].
 pub const SHADOW_MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 /// Stencil that lets each shadow layer cover a pixel once.
@@ -63,7 +66,6 @@ pub struct Targets {
     pub depth: Target,
     pub blur_a: Target,
     pub blur_b: Target,
-    pub enhance: Target,
     pub shadow_mask: Target,
     pub shadow_stencil: Target,
     pub output: Target,
@@ -73,6 +75,7 @@ impl Targets {
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Targets {
         use wgpu::TextureUsages as U;
         let sampled = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
+        let reduced = |k: u32| (size.0.div_ceil(k), size.1.div_ceil(k));
         Targets {
             size,
             color: Target::new(device, "gbuffer color", size, COLOR_FORMAT, sampled),
@@ -81,11 +84,16 @@ impl Targets {
             // COPY_SRC: the window reads one texel back to pick a part.
             part_id: Target::new(device, "gbuffer part id", size, PART_ID_FORMAT, sampled | U::COPY_SRC),
             depth: Target::new(device, "gbuffer depth", size, DEPTH_FORMAT, U::RENDER_ATTACHMENT),
-            blur_a: Target::new(device, "enhance depth blur a", size, BLUR_FORMAT, sampled),
-            blur_b: Target::new(device, "enhance depth blur b", size, BLUR_FORMAT, sampled),
-            enhance: Target::new(device, "enhance result", size, ENHANCE_FORMAT, sampled),
-            shadow_mask: Target::new(device, "shadow mask", size, SHADOW_MASK_FORMAT, sampled),
-            shadow_stencil: Target::new(device, "shadow stencil", size, SHADOW_STENCIL_FORMAT, U::RENDER_ATTACHMENT),
+            blur_a: Target::new(device, "enhance depth blur a", reduced(BLUR_REDUCTION), BLUR_FORMAT, sampled),
+            blur_b: Target::new(device, "enhance depth blur b", reduced(BLUR_REDUCTION), BLUR_FORMAT, sampled),
+            shadow_mask: Target::new(device, "shadow mask", reduced(SHADOW_REDUCTION), SHADOW_MASK_FORMAT, sampled),
+            shadow_stencil: Target::new(
+                device,
+                "shadow stencil",
+                reduced(SHADOW_REDUCTION),
+                SHADOW_STENCIL_FORMAT,
+                U::RENDER_ATTACHMENT,
+            ),
             output: Target::new(device, "display output", size, OUTPUT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC),
         }
     }

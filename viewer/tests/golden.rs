@@ -66,7 +66,7 @@ fn sample_assembly_in_every_style() {
             orthographic: true,
             view: View { azimuth_deg: -60.0, elevation_deg: 60.0 },
             cel_steps: 4,
-            selected_part: Some(12),
+            selected_part: Some(1),
             ..options(Style::Cel)
         },
     ));

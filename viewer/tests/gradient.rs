@@ -1,11 +1,12 @@
 //! The gradient style on the GPU against drafter-bounds' CPU definition: a flat quad seen head-on
 //! through an orthographic camera, every pixel's grey value compared with `ω(γ(p))` at that pixel's
-//! world position — once through the unbaked fallback (default q, f, p) and once through baked
+//! world position (`drafter_core::gradient::omega`) — once through the unbaked fallback (default q, f, p) and once through baked
 //! parameters (q, f, p, transfer and a tilted projector from drafter-bounds' `Projector::matrix`).
 
 mod common;
 
-use drafter_bounds::{Projector, TransferCurve, omega};
+use drafter_bounds::Projector;
+use drafter_core::gradient::{TransferCurve, omega};
 use drafter_core::{Instance, Mesh, MeshId, Node, NodeId, Scene, SourceFormat, TriangleGroup};
 use drafter_format::{BakedFile, BoxRecord, GradientRecord, NodeExtension, PartRecord, ProjectorRecord, RootExtension};
 use drafter_viewer::{Model, RenderOptions, Style, View};
@@ -155,19 +156,4 @@ fn baked_parameters_match_omega() {
         assert!(model.notices.is_empty(), "{:?}", model.notices);
         check(name, &model, |w| omega(curve.eval(projector.coordinate(w)), q, f, p));
     }
-}
-
-#[test]
-fn transfer_curves_match_drafter_bounds() {
-    for (k, name) in drafter_viewer::style::TRANSFER_CURVES.iter().enumerate() {
-        let curve: TransferCurve =
-            serde_json::from_value(serde_json::Value::String((*name).into())).expect("known curve");
-        for i in 0..=100 {
-            let x = f64::from(i) / 100.0;
-            assert!((drafter_viewer::style::transfer(k, x) - curve.eval(x)).abs() < 1e-12, "{name} at {x}");
-        }
-    }
-    assert_eq!(drafter_viewer::model::DEFAULT_Q as u32, drafter_bounds::DEFAULT_QUANTIZATION);
-    assert_eq!(drafter_viewer::model::DEFAULT_F, drafter_bounds::DEFAULT_FADE_STEP);
-    assert_eq!(drafter_viewer::model::DEFAULT_P, drafter_bounds::DEFAULT_POWER);
 }

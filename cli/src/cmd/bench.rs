@@ -4,8 +4,9 @@
 //! Frames are interleaved (one frame of each style in turn, after a warm-up of every style) so that
 //! drift of a shared, noisy machine hits every style alike; each style's time is the median of its
 //! frames. A frame is measured from recording to completion on the device (submit and wait), the
-//! image not read back. `illustration` is the full frame: gradient shading, edges, depth unsharp
-//! mask and a soft shadow.
+//! image not read back. Besides the styles: `edges` (gradient with outlines, creases and the depth
+//! unsharp mask), `shadow_hard` and `shadow_soft` (gradient with a drop shadow), and
+//! `illustration`, the full frame: gradient shading, edges and a soft shadow.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -26,6 +27,25 @@ pub struct Args {
 pub enum What {
     /// Frame time per style, as a ratio to phong (median over N frames after warm-up).
     Render(RenderArgs),
+    /// Frame time of the same triangles in 10 and in 1000 parts (synthetic spheres), as parts of
+    /// one mesh (per-triangle labels) and as separate meshes.
+    Parts(PartsArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct PartsArgs {
+    /// Triangles in the scene.
+    #[arg(long, default_value_t = 200_000)]
+    pub triangles: usize,
+    /// Frame size, WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "1600x1200", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Measured frames per case (at least 30).
+    #[arg(long, default_value_t = 30)]
+    pub frames: usize,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -60,7 +80,7 @@ pub struct Report {
     pub device: String,
     pub triangles: usize,
     pub parts: usize,
-    /// By name, in the order measured (`phong` first).
+    /// By name (`phong`, the styles, `edges`, `shadow_hard`, `shadow_soft`, `illustration`).
     pub styles: serde_json::Map<String, serde_json::Value>,
 }
 
@@ -73,6 +93,7 @@ struct StyleTime {
 pub fn run(args: Args) -> Result<()> {
     match args.what {
         What::Render(args) => render(args),
+        What::Parts(args) => parts(args),
     }
 }
 
@@ -90,6 +111,10 @@ fn render(args: RenderArgs) -> Result<()> {
         .chain(Style::ALL.into_iter().filter(|&s| s != Style::Phong))
         .map(|style| (style.name().to_owned(), RenderOptions { style, ..base.clone() }))
         .collect();
+    let gradient = RenderOptions { style: Style::Gradient, ..base.clone() };
+    cases.push(("edges".to_owned(), RenderOptions { enhancements: Enhancements::ALL, ..gradient.clone() }));
+    cases.push(("shadow_hard".to_owned(), RenderOptions { shadow: ShadowMode::Hard, ..gradient.clone() }));
+    cases.push(("shadow_soft".to_owned(), RenderOptions { shadow: ShadowMode::Soft, ..gradient.clone() }));
     cases.push((
         "illustration".to_owned(),
         RenderOptions {
@@ -153,4 +178,254 @@ fn render(args: RenderArgs) -> Result<()> {
 
 fn round3(x: f64) -> f64 {
     (x * 1e3).round() / 1e3
+}
+
+/// The `bench parts` report: median frame times (ms) per case and the 1000-to-10 ratios.
+#[derive(Debug, Serialize)]
+pub struct PartsReport {
+    pub size: [u32; 2],
+    pub frames: usize,
+    pub device: String,
+    pub triangles: usize,
+    /// `labels_10`, `labels_1000`, `meshes_10`, `meshes_1000`, each `{ "phong": ms, "gradient": ms }`.
+    pub cases: serde_json::Map<String, serde_json::Value>,
+    /// Frame time with 1000 parts over the time with 10, per layout and style.
+    pub ratios: serde_json::Map<String, serde_json::Value>,
+}
+
+fn parts(args: PartsArgs) -> Result<()> {
+    if args.frames < 30 {
+        return Err(BadInput(format!("--frames {}: at least 30 frames are measured", args.frames)).into());
+    }
+    if !(2_000..=20_000_000).contains(&args.triangles) {
+        return Err(BadInput(format!("--triangles {} is out of range 2000..=20000000", args.triangles)).into());
+    }
+    let mut renderer = Renderer::new()?;
+    let layouts = [("labels", true), ("meshes", false)];
+    let styles = [Style::Phong, Style::Gradient];
+    let mut models = Vec::new();
+    for (layout, labelled) in layouts {
+        for n in [10usize, 1000] {
+            models.push((format!("{layout}_{n}"), spheres::model(n, args.triangles, labelled)?));
+        }
+    }
+    let base = RenderOptions { size: args.size, supersample: 1, use_part_styles: false, ..RenderOptions::default() };
+    base.validate().map_err(BadInput)?;
+    let mut cases = serde_json::Map::new();
+    let mut medians = std::collections::BTreeMap::new();
+    for (name, model) in &models {
+        renderer.set_model(model)?;
+        let mut times: Vec<Vec<Duration>> = vec![Vec::new(); styles.len()];
+        for _ in 0..3 {
+            for style in styles {
+                renderer.time_frame(&RenderOptions { style, ..base.clone() })?;
+            }
+        }
+        for _ in 0..args.frames {
+            for (k, style) in styles.iter().enumerate() {
+                times[k].push(renderer.time_frame(&RenderOptions { style: *style, ..base.clone() })?);
+            }
+        }
+        let mut row = serde_json::Map::new();
+        for (k, style) in styles.iter().enumerate() {
+            times[k].sort_unstable();
+            let ms = times[k][times[k].len() / 2].as_secs_f64() * 1e3;
+            medians.insert((name.clone(), style.name()), ms);
+            row.insert(style.name().to_owned(), serde_json::json!(round3(ms)));
+        }
+        cases.insert(name.clone(), serde_json::Value::Object(row));
+    }
+    let mut ratios = serde_json::Map::new();
+    for (layout, _) in layouts {
+        for style in styles {
+            let few = medians.get(&(format!("{layout}_10"), style.name())).copied().unwrap_or(f64::NAN);
+            let many = medians.get(&(format!("{layout}_1000"), style.name())).copied().unwrap_or(f64::NAN);
+            ratios.insert(format!("{layout}_{}", style.name()), serde_json::json!(round3(many / few)));
+        }
+    }
+    let report = PartsReport {
+        size: [args.size.0, args.size.1],
+        frames: args.frames,
+        device: renderer.gpu().description(),
+        triangles: models.first().map_or(0, |(_, m)| m.triangle_count()),
+        cases,
+        ratios,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{} triangles as 10 or 1000 spheres, {}x{}, median of {} frames on {}",
+            report.triangles, args.size.0, args.size.1, args.frames, report.device
+        );
+        for (name, row) in &report.cases {
+            println!("  {name:<12} {row}");
+        }
+        for (name, ratio) in &report.ratios {
+            println!("  1000 / 10 parts, {name:<16} {ratio}×");
+        }
+    }
+    Ok(())
+}
+
+/// Synthetic scenes for `bench parts`: `n` UV spheres on a square grid, sized so that together they
+/// cover about the same pixels at any `n`.
+mod spheres {
+    use drafter_core::{Instance, Mesh, MeshId, Node, NodeId, Scene, SourceFormat, TriangleGroup};
+    use drafter_format::{BakedFile, NodeExtension, PartRecord, RootExtension};
+    use drafter_viewer::Model;
+    use glam::{DMat4, Vec3};
+
+    /// A UV sphere of about `triangles` triangles at `center`.
+    fn sphere(center: Vec3, radius: f32, triangles: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
+        let side = ((triangles as f64 / 2.0).sqrt().round() as u32).max(3);
+        let (rows, cols) = (side, side);
+        let mut positions = Vec::new();
+        let mut normals = Vec::new();
+        for r in 0..=rows {
+            let theta = std::f32::consts::PI * r as f32 / rows as f32;
+            for c in 0..=cols {
+                let phi = std::f32::consts::TAU * c as f32 / cols as f32;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                positions.push(center + n * radius);
+                normals.push(n);
+            }
+        }
+        let mut triangles = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols {
+                let a = r * (cols + 1) + c;
+                let b = a + cols + 1;
+                triangles.push([a, b, a + 1]);
+                triangles.push([a + 1, b, b + 1]);
+            }
+        }
+        (positions, normals, triangles)
+    }
+
+    fn record(id: u32, center: Vec3, radius: f32, triangles: usize) -> anyhow::Result<PartRecord> {
+        let c = center.as_dvec3();
+        let s = f64::from(radius) * 2.0;
+        // Projector along +x over the sphere: p = 1/2 + (x − c.x)/s.
+        let matrix = [
+            1.0 / s,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0 / s,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0 / s,
+            0.0,
+            0.5 - c.x / s,
+            0.5 - c.y / s,
+            0.5 - c.z / s,
+            1.0,
+        ];
+        Ok(serde_json::from_value(serde_json::json!({
+            "id": id,
+            "name": format!("sphere_{id}"),
+            "triangles": triangles,
+            "obb": { "center": c.to_array(), "axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                     "halfExtents": [radius, radius, radius], "volume": s * s * s, "method": "aabb" },
+            "projector": { "anchor": c.to_array(), "direction": [1, 0, 0], "scale": s, "matrix": matrix },
+            "gradient": { "q": 10, "f": 0.5, "p": 1.0, "transfer": "identity" }
+        }))?)
+    }
+
+    /// `n` spheres with `triangles` in all: one mesh with a label per sphere (`labelled`), or one
+    /// mesh and one instance per sphere (unbaked: each instance is a part).
+    pub fn model(n: usize, triangles: usize, labelled: bool) -> anyhow::Result<Model> {
+        let side = (n as f64).sqrt().ceil() as usize;
+        let spacing = 2.0 / side as f32;
+        let radius = spacing * 0.45;
+        let per = triangles / n;
+        let centers: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::new((i % side) as f32 * spacing - 1.0, 0.0, (i / side) as f32 * spacing - 1.0))
+            .collect();
+        let mut scene = Scene::new(SourceFormat::Gltf);
+        if labelled {
+            let mut mesh = Mesh { name: "spheres".into(), ..Mesh::default() };
+            let mut labels = Vec::new();
+            let mut records = Vec::new();
+            for (i, &c) in centers.iter().enumerate() {
+                let (p, nrm, t) = sphere(c, radius, per);
+                let base = mesh.positions.len() as u32;
+                mesh.positions.extend(p);
+                mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
+                labels.extend(std::iter::repeat_n(i as u32, t.len()));
+                records.push(record(i as u32, c, radius, t.len())?);
+                mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+            }
+            let count = mesh.triangles.len() as u32;
+            let vertex_count = mesh.positions.len() as u32;
+            mesh.groups.push(TriangleGroup {
+                start: 0,
+                count,
+                primitive: Some(0),
+                first_vertex: 0,
+                vertex_count,
+                material: None,
+            });
+            scene.meshes.push(mesh);
+            scene.nodes.push(Node {
+                name: "spheres".into(),
+                parent: None,
+                children: Vec::new(),
+                parent_from_local: DMat4::IDENTITY,
+                mesh: Some(MeshId(0)),
+            });
+            scene.roots.push(NodeId(0));
+            scene.instances.push(Instance {
+                name: "spheres".into(),
+                mesh: MeshId(0),
+                node: Some(NodeId(0)),
+                world_from_object: DMat4::IDENTITY,
+            });
+            let root: RootExtension = serde_json::from_value(serde_json::json!({
+                "version": drafter_format::FORMAT_VERSION,
+                "generator": drafter_format::GENERATOR,
+                "input": { "name": "spheres", "format": "gltf", "sha256": "" },
+                "sceneCenter": [0.0, 0.0, 0.0],
+                "partCount": n
+            }))?;
+            let baked = BakedFile {
+                root,
+                nodes: vec![(0, NodeExtension { parts: records })],
+                primitive_labels: vec![(0, 0, labels)],
+            };
+            Model::from_scene(&scene, Some(&baked)).ok_or_else(|| anyhow::anyhow!("empty synthetic scene"))
+        } else {
+            for (i, &c) in centers.iter().enumerate() {
+                let (positions, normals, t) = sphere(Vec3::ZERO, radius, per);
+                let count = t.len() as u32;
+                let vertex_count = positions.len() as u32;
+                scene.meshes.push(Mesh {
+                    name: format!("sphere_{i}"),
+                    positions,
+                    normals: Some(normals),
+                    triangles: t,
+                    uvs: None,
+                    groups: vec![TriangleGroup {
+                        start: 0,
+                        count,
+                        primitive: Some(0),
+                        first_vertex: 0,
+                        vertex_count,
+                        material: None,
+                    }],
+                });
+                scene.instances.push(Instance {
+                    name: format!("sphere_{i}"),
+                    mesh: MeshId(i as u32),
+                    node: None,
+                    world_from_object: DMat4::from_translation(c.as_dvec3()),
+                });
+            }
+            Model::from_scene(&scene, None).ok_or_else(|| anyhow::anyhow!("empty synthetic scene"))
+        }
+    }
 }

@@ -1,11 +1,14 @@
 //! Display pass (Lux et al. 2013, §5 "Display Pass"; Algorithm 1, line 13): one full-screen draw that
-//! composites the G-buffer colour with the enhancement (black outlines, crease lines, depth
-//! darkening), the coloured drop shadow on the background, and the selection highlight.
+//! detects the image-space edges (see [`crate::passes::enhance`] for the tests and why they run
+//! here), darkens recesses by the depth unsharp mask, composites the G-buffer colour with black
+//! outlines and crease lines, puts the coloured drop shadow on the background, and tints the
+//! selected part.
 //!
 //! Colours are display values end to end (no sRGB conversion): the output is written to an
 //! `Rgba8Unorm` texture (or a non-sRGB window surface) and saved as is.
 
 use crate::gpu_types::{DISPLAY_CREASES, DISPLAY_OUTLINES, DISPLAY_SHADOW, DISPLAY_UNSHARP, DisplayUniforms};
+use crate::passes::enhance::{CREASE_ANGLE_DEG, DEPTH_EDGE_THRESHOLD, UNSHARP_STRENGTH};
 use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
 use crate::style::{RenderOptions, ShadowMode, Style};
 use crate::targets::Targets;
@@ -21,8 +24,9 @@ pub const CREASE_DARK: [f32; 4] = [0.1, 0.1, 0.1, 0.6];
 /// Selection tint (orange, 45 %).
 pub const HIGHLIGHT_COLOR: [f32; 4] = [1.0, 0.55, 0.1, 0.45];
 
-/// The display uniforms of `options`.
-pub fn uniforms(options: &RenderOptions) -> DisplayUniforms {
+/// The display uniforms of `options`, for a scene of `scene_radius` (view units) seen through an
+/// orthographic camera or not.
+pub fn uniforms(options: &RenderOptions, scene_radius: f32, orthographic: bool) -> DisplayUniforms {
     let e = options.enhancements;
     let mut flags = 0;
     if e.outlines {
@@ -47,6 +51,13 @@ pub fn uniforms(options: &RenderOptions) -> DisplayUniforms {
         selected: options.selected_part.map_or(0, |p| p.saturating_add(1)),
         flags,
         _pad: [0; 2],
+        depth_threshold: DEPTH_EDGE_THRESHOLD,
+        crease_cos: CREASE_ANGLE_DEG.to_radians().cos(),
+        line_radius: options.supersample.max(1) as f32,
+        unsharp_strength: UNSHARP_STRENGTH,
+        ortho: if orthographic { 1.0 } else { 0.0 },
+        scene_radius: scene_radius.max(1e-12),
+        _pad2: [0.0; 2],
     }
 }
 
@@ -55,6 +66,7 @@ pub struct DisplayPass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
     uniforms: wgpu::Buffer,
+    sampler: wgpu::Sampler,
 }
 
 impl DisplayPass {
@@ -69,6 +81,14 @@ impl DisplayPass {
                 texture_entry(2, UINT),
                 texture_entry(3, FLOAT),
                 texture_entry(4, FLOAT),
+                texture_entry(5, FLOAT),
+                texture_entry(6, wgpu::TextureSampleType::Float { filterable: true }),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -84,7 +104,13 @@ impl DisplayPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        DisplayPass { layout, pipeline, uniforms }
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("display linear sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        DisplayPass { layout, pipeline, uniforms, sampler }
     }
 
     pub fn bind_group(&self, device: &wgpu::Device, targets: &Targets) -> wgpu::BindGroup {
@@ -98,8 +124,11 @@ impl DisplayPass {
                 wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
                 view(1, &targets.color.view),
                 view(2, &targets.part_id.view),
-                view(3, &targets.enhance.view),
-                view(4, &targets.shadow_mask.view),
+                view(3, &targets.normal.view),
+                view(4, &targets.linear_depth.view),
+                view(5, &targets.blur_b.view),
+                view(6, &targets.shadow_mask.view),
+                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         })
     }

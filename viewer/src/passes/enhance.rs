@@ -3,18 +3,24 @@
 //! unsharp mask of the depth buffer for depth cues (Luft, Colditz, Deussen 2006).
 //!
 //! # How it works
-//! Three full-screen draws over the G-buffer:
-//! 1. `fs_blur` horizontally, then 2. vertically: a separable Gaussian of the linear depth
-//!    (σ = [`BLUR_SIGMA_FRACTION`] of the image height, every second tap), background pixels filled
-//!    with a depth just beyond the model;
-//! 3. `fs_edges` writes, per pixel: **outline** (part id differs from a neighbour — drawn on the
-//!    nearer side; against the background on both sides, hence heavier, as Gooch et al. draw
-//!    outer lines; plus depth jumps inside a part, found by the second difference of the depth in
-//!    the quantity that is affine on planes, 1/z or z), **crease** (the normal turns by more than
-//!    [`CREASE_ANGLE_DEG`] to the next pixel of the same part) and **darkening** (`−ΔD` where the
-//!    unsharp mask `ΔD = G∗D − D` is negative, i.e. the pixel lies behind its surroundings).
+//! * **Unsharp mask** (this module): `ΔD = G∗D − D`, with `G∗D` a Gaussian of the linear depth
+//!   (σ = [`BLUR_SIGMA_FRACTION`] of the image height), computed at quarter resolution by two
+//!   full-screen draws of `fs_blur` (horizontal, reading every fourth depth texel with background
+//!   pixels set just beyond the model, then vertical). Where `ΔD < 0` the pixel lies behind its
+//!   surroundings and the display pass darkens it in proportion ([`UNSHARP_STRENGTH`]).
+//! * **Edges** are detected where they are drawn, in the display pass (`display.wgsl`), from the
+//!   G-buffer: an **outline** where the part id differs from a neighbour (on the nearer side;
+//!   against the background on both sides, hence heavier, as Gooch et al. draw outer lines) or the
+//!   depth jumps inside a part (second difference of the depth in the quantity that is affine on
+//!   planes, 1/z or z, above [`DEPTH_EDGE_THRESHOLD`]); a **crease** where the normal turns by more
+//!   than [`CREASE_ANGLE_DEG`] to the next pixel of the same part.
 //!
-//! The display pass turns these into black outlines, crease lines and darker recesses.
+//! Why edges are not a pass of their own, as in Lux et al.: measured on lavapipe (the CPU Vulkan
+//! device of CI and headless use) at 1600×1200, a full-screen pass costs about half a Phong frame
+//! whatever its shader does. With a separate edge pass (and a half-resolution blur) gradient +
+//! edges took 2.7× the Phong frame (`drafter bench render`); with the edges computed in the
+//! display pass, which reads the same texels anyway, and the blur at quarter resolution, 1.4–1.5×.
+//! On a GPU either layout costs well under a millisecond.
 //!
 //! # Limits
 //! Image-space lines are as wide as [`crate::RenderOptions::supersample`] pixels (before
@@ -23,7 +29,7 @@
 
 use crate::gpu_types::EnhanceUniforms;
 use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
-use crate::targets::{BLUR_FORMAT, ENHANCE_FORMAT, Targets};
+use crate::targets::{BLUR_FORMAT, BLUR_REDUCTION, Targets};
 
 pub const LABEL: &str = "enhance";
 
@@ -36,26 +42,20 @@ pub const BLUR_SIGMA_FRACTION: f32 = 0.012;
 /// Scale of the darkening per unit of `−ΔD / scene radius`.
 pub const UNSHARP_STRENGTH: f32 = 6.0;
 
-/// What the edge pass needs to know about the camera and scene.
+/// What the blur needs to know about the frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnhanceSetup {
     /// Target height in pixels.
     pub height: u32,
-    /// Pixels per output pixel (the supersampling factor): the line radius.
-    pub pixel_scale: f32,
     /// A depth beyond every model point (view units).
     pub far_depth: f32,
-    /// Scene radius (view units).
-    pub scene_radius: f32,
-    pub orthographic: bool,
 }
 
 #[derive(Debug)]
 pub struct EnhancePass {
     layout: wgpu::BindGroupLayout,
     blur: wgpu::RenderPipeline,
-    edges: wgpu::RenderPipeline,
-    uniforms: [wgpu::Buffer; 3],
+    uniforms: [wgpu::Buffer; 2],
 }
 
 /// Bind groups of one set of targets.
@@ -63,7 +63,6 @@ pub struct EnhancePass {
 pub struct EnhanceBindings {
     blur_h: wgpu::BindGroup,
     blur_v: wgpu::BindGroup,
-    edges: wgpu::BindGroup,
 }
 
 impl EnhancePass {
@@ -75,8 +74,6 @@ impl EnhancePass {
                 uniform_entry(0, wgpu::ShaderStages::FRAGMENT, false),
                 texture_entry(1, FLOAT),
                 texture_entry(2, UINT),
-                texture_entry(3, FLOAT),
-                texture_entry(4, FLOAT),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -93,15 +90,6 @@ impl EnhancePass {
             BLUR_FORMAT,
             None,
         );
-        let edges = fullscreen_pipeline(
-            device,
-            "enhance edges pipeline",
-            &pipeline_layout,
-            &module,
-            "fs_edges",
-            ENHANCE_FORMAT,
-            None,
-        );
         let uniform = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -110,13 +98,12 @@ impl EnhancePass {
                 mapped_at_creation: false,
             })
         };
-        let uniforms =
-            [uniform("enhance blur h uniforms"), uniform("enhance blur v uniforms"), uniform("enhance edges uniforms")];
-        EnhancePass { layout, blur, edges, uniforms }
+        let uniforms = [uniform("enhance blur h uniforms"), uniform("enhance blur v uniforms")];
+        EnhancePass { layout, blur, uniforms }
     }
 
     pub fn bindings(&self, device: &wgpu::Device, targets: &Targets) -> EnhanceBindings {
-        let group = |label, uniforms: &wgpu::Buffer, depth: &wgpu::TextureView, blurred: &wgpu::TextureView| {
+        let group = |label, uniforms: &wgpu::Buffer, depth: &wgpu::TextureView| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
                 layout: &self.layout,
@@ -127,65 +114,39 @@ impl EnhancePass {
                         binding: 2,
                         resource: wgpu::BindingResource::TextureView(&targets.part_id.view),
                     },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&targets.normal.view),
-                    },
-                    wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(blurred) },
                 ],
             })
         };
         EnhanceBindings {
-            // Binding 4 is unused by the blur; any texture the draw does not write will do.
-            blur_h: group(
-                "enhance blur h bind group",
-                &self.uniforms[0],
-                &targets.linear_depth.view,
-                &targets.blur_b.view,
-            ),
-            blur_v: group(
-                "enhance blur v bind group",
-                &self.uniforms[1],
-                &targets.blur_a.view,
-                &targets.linear_depth.view,
-            ),
-            edges: group(
-                "enhance edges bind group",
-                &self.uniforms[2],
-                &targets.linear_depth.view,
-                &targets.blur_b.view,
-            ),
+            blur_h: group("enhance blur h bind group", &self.uniforms[0], &targets.linear_depth.view),
+            blur_v: group("enhance blur v bind group", &self.uniforms[1], &targets.blur_a.view),
         }
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, setup: &EnhanceSetup) {
-        let sigma = (BLUR_SIGMA_FRACTION * setup.height as f32).max(1.0);
-        let base = EnhanceUniforms {
-            blur: [0.0, 0.0, sigma, (3.0 * sigma).ceil()],
+        // In blur texels.
+        let sigma = (BLUR_SIGMA_FRACTION * setup.height as f32 / BLUR_REDUCTION as f32).max(1.0);
+        let radius = (3.0 * sigma).ceil();
+        let h = EnhanceUniforms {
+            blur: [1.0, 0.0, sigma, radius],
             far_depth: setup.far_depth,
-            depth_threshold: DEPTH_EDGE_THRESHOLD,
-            crease_cos: CREASE_ANGLE_DEG.to_radians().cos(),
-            line_radius: setup.pixel_scale.max(1.0),
-            unsharp_strength: UNSHARP_STRENGTH,
-            ortho: if setup.orthographic { 1.0 } else { 0.0 },
-            scene_radius: setup.scene_radius.max(1e-12),
-            background_fill: 0.0,
+            background_fill: 1.0,
+            source_step: BLUR_REDUCTION as f32,
+            _pad: 0.0,
         };
-        let h = EnhanceUniforms { blur: [1.0, 0.0, base.blur[2], base.blur[3]], background_fill: 1.0, ..base };
-        let v = EnhanceUniforms { blur: [0.0, 1.0, base.blur[2], base.blur[3]], ..base };
+        let v = EnhanceUniforms { blur: [0.0, 1.0, sigma, radius], background_fill: 0.0, source_step: 1.0, ..h };
         queue.write_buffer(&self.uniforms[0], 0, bytemuck::bytes_of(&h));
         queue.write_buffer(&self.uniforms[1], 0, bytemuck::bytes_of(&v));
-        queue.write_buffer(&self.uniforms[2], 0, bytemuck::bytes_of(&base));
     }
 
+    /// Blurs the linear depth into `targets.blur_b` (via `blur_a`).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets, bindings: &EnhanceBindings) {
         encoder.push_debug_group(LABEL);
         let draws = [
-            ("enhance blur h pass", &self.blur, &bindings.blur_h, &targets.blur_a.view),
-            ("enhance blur v pass", &self.blur, &bindings.blur_v, &targets.blur_b.view),
-            ("enhance edges pass", &self.edges, &bindings.edges, &targets.enhance.view),
+            ("enhance blur h pass", &bindings.blur_h, &targets.blur_a.view),
+            ("enhance blur v pass", &bindings.blur_v, &targets.blur_b.view),
         ];
-        for (label, pipeline, group, view) in draws {
+        for (label, group, view) in draws {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(label),
                 color_attachments: &[color_attachment(view, Some(wgpu::Color::TRANSPARENT))],
@@ -194,7 +155,7 @@ impl EnhancePass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(pipeline);
+            pass.set_pipeline(&self.blur);
             pass.set_bind_group(0, group, &[]);
             pass.draw(0..3, 0..1);
         }

@@ -58,7 +58,7 @@ const NO_STYLE: u32 = 0xffffffffu;
 const FLAG_CEL_SPECULAR: u32 = 1u;
 const FLAG_SPLASH_BACK: u32 = 2u;
 
-const TRANSFER_TEXELS: u32 = 128u;
+const TRANSFER_TEXELS: u32 = 128u; // drafter_core::gradient::INTENSITY_TABLE_LEN
 const PI: f32 = 3.14159265358979;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -108,7 +108,7 @@ struct GBufferOut {
     @location(3) part: u32,
 }
 
-// ω(i, q, f, p) of Lux et al. 2013, Listing 1, exactly as drafter-bounds' `omega` (gradient.rs):
+// ω(i, q, f, p) of Lux et al. 2013, Listing 1, exactly as drafter-core's `gradient::omega`:
 // the band and the position inside it both come from one product t = i^p · q.
 fn omega(i_in: f32, q_in: f32, f_in: f32, p_in: f32) -> f32 {
     let i = clamp(i_in, 0.0, 1.0);

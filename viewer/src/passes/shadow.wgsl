@@ -1,19 +1,7 @@
-// Shadow pass: the model flattened onto the ground plane from a point light, one layer per draw
-// set (hard: 1, umbra + penumbra: 2, soft: a stack of planes). Keep the structs in sync with
-// gpu_types.rs (Frame, Instance and ShadowLayer).
-
-struct Frame {
-    clip_from_render: mat4x4<f32>,
-    view_from_render: mat4x4<f32>,
-    camera_position: vec4<f32>,
-    light_in_view: vec4<f32>,
-    viewport: vec4<f32>,
-    scene_style: u32,
-    use_part_styles: u32,
-    cel_steps: u32,
-    flags: u32,
-    style_params: vec4<f32>,
-}
+// Shadow pass: the model flattened onto the ground from a point light. Screen-space layers (hard:
+// 1, umbra + penumbra: 2) accumulate into the mask directly; the soft shadow renders one layer
+// into a top-down ground map and resolves the stack of planes from it (fs_resolve).
+// Keep the structs in sync with gpu_types.rs (Instance, ShadowLayer, Resolve).
 
 struct Instance {
     render_from_object: mat4x4<f32>,
@@ -27,12 +15,20 @@ struct Instance {
 }
 
 struct ShadowLayer {
+    clip_from_render: mat4x4<f32>,
     light_position: vec4<f32>,
     plane: vec4<f32>, // x: projection plane height, y: ground height, z: weight
 }
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> instances: array<Instance>;
+struct Resolve {
+    render_from_clip: mat4x4<f32>,
+    map_rect: vec4<f32>, // min x, min z, width, depth
+    foot_ground_count: vec4<f32>, // foot x, foot z, ground y, planes
+    target_size: vec4<f32>, // mask width, height
+    inverse_scales: array<vec4<f32>, 4>,
+}
+
+@group(0) @binding(0) var<storage, read> instances: array<Instance>;
 @group(1) @binding(0) var<uniform> layer: ShadowLayer;
 
 struct VertexIn {
@@ -53,10 +49,53 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> @builti
     let t = (light.y - h) / drop;
     var q = light + (p - light) * t;
     q.y = layer.plane.y; // moved to the ground
-    return frame.clip_from_render * vec4<f32>(q, 1.0);
+    return layer.clip_from_render * vec4<f32>(q, 1.0);
 }
 
 @fragment
 fn fs_main() -> @location(0) vec4<f32> {
     return vec4<f32>(layer.plane.z, 0.0, 0.0, 0.0);
+}
+
+// The resolve's own group (2), apart from the layer draws' groups 0 and 1.
+@group(2) @binding(0) var<uniform> resolve: Resolve;
+@group(2) @binding(1) var ground_map: texture_2d<f32>;
+@group(2) @binding(2) var map_sampler: sampler;
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The soft shadow at a mask pixel: the camera ray meets the ground at x; the shadow of plane k,
+// moved to the ground, is the ground shadow scaled by s_k about the light's foot point f, so its
+// value at x is the map at f + (x − f) / s_k. The planes are averaged.
+@fragment
+fn fs_resolve(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let uv = frag.xy / resolve.target_size.xy;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let a4 = resolve.render_from_clip * vec4<f32>(ndc, 0.0, 1.0);
+    let b4 = resolve.render_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    let a = a4.xyz / a4.w;
+    let b = b4.xyz / b4.w;
+    let ground = resolve.foot_ground_count.z;
+    let dy = b.y - a.y;
+    let t = (ground - a.y) / select(dy, 1e-30, abs(dy) < 1e-30);
+    if t < 0.0 || abs(dy) < 1e-30 {
+        return vec4<f32>(0.0);
+    }
+    let x = (a + (b - a) * t).xz;
+    let foot = resolve.foot_ground_count.xy;
+    let n = u32(resolve.foot_ground_count.w);
+    var sum = 0.0;
+    for (var k = 0u; k < n; k = k + 1u) {
+        let s = resolve.inverse_scales[k / 4u][k % 4u];
+        let g = foot + (x - foot) * s;
+        let map_uv = (g - resolve.map_rect.xy) / resolve.map_rect.zw;
+        if all(map_uv >= vec2<f32>(0.0)) && all(map_uv <= vec2<f32>(1.0)) {
+            sum = sum + textureSampleLevel(ground_map, map_sampler, map_uv, 0.0).r;
+        }
+    }
+    return vec4<f32>(sum / f32(max(n, 1u)), 0.0, 0.0, 0.0);
 }
