@@ -25,8 +25,11 @@ enum Command {
     Inspect(cmd::inspect::Args),
     /// Render a model headless to PNG in an illustration style (gradient, cel, gooch, metal, ...).
     Render(cmd::render::Args),
-    /// Measure: `bench render FILE` prints frame time per style as a ratio to phong.
+    /// Measure: `bench FILE` charts every stage's speed against accuracy; `bench render FILE` prints
+    /// frame time per style as a ratio to phong.
     Bench(cmd::bench::Args),
+    /// Show a model in a window: turn, zoom, pan, switch styles, pick parts, take screenshots.
+    View(cmd::view::Args),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => cmd::inspect::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::View(args) => cmd::view::run(args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

@@ -301,3 +301,162 @@ fn edge_visibility_decodes_and_recounts() {
         assert!(decoded > 0, "{}: no primitive carried edge visibility", input.display());
     }
 }
+
+/// Bakes `input` with the extra args into `dir/name.glb`, textures into `dir/name/`; returns the
+/// file's bytes and the report.
+fn bake_with_textures(input: &Path, dir: &Path, name: &str, extra: &[&str]) -> (Vec<u8>, Value) {
+    let output = dir.join(format!("{name}.glb"));
+    let report = dir.join(format!("{name}.json"));
+    let textures = dir.join(name);
+    let mut args =
+        vec!["--report", report.to_str().expect("utf-8"), "--textures-out", textures.to_str().expect("utf-8")];
+    args.extend_from_slice(extra);
+    bake(input, &output, &args);
+    let report: Value = serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("report json");
+    (std::fs::read(&output).expect("baked"), report)
+}
+
+/// Image names of the textures record, in record order.
+fn texture_names(glb: &[u8]) -> Vec<String> {
+    drafter_format::read_textures(glb, &|_| None).expect("reads textures").into_iter().map(|t| t.name).collect()
+}
+
+/// The embedded PNGs are exactly the files of `--textures-out` and the report's list; only what the
+/// scene uses is embedded: metal textures for a scene with metallic materials (listing its metal
+/// parts), none for one without, and again when a part is marked metal in the config.
+#[test]
+fn textures_are_embedded_only_as_the_scene_needs() {
+    let dir = common::scratch("bake-textures");
+    let (glb, report) = bake_with_textures(&repo().join("samples/assembly.glb"), &dir, "assembly", &[]);
+    let baked = drafter_format::read(&glb, &|_| None).expect("reads");
+    let record = baked.root.textures.clone().expect("a textures record");
+    let pngs = drafter_format::read_textures(&glb, &|_| None).expect("reads textures");
+    let names: Vec<&str> = pngs.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "gamma_atlas",
+            "cel_atlas",
+            "cool_to_warm_0",
+            "hatching",
+            "hatching_mip1",
+            "hatching_mip2",
+            "hatching_mip3",
+            "metal_bands",
+            "metal_highlights"
+        ]
+    );
+    // The sample's steel and brass parts (metallicFactor 1) are metal, the painted ones are not.
+    let metal = record.metal.as_ref().expect("metal textures");
+    assert!(!metal.parts.is_empty());
+    let doc: Value = serde_json::from_slice(drafter_format::split_container(&glb).expect("glb").0).expect("json");
+    let parts = baked.parts();
+    for p in &parts {
+        let node = doc["nodes"]
+            .as_array()
+            .expect("nodes")
+            .iter()
+            .find(|n| {
+                n["extensions"][drafter_format::EXTENSION]["parts"]
+                    .as_array()
+                    .is_some_and(|a| a.iter().any(|q| q["id"] == p.id))
+            })
+            .expect("the part's node");
+        let material = doc["meshes"][node["mesh"].as_u64().expect("mesh") as usize]["primitives"][0]["material"]
+            .as_u64()
+            .expect("material");
+        let metallic =
+            doc["materials"][material as usize]["pbrMetallicRoughness"]["metallicFactor"].as_f64().unwrap_or(1.0);
+        assert_eq!(metal.parts.contains(&p.id), metallic >= 0.5, "part {} ({})", p.id, p.name);
+    }
+    assert_eq!(record.gradient.as_ref().expect("gradient").curves, ["identity"]);
+    assert_eq!(record.hatching.as_ref().expect("hatching").levels.len(), 4);
+    // Record, report and files agree byte for byte.
+    let listed = report["textures"]["images"].as_array().expect("report lists textures");
+    assert_eq!(listed.len(), pngs.len());
+    let mut total = 0;
+    for png in &pngs {
+        let file = std::fs::read(dir.join("assembly").join(format!("{}.png", png.name))).expect("texture file");
+        assert!(file == png.png, "{} differs from the embedded image", png.name);
+        let entry = listed.iter().find(|e| e["name"] == png.name.as_str()).expect("listed in the report");
+        assert_eq!(entry["bytes"].as_u64(), Some(png.png.len() as u64));
+        total += png.png.len();
+        assert!(png.png.starts_with(b"\x89PNG\r\n\x1a\n"));
+    }
+    assert_eq!(report["textures"]["total_bytes"].as_u64(), Some(total as u64));
+    assert_eq!(std::fs::read_dir(dir.join("assembly")).expect("dir").count(), pngs.len());
+
+    // No metallic material: no metal textures.
+    let bracket = repo().join("samples/bracket.glb");
+    let (plain, plain_report) = bake_with_textures(&bracket, &dir, "bracket", &[]);
+    let plain_names = texture_names(&plain);
+    assert!(!plain_names.iter().any(|n| n.starts_with("metal")), "{plain_names:?}");
+    assert_eq!(plain_names.len(), 7);
+    assert!(drafter_format::read(&plain, &|_| None).expect("reads").root.textures.expect("record").metal.is_none());
+    assert_eq!(plain_report["textures"]["metal_parts"], serde_json::json!([]));
+    // The same part marked metal in the config: metal textures, listing it.
+    let config = dir.join("metal.toml");
+    std::fs::write(&config, "[[part]]\nid = 0\nstyle = \"metal\"\n").expect("config");
+    let (marked, _) = bake_with_textures(&bracket, &dir, "marked", &["--config", config.to_str().expect("utf-8")]);
+    assert_eq!(texture_names(&marked)[7..], ["metal_bands", "metal_highlights"]);
+    let marked_record = drafter_format::read(&marked, &|_| None).expect("reads").root.textures.expect("record");
+    assert_eq!(marked_record.metal.expect("metal").parts, [0]);
+    // A threshold above 1 turns detection from materials off; only the configured styles remain.
+    std::fs::write(&config, "[textures]\nstyles = [\"gradient\"]\nmetallic_threshold = 1.5\n").expect("config");
+    let (only_gamma, _) = bake_with_textures(
+        &repo().join("samples/assembly.glb"),
+        &dir,
+        "gamma",
+        &["--config", config.to_str().expect("utf-8")],
+    );
+    assert_eq!(texture_names(&only_gamma), ["gamma_atlas"]);
+
+    for name in ["assembly", "bracket", "marked", "gamma"] {
+        check_schema(&dir.join(format!("{name}.glb")));
+    }
+    khronos_validate(&["assembly", "bracket", "marked", "gamma"].map(|n| dir.join(format!("{n}.glb"))));
+}
+
+/// Textures add exactly their PNG bytes (each padded to 4) to the binary chunk, and the output with
+/// them is byte-identical across runs and thread counts, as are the PNG files.
+#[test]
+fn textures_add_exactly_their_bytes_and_are_deterministic() {
+    let dir = common::scratch("bake-texture-bytes");
+    let input = repo().join("samples/assembly.glb");
+    let off = dir.join("off.toml");
+    std::fs::write(&off, "[textures]\nenabled = false\n").expect("config");
+    let (without, report_without) =
+        bake_with_textures(&input, &dir, "without", &["--config", off.to_str().expect("utf-8")]);
+    assert!(report_without.get("textures").is_none());
+    assert!(drafter_format::read(&without, &|_| None).expect("reads").root.textures.is_none());
+    let (with, _) = bake_with_textures(&input, &dir, "with", &["--threads", "1"]);
+    let pngs = drafter_format::read_textures(&with, &|_| None).expect("reads textures");
+    let padded: usize = pngs.iter().map(|p| p.png.len().next_multiple_of(4)).sum();
+    let bin = |glb: &[u8]| drafter_format::split_container(glb).expect("glb").1.expect("bin").len();
+    let json = |glb: &[u8]| drafter_format::split_container(glb).expect("glb").0.len();
+    assert_eq!(bin(&with) - bin(&without), padded);
+    assert_eq!(with.len() - without.len(), padded + json(&with) - json(&without));
+    eprintln!(
+        "assembly: {} B without textures, {} B with ({} B of PNG, {} B of JSON)",
+        without.len(),
+        with.len(),
+        padded,
+        json(&with) - json(&without)
+    );
+
+    // `--json` prints the same report, textures listed, on stdout.
+    let printed = bake(&input, &dir.join("json.glb"), &["--json"]);
+    let printed: Value = serde_json::from_slice(&printed.stdout).expect("--json prints the report");
+    let total: usize = pngs.iter().map(|p| p.png.len()).sum();
+    assert_eq!(printed["textures"]["total_bytes"].as_u64(), Some(total as u64));
+    assert_eq!(printed["textures"]["images"].as_array().map(Vec::len), Some(pngs.len()));
+
+    let (again, _) = bake_with_textures(&input, &dir, "again", &["--threads", "2"]);
+    let (default_threads, _) = bake_with_textures(&input, &dir, "default", &[]);
+    assert!(with == again, "textured output differs between 1 and 2 threads");
+    assert!(with == default_threads, "textured output differs between runs");
+    for png in &pngs {
+        let file = |d: &str| std::fs::read(dir.join(d).join(format!("{}.png", png.name))).expect("png");
+        assert!(file("with") == file("again") && file("with") == file("default"), "{} differs", png.name);
+    }
+}

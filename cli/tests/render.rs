@@ -77,6 +77,38 @@ fn unbaked_mesh_renders_with_a_notice() {
 }
 
 #[test]
+fn enhanced_normals_flag_toggles_and_falls_back_with_a_notice() {
+    let dir = common::scratch("render_enhanced_normals");
+    let baked = bake_sample(&dir);
+    let mut images = Vec::new();
+    for flag in [None, Some("--enhanced-normals")] {
+        let png = dir.join(format!("phong{}.png", flag.unwrap_or("")));
+        let mut args = vec![baked.to_str().expect("utf-8"), "-o", png.to_str().expect("utf-8")];
+        args.extend(["--style", "phong", "--size", "160x120", "--supersample", "1"]);
+        args.extend(flag);
+        let out = render(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("no enhanced normals"));
+        images.push(read_png(&png));
+    }
+    let changed = images[0].rgba.chunks_exact(4).zip(images[1].rgba.chunks_exact(4)).filter(|(a, b)| a != b).count();
+    assert!(changed > 160 * 120 / 100, "the flag changed only {changed} pixels");
+
+    // No enhanced normals in an unbaked file: one notice, and the image of its own normals.
+    let model = common::shared_models().join("obj/cgal/pinion.off");
+    let (plain, toggled) = (dir.join("pinion.png"), dir.join("pinion-enhanced.png"));
+    for (png, flag) in [(&plain, None), (&toggled, Some("--enhanced-normals"))] {
+        let mut args = vec![model.to_str().expect("utf-8"), "-o", png.to_str().expect("utf-8"), "--size", "120x90"];
+        args.extend(flag);
+        let out = render(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let notices = String::from_utf8_lossy(&out.stderr).matches("no enhanced normals").count();
+        assert_eq!(notices, usize::from(flag.is_some()));
+    }
+    assert_eq!(read_png(&plain).rgba, read_png(&toggled).rgba);
+}
+
+#[test]
 fn bad_input_exits_2_with_one_line() {
     let dir = common::scratch("render_bad");
     let garbage = dir.join("garbage.glb");

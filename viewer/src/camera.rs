@@ -95,6 +95,14 @@ impl Camera {
         Camera { view_from_render, clip_from_view, position_in_render, orthographic, near, far }
     }
 
+    /// The same camera with the image magnified by `zoom` about the frame's centre, then shifted by
+    /// `pan` in normalised device units (a zoom lens and a lens shift: the eye does not move).
+    pub fn zoomed(mut self, zoom: f32, pan: [f32; 2]) -> Camera {
+        let shift = Mat4::from_translation(Vec3::new(pan[0], pan[1], 0.0));
+        self.clip_from_view = shift * Mat4::from_scale(Vec3::new(zoom, zoom, 1.0)) * self.clip_from_view;
+        self
+    }
+
     pub fn clip_from_render(&self) -> Mat4 {
         self.clip_from_view * self.view_from_render
     }

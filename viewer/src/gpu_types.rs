@@ -1,7 +1,7 @@
 //! Every struct the shaders read, laid out for WGSL (`#[repr(C)]`, 16-byte aligned members).
 //!
 //! Keep in sync with the declarations of the same names in `passes/gbuffer.wgsl`,
-//! `passes/shadow.wgsl`, `passes/enhance.wgsl` and `passes/display.wgsl`; the size assertions at the
+//! `passes/shadow.wgsl`, `passes/enhance.wgsl`, `passes/display.wgsl` and `passes/lines.wgsl`; the size assertions at the
 //! bottom catch a field added on one side only.
 
 use bytemuck::{Pod, Zeroable};
@@ -188,6 +188,42 @@ pub const DISPLAY_UNSHARP: u32 = 4;
 /// `DisplayUniforms::flags` bit: composite the drop shadow.
 pub const DISPLAY_SHADOW: u32 = 8;
 
+/// One line of the lines pass (`lines.wgsl`: `Segment`), in a storage buffer indexed by
+/// `instance_index`: an edge in its mesh's object space, the model instance that places it, and its
+/// [`crate::edges::LineClass`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LineSegmentGpu {
+    pub a_in_object: [f32; 3],
+    /// Index into the scene's instance buffer.
+    pub instance: u32,
+    pub b_in_object: [f32; 3],
+    pub class: u32,
+}
+
+impl LineSegmentGpu {
+    pub fn new(a: glam::Vec3, b: glam::Vec3, instance: u32, class: crate::edges::LineClass) -> Self {
+        Self { a_in_object: a.to_array(), instance, b_in_object: b.to_array(), class: class as u32 }
+    }
+}
+
+/// Uniforms of the lines pass (`lines.wgsl`: `Lines`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LinesUniforms {
+    pub clip_from_view: [[f32; 4]; 4],
+    /// Colour of silhouettes, boundaries, part borders and non-manifold edges.
+    pub outline_color: [f32; 4],
+    /// Colour of creases (a: opacity).
+    pub crease_color: [f32; 4],
+    /// Half-widths in target pixels: outlines, creases, and the extra of the outer outline
+    /// (drawn only over the background); w: the camera's near plane (view units).
+    pub half_widths: [f32; 4],
+    /// Depth tolerance: relative to the line's view depth, and in pixel footprints; the pixel
+    /// footprint at view depth d is `x·d + y` (x for perspective, y for orthographic cameras).
+    pub depth_tolerance: [f32; 4],
+}
+
 const _: () = {
     assert!(size_of::<Vertex>() == 32);
     assert!(size_of::<InstanceGpu>() == 128);
@@ -198,4 +234,6 @@ const _: () = {
     assert!(size_of::<ShadowResolveGpu>() == 176);
     assert!(size_of::<EnhanceUniforms>() == 32);
     assert!(size_of::<DisplayUniforms>() == 128);
+    assert!(size_of::<LineSegmentGpu>() == 32);
+    assert!(size_of::<LinesUniforms>() == 128);
 };

@@ -12,9 +12,13 @@
 //! 3. [`passes::enhance`]: the depth unsharp mask's blur; the image-space edges (part-id, depth and
 //!    normal discontinuities) it specifies are detected in the display pass, which reads the same
 //!    texels (measured on lavapipe: a separate full-screen pass cost half a Phong frame).
-//! 4. [`passes::lines`]: the hook for baked edges (not drawn yet).
-//! 5. [`passes::display`]: edges, depth darkening, composite, background, coloured shadow,
+//! 4. [`passes::display`]: edges, depth darkening, composite, background, coloured shadow,
 //!    selection highlight.
+//! 5. [`passes::lines`]: the baked hard edges and this frame's silhouettes (queried per instance
+//!    from the baked hierarchies, [`edges`]) as screen-space quads over the display output.
+//!
+//! [`window`] runs the same frame in a winit window (`drafter view`); its input handling is pure
+//! functions ([`window::Orbit`], [`window::action_for_key`]) tested without a display.
 //!
 //! Frame times (`drafter bench render`, lavapipe, 1600×1200, ratio to Phong in the same run): every
 //! style 1.00–1.03×; edges 1.4×; soft shadow 1.1×; full illustration (gradient, edges, soft shadow)
@@ -37,6 +41,7 @@
 
 pub mod camera;
 pub mod context;
+pub mod edges;
 pub mod gpu_types;
 pub mod image;
 pub mod model;
@@ -45,6 +50,7 @@ pub mod renderer;
 pub mod scene;
 pub mod style;
 pub mod targets;
+pub mod window;
 
 pub use camera::Camera;
 pub use context::{Gpu, RenderError};

@@ -15,6 +15,13 @@
 //! the longest side of its world-space bounding box (facing away from the scene centre, as the
 //! bake's heuristic does) with the default gradient, and a notice says so.
 //!
+//! # Normals
+//! A baked file carries two normal sets per primitive: the crease-aware `NORMAL` and the enhanced
+//! normals of Cignoni et al. 2005 (`_ENHANCED_NORMAL`; swapped when the bake put the enhanced ones in
+//! `NORMAL`). Both are read ([`drafter_format::read_normal_sets`]) and split with the vertices, so a
+//! batch can be drawn with either ([`crate::RenderOptions::enhanced_normals`]); other files keep their
+//! imported normals.
+//!
 //! Positions are moved into *render space*, the world translated so that the centre of the
 //! scene's bounds is the origin: the transforms are composed in f64 and rounded once, so CAD
 //! coordinates far from the world origin keep their precision in f32.
@@ -25,7 +32,7 @@ use std::path::Path;
 
 use drafter_core::gradient::{DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZATION};
 use drafter_core::{Aabb, Diagnostic, Scene};
-use drafter_format::{BakedFile, FormatError, PartRecord};
+use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
 use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, PartGpu, Vertex};
@@ -54,6 +61,10 @@ pub struct Batch {
     pub name: String,
     pub vertices: Vec<Vertex>,
     pub indices: Vec<u32>,
+    /// The enhanced normals (Cignoni et al. 2005) of `vertices`, one each, when the file carries them
+    /// (`_ENHANCED_NORMAL`): what [`crate::RenderOptions::enhanced_normals`] draws instead of
+    /// `Vertex::normal_in_object`.
+    pub enhanced_normals: Option<Vec<[f32; 3]>>,
     /// Range of [`Model::instances`] that draws this batch.
     pub instances: Range<u32>,
 }
@@ -76,6 +87,13 @@ pub struct Model {
     pub batches: Vec<Batch>,
     /// Every instance, grouped by batch.
     pub instances: Vec<InstanceGpu>,
+    /// Per instance, the scene mesh it draws.
+    pub instance_mesh: Vec<u32>,
+    /// Per instance, its world transform in f64 (the silhouette query takes the eye into object
+    /// space with its inverse).
+    pub instance_world_from_object: Vec<DMat4>,
+    /// The baked edges the lines pass draws (empty for an unbaked file).
+    pub lines: crate::edges::ModelLines,
     /// Per instance, its part ids by label (see the module docs).
     pub label_to_part: Vec<u32>,
     /// Indexed by part id.
@@ -110,7 +128,11 @@ impl Model {
     pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Model, LoadError> {
         let imported = drafter_io::import_bytes(path, bytes)?;
         let baked = read_baked(path, bytes)?;
-        let mut model = Model::from_scene(&imported.scene, baked.as_ref())
+        let normal_sets = match &baked {
+            Some(_) => read_normal_sets(path, bytes)?,
+            None => Vec::new(),
+        };
+        let mut model = Model::from_scene_with_normals(&imported.scene, baked.as_ref(), &normal_sets)
             .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
         model.diagnostics = imported.diagnostics;
         Ok(model)
@@ -119,6 +141,17 @@ impl Model {
     /// Prepares `scene` with its baked data (`None` for an unbaked file). `None` when the scene
     /// draws no triangles.
     pub fn from_scene(scene: &Scene, baked: Option<&BakedFile>) -> Option<Model> {
+        Self::from_scene_with_normals(scene, baked, &[])
+    }
+
+    /// As [`Self::from_scene`], with the baked normal sets of the file's primitives
+    /// ([`drafter_format::read_normal_sets`]): the batches then carry both the crease-aware and the
+    /// enhanced normals, for the toggle.
+    pub fn from_scene_with_normals(
+        scene: &Scene,
+        baked: Option<&BakedFile>,
+        normal_sets: &[PrimitiveNormals],
+    ) -> Option<Model> {
         let bounds = scene.world_bounds();
         if bounds.is_empty() || scene.instanced_triangle_count() == 0 {
             return None;
@@ -134,6 +167,7 @@ impl Model {
         }
 
         let triangle_labels = mesh_labels(scene, baked, &mut notices);
+        let mesh_normals = mesh_normal_sets(scene, normal_sets, &mut notices);
         let node_parts: HashMap<u32, &[PartRecord]> = baked
             .map(|b| b.nodes.iter().map(|(node, ext)| (*node, ext.parts.as_slice())).collect())
             .unwrap_or_default();
@@ -142,6 +176,8 @@ impl Model {
         let mut parts: Vec<Option<Part>> = vec![None; baked_part_count as usize];
         let mut fallback_parts = Vec::new();
         let mut instances = Vec::new();
+        let mut instance_mesh = Vec::new();
+        let mut instance_world_from_object = Vec::new();
         let mut label_to_part = Vec::new();
         let mut batches = Vec::new();
         let mut fit_points = Vec::new();
@@ -201,6 +237,8 @@ impl Model {
                     }
                 }
                 instances.push(instance_gpu(&instance.world_from_object, origin, label_base, label_count));
+                instance_mesh.push(mesh_index as u32);
+                instance_world_from_object.push(instance.world_from_object);
                 let object = mesh.bounds();
                 if !object.is_empty() {
                     let render_from_object = DMat4::from_translation(-origin) * instance.world_from_object;
@@ -216,11 +254,13 @@ impl Model {
             }
             let last_instance = instances.len() as u32;
             if last_instance > first_instance && !mesh.triangles.is_empty() {
-                let (vertices, indices) = split_vertices(mesh, labels);
+                let (vertices, indices, enhanced_normals) =
+                    split_vertices_with(mesh, labels, mesh_normals[mesh_index].as_ref());
                 batches.push(Batch {
                     name: mesh.name.clone(),
                     vertices,
                     indices,
+                    enhanced_normals,
                     instances: first_instance..last_instance,
                 });
             }
@@ -263,9 +303,17 @@ impl Model {
             _pad: [0.0; 2],
         }));
 
+        let lines = baked
+            .map(|b| crate::edges::ModelLines::from_scene(scene, b, &instance_mesh, &instance_world_from_object))
+            .unwrap_or_default();
+        notices.extend(lines.notices.iter().cloned());
+
         Some(Model {
             batches,
             instances,
+            instance_mesh,
+            instance_world_from_object,
+            lines,
             label_to_part,
             parts,
             materials,
@@ -276,6 +324,11 @@ impl Model {
             notices,
             diagnostics: Vec::new(),
         })
+    }
+
+    /// Whether some batch carries enhanced normals (the file was baked with them).
+    pub fn has_enhanced_normals(&self) -> bool {
+        self.batches.iter().any(|b| b.enhanced_normals.is_some())
     }
 
     /// Triangles drawn (every instance counted).
@@ -311,6 +364,60 @@ fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedFile>, LoadError>
     }
 }
 
+/// Reads both normal sets of a baked glTF/GLB (see [`read_baked`] for the buffer resolution).
+fn read_normal_sets(path: &Path, bytes: &[u8]) -> Result<Vec<PrimitiveNormals>, LoadError> {
+    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+    drafter_format::read_normal_sets(bytes, &external)
+        .map_err(|source| LoadError::Baked { path: path.display().to_string(), source })
+}
+
+/// Both normal sets of a mesh, one entry per mesh vertex.
+#[derive(Clone, Debug)]
+struct MeshNormalSets {
+    normals: Vec<[f32; 3]>,
+    enhanced: Vec<[f32; 3]>,
+}
+
+/// Per mesh, its crease-aware and enhanced normals from the primitives' baked sets (a glTF primitive
+/// is the mesh's vertex range `first_vertex..first_vertex + vertex_count`); `None` for a mesh without
+/// any. Vertices of primitives without a set keep the imported normal in both.
+fn mesh_normal_sets(
+    scene: &Scene,
+    sets: &[PrimitiveNormals],
+    notices: &mut Vec<String>,
+) -> Vec<Option<MeshNormalSets>> {
+    let mut out: Vec<Option<MeshNormalSets>> = vec![None; scene.meshes.len()];
+    let mut mismatched = 0usize;
+    for set in sets {
+        let Some(mesh) = scene.meshes.get(set.mesh as usize) else {
+            mismatched += 1;
+            continue;
+        };
+        let group = mesh.groups.iter().find(|g| g.primitive == Some(set.primitive));
+        let Some(g) = group.filter(|g| g.vertex_count as usize == set.normals.len()) else {
+            mismatched += 1;
+            continue;
+        };
+        let slot = out[set.mesh as usize].get_or_insert_with(|| {
+            let imported: Vec<[f32; 3]> = match &mesh.normals {
+                Some(n) => n.iter().map(|n| n.to_array()).collect(),
+                None => vec![[0.0; 3]; mesh.positions.len()],
+            };
+            MeshNormalSets { normals: imported.clone(), enhanced: imported }
+        });
+        let range = g.first_vertex as usize..(g.first_vertex + g.vertex_count) as usize;
+        slot.normals[range.clone()].copy_from_slice(&set.normals);
+        slot.enhanced[range].copy_from_slice(&set.enhanced);
+    }
+    if mismatched > 0 {
+        notices.push(format!(
+            "{mismatched} primitives' enhanced normals do not match their vertices: imported normals used for them"
+        ));
+    }
+    out
+}
+
 /// Part label of every triangle of every mesh (0 where the file has none).
 fn mesh_labels(scene: &Scene, baked: Option<&BakedFile>, notices: &mut Vec<String>) -> Vec<Vec<u32>> {
     let mut labels: Vec<Vec<u32>> = scene.meshes.iter().map(|m| vec![0; m.triangles.len()]).collect();
@@ -338,7 +445,20 @@ fn mesh_labels(scene: &Scene, baked: Option<&BakedFile>, notices: &mut Vec<Strin
 
 /// Splits vertices shared by triangles of different labels or materials; returns the batch's
 /// vertices and indices (triangle order kept).
+#[cfg(test)]
 fn split_vertices(mesh: &drafter_core::Mesh, labels: &[u32]) -> (Vec<Vertex>, Vec<u32>) {
+    let (vertices, indices, _) = split_vertices_with(mesh, labels, None);
+    (vertices, indices)
+}
+
+/// As `split_vertices`, with the normals taken from `sets` when given; the third result is then the
+/// enhanced normal of every output vertex.
+fn split_vertices_with(
+    mesh: &drafter_core::Mesh,
+    labels: &[u32],
+    sets: Option<&MeshNormalSets>,
+) -> (Vec<Vertex>, Vec<u32>, Option<Vec<[f32; 3]>>) {
+    let mut enhanced = sets.map(|_| Vec::with_capacity(mesh.positions.len()));
     let mut material_of = vec![0u32; mesh.triangles.len()];
     for g in &mesh.groups {
         let m = g.material.map_or(0, |m| m.0 + 1);
@@ -355,8 +475,14 @@ fn split_vertices(mesh: &drafter_core::Mesh, labels: &[u32]) -> (Vec<Vertex>, Ve
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let (label, material) = (labels.get(t).copied().unwrap_or(0), material_of[t]);
         for &v in tri {
-            let make = |vertices: &mut Vec<Vertex>| {
-                let normal = mesh.normals.as_ref().map_or([0.0; 3], |n| n[v as usize].to_array());
+            let make = |vertices: &mut Vec<Vertex>, enhanced: &mut Option<Vec<[f32; 3]>>| {
+                let normal = match sets {
+                    Some(s) => s.normals[v as usize],
+                    None => mesh.normals.as_ref().map_or([0.0; 3], |n| n[v as usize].to_array()),
+                };
+                if let (Some(out), Some(s)) = (enhanced.as_mut(), sets) {
+                    out.push(s.enhanced[v as usize]);
+                }
                 vertices.push(Vertex {
                     position_in_object: mesh.positions[v as usize].to_array(),
                     normal_in_object: normal,
@@ -367,17 +493,17 @@ fn split_vertices(mesh: &drafter_core::Mesh, labels: &[u32]) -> (Vec<Vertex>, Ve
             };
             let index = match first[v as usize] {
                 None => {
-                    let i = make(&mut vertices);
+                    let i = make(&mut vertices, &mut enhanced);
                     first[v as usize] = Some((label, material, i));
                     i
                 }
                 Some((l, m, i)) if l == label && m == material => i,
-                Some(_) => *extra.entry((v, label, material)).or_insert_with(|| make(&mut vertices)),
+                Some(_) => *extra.entry((v, label, material)).or_insert_with(|| make(&mut vertices, &mut enhanced)),
             };
             indices.push(index);
         }
     }
-    (vertices, indices)
+    (vertices, indices, enhanced)
 }
 
 fn instance_gpu(world_from_object: &DMat4, origin: DVec3, label_base: u32, label_count: u32) -> InstanceGpu {

@@ -15,6 +15,7 @@ use crate::model::Model;
 use crate::passes::display::{self, DisplayPass};
 use crate::passes::enhance::{EnhanceBindings, EnhancePass, EnhanceSetup};
 use crate::passes::gbuffer::GBufferPass;
+use crate::passes::lines::{self, LinesPass, LinesScene};
 use crate::passes::shadow::{self, ShadowPass};
 use crate::scene::SceneGpu;
 use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
@@ -29,6 +30,9 @@ struct LoadedScene {
     max: Vec3,
     /// See [`Model::fit_points`].
     fit_points: Vec<Vec3>,
+    /// World position of the render-space origin.
+    origin: glam::DVec3,
+    lines: LinesScene,
 }
 
 /// Targets of one size with their bind groups.
@@ -37,6 +41,7 @@ struct FrameTargets {
     targets: Targets,
     enhance: EnhanceBindings,
     display: wgpu::BindGroup,
+    lines: wgpu::BindGroup,
 }
 
 /// What a recorded frame used.
@@ -56,6 +61,7 @@ pub struct Renderer {
     shadow: ShadowPass,
     enhance: EnhancePass,
     display: DisplayPass,
+    lines: LinesPass,
     scene: Option<LoadedScene>,
     targets: Option<FrameTargets>,
     last_frame: Option<FrameInfo>,
@@ -72,7 +78,7 @@ impl Renderer {
     /// A renderer on `gpu` whose display pass writes `output_format`.
     pub fn with_gpu(gpu: Gpu, output_format: wgpu::TextureFormat) -> Result<Renderer, RenderError> {
         let device = &gpu.device;
-        let (frame_uniforms, gbuffer, shadow, enhance, display) = scoped(device, || {
+        let (frame_uniforms, gbuffer, shadow, enhance, display, lines) = scoped(device, || {
             let frame_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: size_of::<FrameUniforms>() as u64,
@@ -85,6 +91,7 @@ impl Renderer {
                 ShadowPass::new(device),
                 EnhancePass::new(device),
                 DisplayPass::new(device, output_format),
+                LinesPass::new(device, output_format),
             )
         })?;
         Ok(Renderer {
@@ -94,6 +101,7 @@ impl Renderer {
             shadow,
             enhance,
             display,
+            lines,
             scene: None,
             targets: None,
             last_frame: None,
@@ -108,17 +116,34 @@ impl Renderer {
     /// Uploads `model`, replacing the previous one.
     pub fn set_model(&mut self, model: &Model) -> Result<(), RenderError> {
         let device = &self.gpu.device;
-        let gpu =
-            scoped(device, || SceneGpu::upload(device, model, &self.gbuffer, &self.shadow, &self.frame_uniforms))?;
+        let queue = &self.gpu.queue;
+        let (gpu, lines) = scoped(device, || {
+            let gpu = SceneGpu::upload(device, model, &self.gbuffer, &self.shadow, &self.frame_uniforms);
+            let lines =
+                self.lines.scene(device, queue, model.lines.clone(), &self.frame_uniforms, &gpu.buffers.instances);
+            (gpu, lines)
+        })?;
         let min = (model.bounds.min - model.origin).as_vec3();
         let max = (model.bounds.max - model.origin).as_vec3();
-        self.scene = Some(LoadedScene { gpu, min, max, fit_points: model.fit_points.clone() });
+        self.scene =
+            Some(LoadedScene { gpu, min, max, fit_points: model.fit_points.clone(), origin: model.origin, lines });
         Ok(())
     }
 
     /// The camera and size of the last frame recorded.
     pub fn last_frame(&self) -> Option<FrameInfo> {
         self.last_frame
+    }
+
+    /// The silhouettes the lines pass drew in the last frame with lines on: which edges (by
+    /// instance and corner), how many queries, and how long the CPU query took.
+    pub fn last_silhouettes(&self) -> Option<&crate::edges::SilhouetteFrame> {
+        self.scene.as_ref().and_then(|s| s.lines.last_silhouettes())
+    }
+
+    /// Hard-edge segments of the loaded model (edges × instances).
+    pub fn hard_edge_count(&self) -> u32 {
+        self.scene.as_ref().map_or(0, |s| s.lines.hard_count())
     }
 
     /// The G-buffer's part-id target of the last frame (the window reads it to pick parts).
@@ -129,7 +154,6 @@ impl Renderer {
     /// Fits the camera for `options` and writes every pass's uniforms.
     fn prepare(&mut self, options: &RenderOptions) -> Result<FrameInfo, RenderError> {
         options.validate().map_err(RenderError::Options)?;
-        let scene = self.scene.as_ref().ok_or(RenderError::NoModel)?;
         let size = options.target_size();
         if self.targets.as_ref().is_none_or(|t| t.targets.size != size) {
             let device = &self.gpu.device;
@@ -137,9 +161,11 @@ impl Renderer {
                 let targets = Targets::new(device, size);
                 let enhance = self.enhance.bindings(device, &targets);
                 let display = self.display.bind_group(device, &targets);
-                FrameTargets { targets, enhance, display }
+                let lines = self.lines.targets_bind_group(device, &targets);
+                FrameTargets { targets, enhance, display, lines }
             })?);
         }
+        let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
 
         let (min, max) = (scene.min, scene.max);
         let light_in_render = view_rotation(options.view).inverse().transform_vector3(LIGHT_IN_VIEW.normalize());
@@ -150,7 +176,8 @@ impl Renderer {
             fit_points.extend(scene.fit_points.iter().map(|&c| shadow::project(layer, c)));
         }
         let aspect = size.0 as f32 / size.1 as f32;
-        let camera = Camera::fit(&fit_points, options.view, aspect, options.orthographic, options.fov_y_deg);
+        let camera = Camera::fit(&fit_points, options.view, aspect, options.orthographic, options.fov_y_deg)
+            .zoomed(options.zoom, options.pan);
 
         let mut flags = 0;
         if options.cel_specular {
@@ -181,6 +208,12 @@ impl Renderer {
         self.enhance
             .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
         self.display.prepare(queue, &display::uniforms(options, radius, options.orthographic));
+        if options.lines {
+            let view = world_view(&camera, scene.origin);
+            let silhouettes = scene.lines.lines.silhouettes(view);
+            let uniforms = lines::uniforms(options, &camera, size.1);
+            self.lines.prepare(&self.gpu.device, queue, &mut scene.lines, &uniforms, silhouettes);
+        }
         let info = FrameInfo { camera, target_size: size };
         self.last_frame = Some(info);
         self.shadow_plan = plan;
@@ -200,15 +233,18 @@ impl Renderer {
             return Err(RenderError::NoModel);
         };
         let targets = &frame.targets;
-        self.gbuffer.encode(encoder, targets, &scene.gpu);
+        self.gbuffer.encode(encoder, targets, &scene.gpu, options.enhanced_normals);
         if options.shadow != ShadowMode::None {
             self.shadow.encode(encoder, targets, &scene.gpu, &self.shadow_plan);
         }
         if options.enhancements.unsharp_mask {
             self.enhance.encode(encoder, targets, &frame.enhance);
         }
-        // The lines pass goes here once edges are baked (see passes::lines).
-        self.display.encode(encoder, &frame.display, output.unwrap_or(&targets.output.view));
+        let output = output.unwrap_or(&targets.output.view);
+        self.display.encode(encoder, &frame.display, output);
+        if options.lines {
+            self.lines.encode(encoder, &scene.lines, &frame.lines, output);
+        }
         Ok(info)
     }
 
@@ -246,6 +282,44 @@ impl Renderer {
         Ok(Image { width: w, height: h, rgba }.downsample(options.supersample))
     }
 
+    /// The part drawn at target pixel (`x`, `y`) of the last frame (the G-buffer's part-id target,
+    /// read back), `None` for the background or outside the frame.
+    pub fn pick(&self, x: u32, y: u32) -> Result<Option<u32>, RenderError> {
+        let Some(frame) = self.targets.as_ref() else { return Ok(None) };
+        let (w, h) = frame.targets.size;
+        if x >= w || y >= h {
+            return Ok(None);
+        }
+        let device = &self.gpu.device;
+        let guard = ErrorScopes::push(device);
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pick readback"),
+            size: u64::from(align),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pick") });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &frame.targets.part_id.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x, y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(align), rows_per_image: Some(1) },
+            },
+            wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = read_buffer(device, &readback, align, 1, 1)?;
+        guard.pop()?;
+        let id = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        Ok(id.checked_sub(1))
+    }
+
     /// Records, submits and waits for one frame without reading it back; the wall time from
     /// recording to completion (the benchmark's measure).
     pub fn time_frame(&mut self, options: &RenderOptions) -> Result<Duration, RenderError> {
@@ -256,6 +330,16 @@ impl Renderer {
         self.gpu.queue.submit([encoder.finish()]);
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
         Ok(start.elapsed())
+    }
+}
+
+/// Where `camera` looks from, in world space (the render space's `origin` added back in f64).
+pub fn world_view(camera: &Camera, origin: glam::DVec3) -> crate::edges::WorldView {
+    if camera.orthographic {
+        let direction = camera.view_from_render.inverse().transform_vector3(Vec3::NEG_Z);
+        crate::edges::WorldView::Orthographic { direction: direction.as_dvec3() }
+    } else {
+        crate::edges::WorldView::Perspective { eye: camera.position_in_render.as_dvec3() + origin }
     }
 }
 

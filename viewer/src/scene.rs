@@ -12,6 +12,8 @@ use crate::model::Model;
 #[derive(Debug)]
 pub struct BatchGpu {
     pub vertices: wgpu::Buffer,
+    /// The same vertices with the enhanced normals, when the batch has them.
+    pub enhanced_vertices: Option<wgpu::Buffer>,
     pub indices: wgpu::Buffer,
     pub index_count: u32,
     pub instances: Range<u32>,
@@ -33,6 +35,16 @@ pub struct SceneGpu {
     pub buffers: SceneBuffers,
     pub gbuffer_bind_group: wgpu::BindGroup,
     pub shadow_bind_group: wgpu::BindGroup,
+}
+
+impl BatchGpu {
+    /// The vertex buffer to draw: with the enhanced normals when asked for and present.
+    pub fn vertices_for(&self, enhanced_normals: bool) -> &wgpu::Buffer {
+        match (&self.enhanced_vertices, enhanced_normals) {
+            (Some(enhanced), true) => enhanced,
+            _ => &self.vertices,
+        }
+    }
 }
 
 impl SceneGpu {
@@ -73,6 +85,19 @@ impl SceneGpu {
                     label: Some(&format!("batch {} indices", b.name)),
                     contents: bytemuck::cast_slice(&b.indices),
                     usage: wgpu::BufferUsages::INDEX,
+                }),
+                enhanced_vertices: b.enhanced_normals.as_ref().map(|normals| {
+                    let vertices: Vec<crate::gpu_types::Vertex> = b
+                        .vertices
+                        .iter()
+                        .zip(normals)
+                        .map(|(v, &n)| crate::gpu_types::Vertex { normal_in_object: n, ..*v })
+                        .collect();
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&format!("batch {} vertices, enhanced normals", b.name)),
+                        contents: bytemuck::cast_slice(&vertices),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    })
                 }),
                 index_count: b.indices.len() as u32,
                 instances: b.instances.clone(),

@@ -189,7 +189,15 @@ pub struct RenderOptions {
     pub orthographic: bool,
     /// Vertical field of view of the perspective camera, degrees. Default [`DEFAULT_FOV_Y_DEG`] (30).
     pub fov_y_deg: f32,
+    /// Magnification of the fitted frame about its centre (the window's wheel). Default 1; range
+    /// [`ZOOM_RANGE`].
+    pub zoom: f32,
+    /// Shift of the image in normalised device units (x right, y up; 2 = the frame's width or
+    /// height), applied after the zoom (the window's right/middle drag). Default (0, 0).
+    pub pan: [f32; 2],
     pub enhancements: Enhancements,
+    /// Draw the baked edges and this view's silhouettes (the lines pass). Default false.
+    pub lines: bool,
     pub shadow: ShadowMode,
     /// Shadow colour (display values). Default [`DEFAULT_SHADOW_COLOR`].
     pub shadow_color: [f32; 3],
@@ -205,6 +213,11 @@ pub struct RenderOptions {
     pub hatch_period_px: f32,
     /// Part id to highlight (the display pass tints it). Default none.
     pub selected_part: Option<u32>,
+    /// Shade with the baked enhanced normals (Cignoni et al. 2005, `_ENHANCED_NORMAL`) instead of
+    /// the crease-aware `NORMAL`: the paper's toggle. Every normal-based style (all but gradient,
+    /// whose shade comes from the projector) and the image-space crease edges see it; batches without enhanced
+    /// normals keep theirs ([`crate::Model::has_enhanced_normals`]). Default false.
+    pub enhanced_normals: bool,
 }
 
 impl Default for RenderOptions {
@@ -217,7 +230,10 @@ impl Default for RenderOptions {
             view: View::default(),
             orthographic: false,
             fov_y_deg: DEFAULT_FOV_Y_DEG,
+            zoom: 1.0,
+            pan: [0.0, 0.0],
             enhancements: Enhancements::default(),
+            lines: false,
             shadow: ShadowMode::default(),
             shadow_color: DEFAULT_SHADOW_COLOR,
             background: DEFAULT_BACKGROUND,
@@ -226,9 +242,13 @@ impl Default for RenderOptions {
             splash_back: false,
             hatch_period_px: DEFAULT_HATCH_PERIOD_PX,
             selected_part: None,
+            enhanced_normals: false,
         }
     }
 }
+
+/// Accepted range of [`RenderOptions::zoom`].
+pub const ZOOM_RANGE: (f32, f32) = (0.05, 100.0);
 
 /// Largest accepted side of [`RenderOptions::size`] times the supersampling factor.
 pub const MAX_TARGET_SIDE: u32 = 8192;
@@ -261,6 +281,12 @@ impl RenderOptions {
         }
         if !(self.fov_y_deg > 1.0 && self.fov_y_deg < 150.0) {
             return Err(format!("field of view {} is out of range (1, 150) degrees", self.fov_y_deg));
+        }
+        if !(self.zoom >= ZOOM_RANGE.0 && self.zoom <= ZOOM_RANGE.1) {
+            return Err(format!("zoom {} is out of range [{}, {}]", self.zoom, ZOOM_RANGE.0, ZOOM_RANGE.1));
+        }
+        if !self.pan.iter().all(|p| p.is_finite() && p.abs() <= 100.0) {
+            return Err(format!("pan {:?}: each component must be finite and within ±100", self.pan));
         }
         if !(self.hatch_period_px >= 1.0 && self.hatch_period_px <= 256.0) {
             return Err(format!("hatch period {} is out of range [1, 256] pixels", self.hatch_period_px));

@@ -93,3 +93,47 @@ fn corpus_models() {
     assert!(!fandisk.baked && !fandisk.notices.is_empty());
     run_cases(&fandisk, &[("fandisk_unbaked_metal".into(), options(Style::Metal))]);
 }
+
+#[test]
+fn lines_on_the_sample_and_a_corpus_part() {
+    // The lines pass alone (no image-space edges) and in the full illustration.
+    let model = common::sample();
+    run_cases(
+        &model,
+        &[
+            (
+                "assembly_gooch_lines".into(),
+                RenderOptions { enhancements: Enhancements::default(), lines: true, ..options(Style::Gooch) },
+            ),
+            (
+                "assembly_illustration_lines".into(),
+                RenderOptions { lines: true, shadow: ShadowMode::Soft, ..options(Style::Gradient) },
+            ),
+            (
+                "assembly_cel_lines_ortho".into(),
+                RenderOptions {
+                    enhancements: Enhancements::default(),
+                    lines: true,
+                    orthographic: true,
+                    view: View { azimuth_deg: -60.0, elevation_deg: 60.0 },
+                    ..options(Style::Cel)
+                },
+            ),
+        ],
+    );
+    // A CAD part from ../shared/models, baked: creases white, silhouettes and boundaries black.
+    let fandisk = common::baked(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"));
+    assert!(!fandisk.lines.is_empty());
+    run_cases(
+        &fandisk,
+        &[(
+            "fandisk_gooch_lines".into(),
+            RenderOptions {
+                enhancements: Enhancements::default(),
+                lines: true,
+                view: View { azimuth_deg: 150.0, elevation_deg: 30.0 },
+                ..options(Style::Gooch)
+            },
+        )],
+    );
+}

@@ -83,6 +83,8 @@ fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: &str) -> Baked
         .expect("root extension"),
         nodes: vec![(0, NodeExtension { parts: vec![part] })],
         primitive_labels: vec![],
+        primitive_edges: vec![],
+        mesh_silhouettes: vec![],
     }
 }
 

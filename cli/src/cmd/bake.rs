@@ -1,5 +1,5 @@
-//! `drafter bake [INPUT] [-o OUTPUT] [--config FILE] [--report FILE.json] [--segment MODE] [--obb METHOD]
-//! [--threads N] [--quiet]`.
+//! `drafter bake [INPUT] [-o OUTPUT] [--config FILE] [--report FILE.json] [--json] [--textures-out DIR]
+//! [--segment MODE] [--obb METHOD] [--threads N] [--quiet]`.
 //!
 //! With no INPUT it bakes the embedded sample assembly into `./sample.baked.glb`. The output is
 //! written atomically (a temporary file beside it, then a rename): a failed or interrupted bake
@@ -37,6 +37,13 @@ pub struct Args {
     /// Also write the bake report (parts, boxes, projectors, stage timings) as JSON.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Print the bake report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the embedded NPR textures as PNG files into DIR (created if missing), one file
+    /// per image: `NAME.png`, byte-identical to the images in the output.
+    #[arg(long, value_name = "DIR")]
+    pub textures_out: Option<PathBuf>,
     /// How the scene is cut into parts (overrides the config file).
     #[arg(long, value_enum)]
     pub segment: Option<SegmentArg>,
@@ -150,7 +157,16 @@ pub fn run(args: Args) -> Result<()> {
         let json = serde_json::to_vec_pretty(&baked.report)?;
         write_atomically(report_path, &json)?;
     }
+    if let Some(dir) = &args.textures_out {
+        std::fs::create_dir_all(dir).map_err(|e| BadInput(format!("{}: cannot create: {e}", dir.display())))?;
+        for image in &baked.textures {
+            write_atomically(&dir.join(format!("{}.png", image.name)), &image.png)?;
+        }
+    }
     progress.finish();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&baked.report)?);
+    }
 
     if !args.quiet {
         let r = &baked.report;
@@ -164,6 +180,10 @@ pub fn run(args: Args) -> Result<()> {
             started.elapsed().as_secs_f64() * 1e3,
             r.stages.iter().map(|s| format!("{} {:.0} ms", s.name, s.ms)).collect::<Vec<_>>().join(", ")
         );
+        if let Some(t) = &r.textures {
+            let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
+            eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);
+        }
         for d in &r.diagnostics {
             eprintln!("  note: {d}");
         }

@@ -5,8 +5,10 @@
 //! drift of a shared, noisy machine hits every style alike; each style's time is the median of its
 //! frames. A frame is measured from recording to completion on the device (submit and wait), the
 //! image not read back. Besides the styles: `edges` (gradient with outlines, creases and the depth
-//! unsharp mask), `shadow_hard` and `shadow_soft` (gradient with a drop shadow), and
-//! `illustration`, the full frame: gradient shading, edges and a soft shadow.
+//! unsharp mask), `lines` (gradient with the baked lines: hard edges and this view's silhouettes from
+//! the baked hierarchies), `shadow_hard` and `shadow_soft` (gradient with a drop shadow), and
+//! `illustration`, the full frame: gradient shading, edges, lines and a soft shadow. The CPU
+//! silhouette query of the line frames is timed on its own too (median per frame).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -17,10 +19,15 @@ use serde::Serialize;
 
 use crate::exit::BadInput;
 
+/// `drafter bench FILE` (the whole-stage sweep, `bench_sweep.rs`) or `drafter bench WHAT ...`.
 #[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+#[group(skip)]
 pub struct Args {
     #[command(subcommand)]
-    pub what: What,
+    pub what: Option<What>,
+    #[command(flatten)]
+    pub sweep: crate::cmd::bench_sweep::Args,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -30,6 +37,9 @@ pub enum What {
     /// Frame time of the same triangles in 10 and in 1000 parts (synthetic spheres), as parts of
     /// one mesh (per-triangle labels) and as separate meshes.
     Parts(PartsArgs),
+    /// Silhouettes per view: brute force against the stored hierarchies, speedup, counts and
+    /// mismatches (`--views N|icosa`, `--perspective`).
+    Silhouettes(super::bench_silhouettes::Args),
 }
 
 #[derive(Debug, clap::Args)]
@@ -80,8 +90,16 @@ pub struct Report {
     pub device: String,
     pub triangles: usize,
     pub parts: usize,
-    /// By name (`phong`, the styles, `edges`, `shadow_hard`, `shadow_soft`, `illustration`).
+    /// By name (`phong`, the styles, `edges`, `lines`, `shadow_hard`, `shadow_soft`, `illustration`).
     pub styles: serde_json::Map<String, serde_json::Value>,
+    /// Hard-edge segments drawn (edges × instances).
+    pub hard_edges: u32,
+    /// Silhouette candidates of the model.
+    pub silhouette_candidates: usize,
+    /// Silhouettes drawn in the illustration frame.
+    pub silhouettes: usize,
+    /// Median CPU time of the per-frame silhouette query (all instances), milliseconds.
+    pub silhouette_query_ms: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -91,9 +109,11 @@ struct StyleTime {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    match args.what {
+    let Some(what) = args.what else { return crate::cmd::bench_sweep::run(args.sweep) };
+    match what {
         What::Render(args) => render(args),
         What::Parts(args) => parts(args),
+        What::Silhouettes(args) => super::bench_silhouettes::run(args),
     }
 }
 
@@ -113,6 +133,7 @@ fn render(args: RenderArgs) -> Result<()> {
         .collect();
     let gradient = RenderOptions { style: Style::Gradient, ..base.clone() };
     cases.push(("edges".to_owned(), RenderOptions { enhancements: Enhancements::ALL, ..gradient.clone() }));
+    cases.push(("lines".to_owned(), RenderOptions { lines: true, ..gradient.clone() }));
     cases.push(("shadow_hard".to_owned(), RenderOptions { shadow: ShadowMode::Hard, ..gradient.clone() }));
     cases.push(("shadow_soft".to_owned(), RenderOptions { shadow: ShadowMode::Soft, ..gradient.clone() }));
     cases.push((
@@ -120,6 +141,7 @@ fn render(args: RenderArgs) -> Result<()> {
         RenderOptions {
             style: Style::Gradient,
             enhancements: Enhancements::ALL,
+            lines: true,
             shadow: ShadowMode::Soft,
             ..base.clone()
         },
@@ -131,11 +153,19 @@ fn render(args: RenderArgs) -> Result<()> {
         }
     }
     let mut times: Vec<Vec<Duration>> = vec![Vec::with_capacity(args.frames); cases.len()];
+    let mut queries: Vec<Duration> = Vec::new();
+    let mut silhouettes = 0;
     for _ in 0..args.frames {
         for (k, (_, options)) in cases.iter().enumerate() {
             times[k].push(renderer.time_frame(options)?);
+            if let (true, Some(frame)) = (options.lines, renderer.last_silhouettes()) {
+                queries.push(frame.elapsed);
+                silhouettes = frame.drawn.len();
+            }
         }
     }
+    queries.sort_unstable();
+    let silhouette_query_ms = queries.get(queries.len() / 2).map_or(0.0, |d| d.as_secs_f64() * 1e3);
     let medians: Vec<f64> = times
         .iter_mut()
         .map(|t| {
@@ -155,6 +185,10 @@ fn render(args: RenderArgs) -> Result<()> {
         triangles: model.triangle_count(),
         parts: model.parts.len(),
         styles,
+        hard_edges: renderer.hard_edge_count(),
+        silhouette_candidates: model.lines.candidate_count(),
+        silhouettes,
+        silhouette_query_ms: round3(silhouette_query_ms),
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -172,6 +206,10 @@ fn render(args: RenderArgs) -> Result<()> {
         for ((name, _), ms) in cases.iter().zip(&medians) {
             println!("  {name:<13} {ms:8.2} ms  {:5.2}× phong", ms / phong);
         }
+        println!(
+            "  lines: {} hard-edge segments, {} silhouettes of {} candidates; silhouette query {:.3} ms per frame (CPU, median)",
+            report.hard_edges, report.silhouettes, report.silhouette_candidates, report.silhouette_query_ms
+        );
     }
     Ok(())
 }
@@ -396,6 +434,8 @@ mod spheres {
                 root,
                 nodes: vec![(0, NodeExtension { parts: records })],
                 primitive_labels: vec![(0, 0, labels)],
+                primitive_edges: Vec::new(),
+                mesh_silhouettes: Vec::new(),
             };
             Model::from_scene(&scene, Some(&baked)).ok_or_else(|| anyhow::anyhow!("empty synthetic scene"))
         } else {

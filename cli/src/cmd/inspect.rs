@@ -313,6 +313,15 @@ fn print_text(r: &Report) {
         if b.parts.len() > TABLE_ROWS {
             println!("  ... {} more parts (--json lists all)", b.parts.len() - TABLE_ROWS);
         }
+        if let Some(t) = &b.root.textures {
+            let mut kinds = Vec::new();
+            kinds.extend(t.gradient.as_ref().map(|g| format!("gradient #{} ({} curves)", g.index, g.curves.len())));
+            kinds.extend(t.cel.as_ref().map(|c| format!("cel #{}", c.index)));
+            kinds.extend(t.cool_to_warm.iter().map(|c| format!("cool-to-warm #{}", c.index)));
+            kinds.extend(t.hatching.as_ref().map(|h| format!("hatching ({} levels)", h.levels.len())));
+            kinds.extend(t.metal.as_ref().map(|m| format!("metal ({} metal parts)", m.parts.len())));
+            println!("  textures: {}", kinds.join(", "));
+        }
     }
     if !r.diagnostics.is_empty() {
         println!("\n  input problems recovered from:");

@@ -2,5 +2,8 @@
 
 pub mod bake;
 pub mod bench;
+pub mod bench_silhouettes;
+pub mod bench_sweep;
 pub mod inspect;
 pub mod render;
+pub mod view;

@@ -1,4 +1,4 @@
-//! `drafter render FILE -o out.png [--style S] [--size WxH] [--view AZ,EL] [--edges]
+//! `drafter render FILE -o out.png [--style S] [--size WxH] [--view AZ,EL] [--edges] [--lines]
 //! [--shadow hard|penumbra|soft|none] [--ortho] [--supersample N] ...`: renders a baked file (or any
 //! model) headless with the viewer's passes and writes a PNG. Works without a GPU on lavapipe.
 
@@ -32,7 +32,8 @@ pub struct Args {
     /// the depth unsharp mask.
     #[arg(long)]
     pub edges: bool,
-    /// Lines from baked edges (not in baked files yet: image-space edges are drawn instead).
+    /// Lines from the baked edges: creases, boundaries, part borders and this view's silhouettes
+    /// (from the baked hierarchies), drawn as wide screen-space lines.
     #[arg(long)]
     pub lines: bool,
     /// Drop shadow on the ground plane.
@@ -53,6 +54,10 @@ pub struct Args {
     /// Highlight the part with this id.
     #[arg(long, value_name = "ID")]
     pub select: Option<u32>,
+    /// Shade with the baked enhanced normals (Cignoni et al. 2005, `_ENHANCED_NORMAL`) instead of
+    /// the crease-aware ones; a file baked without them renders as usual, with a notice.
+    #[arg(long)]
+    pub enhanced_normals: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -102,13 +107,13 @@ impl From<ShadowArg> for ShadowMode {
     }
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("{s:?}: {e}"));
     Ok((parse(w)?, parse(h)?))
 }
 
-fn parse_view(s: &str) -> Result<(f32, f32), String> {
+pub(crate) fn parse_view(s: &str) -> Result<(f32, f32), String> {
     let (az, el) = s.split_once(',').ok_or_else(|| format!("{s:?} is not AZ,EL"))?;
     let parse = |v: &str| v.trim().parse::<f32>().map_err(|e| format!("{s:?}: {e}"));
     Ok((parse(az)?, parse(el)?))
@@ -124,11 +129,13 @@ impl Args {
             use_part_styles: !self.uniform_style,
             view: View { azimuth_deg: self.view.0, elevation_deg: self.view.1 },
             orthographic: self.ortho,
-            enhancements: if self.edges || self.lines { Enhancements::ALL } else { Enhancements::default() },
+            enhancements: if self.edges { Enhancements::ALL } else { Enhancements::default() },
+            lines: self.lines,
             shadow: self.shadow.into(),
             cel_steps: self.cel_steps,
             splash_back: self.splash_back,
             selected_part: self.select,
+            enhanced_normals: self.enhanced_normals,
             ..RenderOptions::default()
         }
     }
@@ -169,8 +176,11 @@ pub fn run(args: Args) -> Result<()> {
         for notice in &model.notices {
             eprintln!("  note: {notice}");
         }
+        if args.enhanced_normals && !model.has_enhanced_normals() {
+            eprintln!("  note: no enhanced normals in the file (bake it with normals): drawn with its own normals");
+        }
         if args.lines
-            && let Some(notice) = drafter_viewer::passes::lines::notice(&model)
+            && let Some(notice) = drafter_viewer::passes::lines::notice(&model.lines)
         {
             eprintln!("  note: {notice}");
         }

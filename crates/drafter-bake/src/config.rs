@@ -26,6 +26,20 @@
 //! crease_angle_deg = 30.0    # sharper edges are creases (hard edges, drawn white)
 //! hierarchies = true         # store silhouette hierarchies where they beat brute force
 //!
+//! [textures]                 # NPR lookup textures embedded as PNG (see `crate::textures`)
+//! enabled = true
+//! styles = ["gradient", "cel", "gooch", "goochel", "hatch"]  # scene-wide styles to bake lookups for
+//! metallic_threshold = 0.5   # material metallicFactor >= this makes a part metal
+//! [textures.cool_to_warm]    # drafter-textures' options; a table replaces that texture's defaults
+//! splash_back = true
+//! [textures.metal]
+//! specular_power = 40.0
+//! [textures.hatching]
+//! contrast = 4.0
+//! [textures.cel]
+//! steps = 3
+//! specular = true
+//!
 //! [[part]]                   # any number; `name` or `id` selects the part(s)
 //! name = "gear"
 //! method = "optimal"
@@ -44,6 +58,7 @@ use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
 use drafter_format::{Container, InputInfo};
 use drafter_normals::NormalsOptions;
 use drafter_segment::{SegmentMode, SegmentOptions};
+use drafter_textures::{CelOptions, CoolToWarmOptions, HatchingOptions, MetalOptions};
 use serde::Deserialize;
 
 use crate::BakeError;
@@ -57,6 +72,7 @@ pub struct BakeConfig {
     pub segment: SegmentOptions,
     pub normals: NormalsStage,
     pub lines: LinesStage,
+    pub textures: TexturesStage,
     pub obb: ObbOptions,
     /// The gradient parameters of every part without an override.
     pub gradient: GradientParams,
@@ -74,6 +90,7 @@ impl Default for BakeConfig {
             segment: SegmentOptions::default(),
             normals: NormalsStage::default(),
             lines: LinesStage::default(),
+            textures: TexturesStage::default(),
             obb: ObbOptions::default(),
             gradient: GradientParams::default(),
             transfer: TransferCurve::default(),
@@ -118,6 +135,73 @@ pub struct LinesStage {
 impl Default for LinesStage {
     fn default() -> Self {
         Self { enabled: true, crease_angle_deg: drafter_lines::DEFAULT_CREASE_ANGLE_DEG, hierarchies: true }
+    }
+}
+
+/// Default of [`TexturesStage::styles`]: every scene-wide style of the viewer that reads a lookup,
+/// except `metal` (baked only for metal parts, or when listed).
+pub const DEFAULT_TEXTURE_STYLES: [&str; 5] = ["gradient", "cel", "gooch", "goochel", "hatch"];
+
+/// Default of [`TexturesStage::metallic_threshold`]: a material at least half metallic is metal.
+pub const DEFAULT_METALLIC_THRESHOLD: f32 = 0.5;
+
+/// The textures stage: which NPR lookup textures (drafter-textures) are baked and embedded as PNG.
+/// What is baked when is documented in `crate::textures`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TexturesStage {
+    /// Bake and embed textures. Default true.
+    pub enabled: bool,
+    /// Styles a viewer may apply to the whole scene; the lookups they read are baked (`gradient`:
+    /// γ atlas, `cel`: cel atlas, `gooch`: cool-to-warm map, `goochel`: both, `hatch`: hatching,
+    /// `metal`: metal bands and highlights, `phong`: none). Part style hints and metal parts add to
+    /// them. Default [`DEFAULT_TEXTURE_STYLES`]; each one of [`STYLES`].
+    pub styles: Vec<String>,
+    /// A part without a style hint whose material's metallic factor is at least this is metal and
+    /// gets the metal textures baked. Default [`DEFAULT_METALLIC_THRESHOLD`] (0.5); range [0, ∞),
+    /// above 1 turns detection from materials off.
+    pub metallic_threshold: f32,
+    /// Metal bands and highlights. Default: the paper's (drafter-textures' `MetalOptions::default`).
+    pub metal: MetalOptions,
+    /// The cool-to-warm map. Default: factored (serves every part colour), octahedral, no
+    /// splash-back.
+    pub cool_to_warm: CoolToWarmOptions,
+    /// The hatching halftone. Default: drafter-textures' (128², 4 mip levels).
+    pub hatching: HatchingOptions,
+    /// The cel step table (read by `cel` and `goochel`). Default: 3 steps with a specular band, as
+    /// the viewer's default cel shading.
+    pub cel: CelOptions,
+}
+
+impl Default for TexturesStage {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            styles: DEFAULT_TEXTURE_STYLES.iter().map(|s| (*s).to_owned()).collect(),
+            metallic_threshold: DEFAULT_METALLIC_THRESHOLD,
+            metal: MetalOptions::default(),
+            cool_to_warm: CoolToWarmOptions::default(),
+            hatching: HatchingOptions::default(),
+            cel: CelOptions { specular: true, ..CelOptions::default() },
+        }
+    }
+}
+
+impl TexturesStage {
+    /// Checks every option against its documented range; errors name the key.
+    pub fn validate(&self) -> Result<(), String> {
+        for style in &self.styles {
+            if !STYLES.contains(&style.as_str()) {
+                return Err(format!("textures.styles: {style:?} is not one of {}", STYLES.join(", ")));
+            }
+        }
+        if !(self.metallic_threshold.is_finite() && self.metallic_threshold >= 0.0) {
+            return Err(format!("textures.metallic_threshold = {} must be finite and >= 0", self.metallic_threshold));
+        }
+        self.metal.validate("textures.metal.").map_err(|e| e.to_string())?;
+        self.cool_to_warm.validate("textures.cool_to_warm.").map_err(|e| e.to_string())?;
+        self.hatching.validate("textures.hatching.").map_err(|e| e.to_string())?;
+        self.cel.validate("textures.cel.").map_err(|e| e.to_string())?;
+        Ok(())
     }
 }
 
@@ -168,6 +252,8 @@ struct FileConfig {
     normals: NormalsSection,
     #[serde(default)]
     lines: LinesSection,
+    #[serde(default)]
+    textures: TexturesSection,
     #[serde(default, rename = "part")]
     parts: Vec<PartOverride>,
 }
@@ -185,6 +271,18 @@ struct LinesSection {
     enabled: Option<bool>,
     crease_angle_deg: Option<f32>,
     hierarchies: Option<bool>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TexturesSection {
+    enabled: Option<bool>,
+    styles: Option<Vec<String>>,
+    metallic_threshold: Option<f32>,
+    metal: Option<MetalOptions>,
+    cool_to_warm: Option<CoolToWarmOptions>,
+    hatching: Option<HatchingOptions>,
+    cel: Option<CelOptions>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -263,6 +361,29 @@ impl BakeConfig {
         if let Some(e) = n.enhanced_in_normal {
             self.normals.enhanced_in_normal = e;
         }
+        let t = file.textures;
+        if let Some(enabled) = t.enabled {
+            self.textures.enabled = enabled;
+        }
+        if let Some(styles) = t.styles {
+            self.textures.styles = styles;
+        }
+        if let Some(threshold) = t.metallic_threshold {
+            self.textures.metallic_threshold = threshold;
+        }
+        if let Some(metal) = t.metal {
+            self.textures.metal = metal;
+        }
+        if let Some(c) = t.cool_to_warm {
+            self.textures.cool_to_warm = c;
+        }
+        if let Some(h) = t.hatching {
+            self.textures.hatching = h;
+        }
+        if let Some(c) = t.cel {
+            self.textures.cel = c;
+        }
+        self.textures.validate().map_err(BakeError::Config)?;
         if let Some(method) = file.obb.method {
             self.obb.method = method;
         }
@@ -366,6 +487,25 @@ mod tests {
     }
 
     #[test]
+    fn textures_section_parses() {
+        let mut c = BakeConfig::default();
+        assert_eq!(c.textures.styles, DEFAULT_TEXTURE_STYLES);
+        c.apply_toml(
+            "[textures]\nstyles = [\"gooch\"]\nmetallic_threshold = 0.9\n[textures.cool_to_warm]\nsplash_back = true\n\
+             [textures.cel]\nsteps = 2\n",
+        )
+        .unwrap();
+        assert_eq!(c.textures.styles, ["gooch"]);
+        assert_eq!(c.textures.metallic_threshold, 0.9);
+        assert!(c.textures.cool_to_warm.splash_back);
+        assert_eq!(c.textures.cool_to_warm.alpha, drafter_textures::cool_warm::DEFAULT_COOL_MIX);
+        assert_eq!((c.textures.cel.steps, c.textures.cel.specular), (2, false));
+        assert!(c.textures.enabled);
+        c.apply_toml("[textures]\nenabled = false\n").unwrap();
+        assert!(!c.textures.enabled);
+    }
+
+    #[test]
     fn errors_name_the_key() {
         let cases = [
             ("[obb]\nmethdo = \"pca\"\n", "methdo"),
@@ -378,6 +518,12 @@ mod tests {
             ("[segment]\nmode = \"blobs\"\n", "blobs"),
             ("[normals]\nstrength = 9.0\n", "strength"),
             ("[normals]\nsmooth = true\n", "smooth"),
+            ("[textures]\nstyles = [\"neon\"]\n", "neon"),
+            ("[textures]\nmetallic_threshold = -1.0\n", "metallic_threshold"),
+            ("[textures.cel]\nsteps = 9\n", "textures.cel.steps"),
+            ("[textures.metal]\nexponent = 0.0\n", "textures.metal.exponent"),
+            ("[textures.hatching]\nsize = 100\n", "textures.hatching.size"),
+            ("[textures]\nhatch = true\n", "hatch"),
         ];
         for (text, needle) in cases {
             let err = BakeConfig::default().apply_toml(text).unwrap_err().to_string();

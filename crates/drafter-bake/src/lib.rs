@@ -9,13 +9,16 @@
 //! 4. `lines` — per unique mesh, edge classes on the welded topology (creases, boundaries, part
 //!    borders, silhouette candidates), their EXT_mesh_primitive_edge_visibility encoding per
 //!    primitive, and the silhouette hierarchies (drafter-lines);
-//! 5. `write` — the extended glTF (drafter-format).
+//! 5. `textures` — the NPR lookup textures the scene uses (γ, cel, cool-to-warm, hatching, metal),
+//!    baked by drafter-textures and encoded as PNG (what is baked when: [`textures`]);
+//! 6. `write` — the extended glTF (drafter-format), the PNGs embedded as glTF images.
 //!
 //! Invariant: this is the only crate that knows the order. The output bytes depend only on the
 //! scene and the config, never on timings or the thread count (parts are processed in parallel and
 //! collected in part order).
 
 mod config;
+pub mod textures;
 
 use std::time::Instant;
 
@@ -23,8 +26,8 @@ use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
 use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
 use drafter_format::{
     BakeOutput, BoxRecord, ConeBvhData, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord, HardEdgeClass,
-    InputInfo, MeshSilhouettes, NormalsInfo, PartRecord, PrimitiveEdges, ProjectorRecord, RootExtension, VertexData,
-    Written,
+    InputInfo, MeshSilhouettes, NormalsInfo, PartRecord, PrimitiveEdges, ProjectorRecord, RootExtension, TextureImage,
+    VertexData, Written,
 };
 use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
@@ -32,7 +35,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use config::{BakeConfig, LinesStage, NormalsStage, PartOverride, PartSelector, STYLES};
+pub use config::{
+    BakeConfig, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage, PartOverride,
+    PartSelector, STYLES, TexturesStage,
+};
+pub use textures::{TextureReport, TexturesSummary};
 
 /// Why a bake failed.
 #[derive(Debug, thiserror::Error)]
@@ -53,6 +60,9 @@ pub enum BakeError {
 pub struct Baked {
     pub written: Written,
     pub report: BakeReport,
+    /// The embedded textures' PNGs (exactly the bytes in the file), in the file's image order; what
+    /// `drafter bake --textures-out` writes.
+    pub textures: Vec<TextureImage>,
 }
 
 /// What `--report FILE.json` contains.
@@ -70,6 +80,9 @@ pub struct BakeReport {
     /// What the line stage found, summed over unique meshes (absent when it was off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines: Option<LinesSummary>,
+    /// The embedded textures and their PNG bytes (absent when none were baked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub textures: Option<TexturesSummary>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -171,6 +184,16 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     timed("lines", start);
 
     let start = Instant::now();
+    let metal_parts = textures::metal_parts(scene, &parts, &records, config.textures.metallic_threshold);
+    let request = textures::request(&records, &metal_parts, &config.textures);
+    let baked_textures = if request.is_empty() {
+        None
+    } else {
+        Some(textures::bake(&request, metal_parts, config.textures.metallic_threshold)?)
+    };
+    timed("textures", start);
+
+    let start = Instant::now();
     let bounds = scene.world_bounds();
     let center = if bounds.is_empty() { DVec3::ZERO } else { (bounds.min + bounds.max) * 0.5 };
     let root = RootExtension {
@@ -186,6 +209,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
             crease_angle_deg: f64::from(config.normals.options.crease.crease_angle_deg),
             enhanced_in_normal: config.normals.enhanced_in_normal,
         }),
+        textures: None,
     };
     let instance_parts: Vec<Vec<PartRecord>> = parts
         .instances
@@ -198,10 +222,23 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
             mesh_labels[inst.mesh.index()].get_or_insert_with(|| table.labels().to_vec());
         }
     }
-    let output =
-        BakeOutput { scene, root, instance_parts, mesh_labels, vertex_data, primitive_edges, mesh_silhouettes };
+    let (textures_summary, embedded) = match baked_textures {
+        Some(b) => (Some(b.summary), Some(b.embedded)),
+        None => (None, None),
+    };
+    let output = BakeOutput {
+        scene,
+        root,
+        instance_parts,
+        mesh_labels,
+        vertex_data,
+        primitive_edges,
+        mesh_silhouettes,
+        textures: embedded,
+    };
     let written = drafter_format::write(&output, &config.container)
         .map_err(|e| BakeError::Internal { stage: "write", message: e.to_string() })?;
+    let texture_images = output.textures.map(|t| t.images).unwrap_or_default();
     for note in &written.notes {
         diagnostics.push(Diagnostic { kind: DiagnosticKind::Other, count: 1, first_example: note.clone() });
     }
@@ -217,9 +254,10 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
         output_bytes,
         normals: normals_summary,
         lines: lines_summary,
+        textures: textures_summary,
         diagnostics,
     };
-    Ok(Baked { written, report })
+    Ok(Baked { written, report, textures: texture_images })
 }
 
 /// Normals of every mesh used by an instance, in mesh order. UV seams are kept where the mesh has
@@ -395,13 +433,28 @@ fn hard_edge_code(class: EdgeClass) -> u8 {
 fn silhouettes_of(topology: &Topology, feature: &drafter_lines::FeatureEdges, hierarchies: bool) -> MeshSilhouettes {
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
-    let index = SilhouetteIndex::build(feature, &options);
-    let arrays = index.to_arrays();
     let corner_of = |e: u32| -> u32 {
         let f = topology.faces_of_edge(e as usize)[0];
         let k = topology.face_edges[f as usize].iter().position(|&x| x == e).unwrap_or(0) as u32;
         3 * f + k
     };
+    // The perspective test's point v is the first vertex of the corner the file stores (the spec's
+    // "v the edge's first vertex"), so that a reader rebuilds the same candidates from the file.
+    let points = feature
+        .candidates
+        .iter()
+        .map(|&e| {
+            let c = corner_of(e) as usize;
+            topology.welded_positions[topology.faces[c / 3][c % 3] as usize]
+        })
+        .collect();
+    let index = SilhouetteIndex::from_candidates(
+        feature.candidates.clone(),
+        feature.candidate_normals.clone(),
+        points,
+        &options,
+    );
+    let arrays = index.to_arrays();
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",
         HierarchyChoice::ConeBvh { .. } => "coneBvh",
@@ -454,6 +507,7 @@ fn settings_echo(config: &BakeConfig) -> serde_json::Value {
         "obb": {"method": config.obb.method.name()},
         "normals": {"enabled": config.normals.enabled},
         "lines": {"enabled": config.lines.enabled, "creaseAngleDeg": config.lines.crease_angle_deg, "hierarchies": config.lines.hierarchies},
+        "textures": {"enabled": config.textures.enabled, "styles": config.textures.styles, "metallicThreshold": config.textures.metallic_threshold},
         "gradient": {"q": config.gradient.q, "f": config.gradient.f, "p": config.gradient.p, "transfer": config.transfer},
         "partOverrides": config.overrides.len(),
     })

@@ -27,6 +27,152 @@ pub struct RootExtension {
     /// How the normals were computed, when the bake wrote them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub normals: Option<NormalsInfo>,
+    /// The baked NPR lookup textures, by glTF texture index (absent when the bake embedded none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub textures: Option<TexturesRecord>,
+}
+
+/// A reference to a glTF texture (`textures[index]`), as glTF's own `textureInfo`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct TextureRef {
+    pub index: u32,
+}
+
+/// The NPR lookup textures a bake embedded (only those the scene uses; see the spec's "Textures").
+/// Every texture is a PNG image in the binary buffer with a standard glTF `texture` and `sampler`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct TexturesRecord {
+    /// γ transfer tables (Lux et al. 2013): R8, 128 × rows, row `r` is the curve `curves[r]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gradient: Option<GradientTexture>,
+    /// Cel step tables (ten Bosch 2005): R8, 128 × rows, row `r` is `tables[r]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cel: Option<CelTexture>,
+    /// Cool-to-warm maps (Gooch et al. 1999, Fig. 10), one per variant.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cool_to_warm: Vec<CoolToWarmTexture>,
+    /// Hatching halftone (Freudenberg 2002), one texture per stored mip level.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hatching: Option<HatchingTexture>,
+    /// Gooch metal bands and highlights; present only when some part is metal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub metal: Option<MetalTexture>,
+}
+
+impl TexturesRecord {
+    /// Every texture index the record refers to: gradient, cel, cool-to-warm maps, hatching levels,
+    /// metal bands and highlights.
+    pub fn indices(&self) -> Vec<u32> {
+        let mut out = Vec::new();
+        out.extend(self.gradient.as_ref().map(|g| g.index));
+        out.extend(self.cel.as_ref().map(|c| c.index));
+        out.extend(self.cool_to_warm.iter().map(|c| c.index));
+        if let Some(h) = &self.hatching {
+            out.extend(h.levels.iter().map(|l| l.index));
+        }
+        if let Some(m) = &self.metal {
+            out.extend([m.bands.index, m.highlights.index]);
+        }
+        out
+    }
+
+    /// Mutable access to every texture index, same order as [`Self::indices`].
+    pub fn indices_mut(&mut self) -> Vec<&mut u32> {
+        let mut out = Vec::new();
+        out.extend(self.gradient.as_mut().map(|g| &mut g.index));
+        out.extend(self.cel.as_mut().map(|c| &mut c.index));
+        out.extend(self.cool_to_warm.iter_mut().map(|c| &mut c.index));
+        if let Some(h) = &mut self.hatching {
+            out.extend(h.levels.iter_mut().map(|l| &mut l.index));
+        }
+        if let Some(m) = &mut self.metal {
+            out.push(&mut m.bands.index);
+            out.push(&mut m.highlights.index);
+        }
+        out
+    }
+}
+
+/// The γ atlas: sample at `u = (0.5 + 127·p)/128`, `v = (row + 0.5)/rows`, linear, clamped.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct GradientTexture {
+    /// The glTF texture.
+    pub index: u32,
+    /// The transfer curve of each row (the names of the parts' `gradient.transfer`).
+    pub curves: Vec<String>,
+}
+
+/// The cel atlas: sample at `u = (0.5 + 127·x)/128`, `v = (row + 0.5)/rows`, `x = max(n·l, 0)`
+/// (cel) or `(1 + n·l)/2` (Goochel).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct CelTexture {
+    /// The glTF texture.
+    pub index: u32,
+    pub tables: Vec<CelTableRecord>,
+}
+
+/// One cel step table.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct CelTableRecord {
+    /// Diffuse steps, 2–4.
+    pub steps: u32,
+    /// Whether the table ends in a white specular band.
+    pub specular: bool,
+    /// Value of the darkest step.
+    pub min_level: f64,
+    /// Start of the specular band (when `specular`).
+    pub specular_threshold: f64,
+    /// Value of the brightest diffuse step when `specular`.
+    pub diffuse_max: f64,
+}
+
+/// A cool-to-warm map indexed by the eye-space normal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct CoolToWarmTexture {
+    /// The glTF texture.
+    pub index: u32,
+    /// `octahedral` or `normal_sphere` (formulas in the spec).
+    pub mapping: String,
+    /// `factored` (RGB = base, A = object-colour weight: `clamp(rgb + a·k_d)`) or `colour`.
+    pub encoding: String,
+    /// Unit direction towards the light in eye space the map was baked for.
+    pub light_in_eye: [f64; 3],
+    /// Whether the splash-back multiplier is included (Fig. 10(b)).
+    pub splash_back: bool,
+}
+
+/// The hatching halftone T: ink = `clamp(contrast·(1 − (T + I)), 0, 1)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct HatchingTexture {
+    /// Mip levels, level 0 (full size) first; level `m` is `size/2^m` square. A renderer uploads them
+    /// as the texture's mip chain (and creates no further levels).
+    pub levels: Vec<TextureRef>,
+    /// The recommended soft-threshold constant `c` (> 1).
+    pub contrast: f64,
+}
+
+/// Gooch metal: `colour = base · band(u) + highlight(n_eye)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct MetalTexture {
+    /// R8, `n × 1`, repeat: sampled at `u = s·(1 + n·w)/2`, `w` the part's `obb.axes[1]`.
+    pub bands: TextureRef,
+    /// R8 highlights, indexed by the eye-space normal through `highlightMapping`.
+    pub highlights: TextureRef,
+    /// `octahedral` or `normal_sphere`.
+    pub highlight_mapping: String,
+    /// Ids of the parts the bake found metal (style hint `metal`, or material metallic factor at
+    /// or above `metallicThreshold`).
+    pub parts: Vec<u32>,
+    /// The metallic-factor threshold of the detection.
+    pub metallic_threshold: f64,
 }
 
 /// The normal stage's parameters (Cignoni et al. 2005), for provenance and for a viewer's toggle.
@@ -180,7 +326,8 @@ pub struct SilhouettesRecord {
     pub candidate_corners: u32,
     /// Accessor (SCALAR, FLOAT): 6 per candidate, the two face normals (x, y, z each) in full
     /// precision. A candidate is a silhouette for view direction u iff (n1·u) and (n2·u) have
-    /// strictly opposite signs (for an eye e: n·(e − v), v the edge's first vertex).
+    /// strictly opposite signs (for an eye e: n·(e − v), v the position of the corner's first
+    /// vertex v_k).
     pub candidate_normals: u32,
     /// `gaussMap` or `bruteForce`: what answers orthographic views.
     pub orthographic: String,

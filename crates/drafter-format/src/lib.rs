@@ -3,7 +3,8 @@
 //! JSON Schema).
 //!
 //! * [`write`] serialises a bake (a [`BakeOutput`]) as .glb or .gltf + .bin;
-//! * [`read`] loads a baked file back into the same types.
+//! * [`read`] loads a baked file back into the same types, [`read_textures`] its embedded textures,
+//!   [`read_normal_sets`] both sets of vertex normals (crease-aware and enhanced) for the viewer's toggle.
 //!
 //! Invariant: this is the only crate that knows the file format. The extension is listed in
 //! `extensionsUsed` and never in `extensionsRequired`, so any glTF viewer opens the result as a plain
@@ -15,13 +16,18 @@ mod reader;
 mod writer;
 
 pub use ext::{
-    BoxRecord, ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION,
-    GaussMapRecord, GradientRecord, HardEdgeClass, InputInfo, MeshExtension, NodeExtension, NormalsInfo, PartRecord,
-    PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord,
+    BoxRecord, CelTableRecord, CelTexture, ConeBvhRecord, CoolToWarmTexture, EDGE_VISIBILITY_EXTENSION,
+    ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION, GaussMapRecord, GradientRecord, GradientTexture,
+    HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture, NodeExtension, NormalsInfo, PartRecord,
+    PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef, TexturesRecord,
 };
-pub use reader::{BakedFile, read, read_scalars, split_container};
+pub use reader::{
+    BakedFile, EmbeddedPng, PrimitiveNormals, read, read_floats, read_normal_sets, read_scalars, read_textures,
+    split_container,
+};
 pub use writer::{
-    BakeOutput, ConeBvhData, Container, GaussMapData, MeshSilhouettes, PrimitiveEdges, VertexData, Written, write,
+    BakeOutput, ConeBvhData, Container, EmbeddedTextures, GaussMapData, MeshSilhouettes, PrimitiveEdges, SamplerDesc,
+    TextureImage, VertexData, Written, write,
 };
 
 /// `drafter <version>`, written as the generator.

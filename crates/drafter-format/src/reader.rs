@@ -1,9 +1,15 @@
 //! Reads a baked file back into the extension's types (the viewer and `drafter inspect` use it).
+//! [`read`] gives the extension's records (the root's `textures` holds the glTF texture indices of
+//! the baked lookups); [`read_textures`] gives those textures' PNG bytes.
 
 use serde_json::Value;
 
 use crate::FormatError;
-use crate::ext::{EXTENSION, NodeExtension, PartRecord, PrimitiveExtension, RootExtension};
+use crate::ext::{
+    EDGE_VISIBILITY_EXTENSION, EXTENSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension, RootExtension,
+    TexturesRecord,
+};
+use crate::writer::{ConeBvhData, GaussMapData, MeshSilhouettes, PrimitiveEdges};
 
 /// What a baked file carries in `DRAFTER_illustration`.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,6 +19,12 @@ pub struct BakedFile {
     pub nodes: Vec<(u32, NodeExtension)>,
     /// (mesh index, primitive index, part label per triangle), in mesh then primitive order.
     pub primitive_labels: Vec<(u32, u32, Vec<u32>)>,
+    /// (mesh index, primitive index, its edges): `EXT_mesh_primitive_edge_visibility` plus our
+    /// `hardEdgeClasses`, in mesh then primitive order. The same type the writer takes.
+    pub primitive_edges: Vec<(u32, u32, PrimitiveEdges)>,
+    /// (mesh index, its silhouette candidates and hierarchies), in mesh order. The same type the
+    /// writer takes; drafter-lines' `SilhouetteIndex::from_arrays` loads the arrays.
+    pub mesh_silhouettes: Vec<(u32, MeshSilhouettes)>,
 }
 
 impl BakedFile {
@@ -50,6 +62,74 @@ pub fn split_container(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), FormatErr
     Ok((json, bin))
 }
 
+/// The PNG bytes of one texture the extension refers to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EmbeddedPng {
+    /// glTF texture index (as in `root.textures`).
+    pub texture: u32,
+    /// The image's `name`.
+    pub name: String,
+    /// The PNG file's bytes.
+    pub png: Vec<u8>,
+}
+
+/// The PNG images of every texture `root.extensions.DRAFTER_illustration.textures` refers to, in the
+/// record's order (gradient, cel, cool-to-warm, hatching levels, metal bands, metal highlights);
+/// empty when the file has no textures. `external` loads a .gltf's buffer, as for [`read`].
+pub fn read_textures(
+    bytes: &[u8],
+    external: &dyn Fn(&str) -> Option<Vec<u8>>,
+) -> Result<Vec<EmbeddedPng>, FormatError> {
+    let (json, bin) = split_container(bytes)?;
+    let doc: Value = serde_json::from_slice(json)?;
+    let Some(record) = doc.pointer(&format!("/extensions/{EXTENSION}/textures")) else { return Ok(Vec::new()) };
+    let record: TexturesRecord = serde_json::from_value(record.clone())?;
+    let buffer = load_buffer(&doc, bin, external)?;
+    record
+        .indices()
+        .into_iter()
+        .map(|texture| {
+            let bad = |what: &str| FormatError::Invalid(format!("/textures/{texture}: {what}"));
+            let source = doc
+                .pointer(&format!("/textures/{texture}/source"))
+                .and_then(Value::as_u64)
+                .ok_or_else(|| bad("missing, or no source"))?;
+            let image = doc.pointer(&format!("/images/{source}")).ok_or_else(|| bad("image missing"))?;
+            if image.get("mimeType").and_then(Value::as_str) != Some("image/png") {
+                return Err(bad("image is not image/png"));
+            }
+            let view = image.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("image has no bufferView"))?;
+            let view = doc.pointer(&format!("/bufferViews/{view}")).ok_or_else(|| bad("bufferView missing"))?;
+            let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+            let length = view.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad("no byteLength"))? as usize;
+            let png = buffer
+                .as_deref()
+                .and_then(|b| b.get(start..start.checked_add(length)?))
+                .ok_or_else(|| bad("image bytes outside the buffer"))?
+                .to_vec();
+            let name = image.get("name").and_then(Value::as_str).unwrap_or_default().to_owned();
+            Ok(EmbeddedPng { texture, name, png })
+        })
+        .collect()
+}
+
+/// The bytes of the single buffer: the .glb's BIN chunk or the .gltf's external file.
+fn load_buffer(
+    doc: &Value,
+    bin: Option<&[u8]>,
+    external: &dyn Fn(&str) -> Option<Vec<u8>>,
+) -> Result<Option<Vec<u8>>, FormatError> {
+    Ok(match doc.get("buffers").and_then(|b| b.get(0)) {
+        Some(b) => match b.get("uri").and_then(Value::as_str) {
+            Some(uri) => {
+                Some(external(uri).ok_or_else(|| FormatError::Invalid(format!("cannot load buffer {uri:?}")))?)
+            }
+            None => bin.map(<[u8]>::to_vec),
+        },
+        None => None,
+    })
+}
+
 /// Reads a baked .glb, or a .gltf whose buffer `external` returns (given the buffer's URI).
 pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<BakedFile, FormatError> {
     let (json, bin) = split_container(bytes)?;
@@ -59,56 +139,141 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
         .and_then(|e| e.get(EXTENSION))
         .ok_or_else(|| FormatError::NotBaked(format!("no {EXTENSION} extension on the root")))?;
     let root: RootExtension = serde_json::from_value(root_value.clone())?;
-    let buffer: Option<Vec<u8>> = match doc.get("buffers").and_then(|b| b.get(0)) {
-        Some(b) => match b.get("uri").and_then(Value::as_str) {
-            Some(uri) => {
-                Some(external(uri).ok_or_else(|| FormatError::Invalid(format!("cannot load buffer {uri:?}")))?)
-            }
-            None => bin.map(<[u8]>::to_vec),
-        },
-        None => None,
-    };
+    let buffer = load_buffer(&doc, bin, external)?;
     let mut nodes = Vec::new();
     for (i, node) in doc.get("nodes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
         if let Some(ext) = node.get("extensions").and_then(|e| e.get(EXTENSION)) {
             nodes.push((i as u32, serde_json::from_value::<NodeExtension>(ext.clone())?));
         }
     }
+    let data = || buffer.as_deref().ok_or_else(|| FormatError::Invalid("accessors but no buffer".into()));
     let mut primitive_labels = Vec::new();
+    let mut primitive_edges = Vec::new();
+    let mut mesh_silhouettes = Vec::new();
     for (m, mesh) in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
         for (p, prim) in
             mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate()
         {
-            let Some(ext) = prim.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
-            let ext: PrimitiveExtension = serde_json::from_value(ext.clone())?;
-            if let Some(accessor) = ext.part_labels {
-                let data = buffer.as_deref().ok_or_else(|| FormatError::Invalid("labels but no buffer".into()))?;
-                primitive_labels.push((m as u32, p as u32, read_scalars(&doc, accessor as usize, data)?));
+            let extensions = prim.get("extensions");
+            let ours = match extensions.and_then(|e| e.get(EXTENSION)) {
+                Some(ext) => Some(serde_json::from_value::<PrimitiveExtension>(ext.clone())?),
+                None => None,
+            };
+            if let Some(accessor) = ours.as_ref().and_then(|e| e.part_labels) {
+                primitive_labels.push((m as u32, p as u32, read_scalars(&doc, accessor as usize, data()?)?));
+            }
+            if let Some(edges) = extensions.and_then(|e| e.get(EDGE_VISIBILITY_EXTENSION)) {
+                let accessor = |key: &str| edges.get(key).and_then(Value::as_u64).map(|a| a as usize);
+                let bad = |what: &str| FormatError::Invalid(format!("/meshes/{m}/primitives/{p}: {what}"));
+                let visibility = accessor("visibility").ok_or_else(|| bad("edge visibility without `visibility`"))?;
+                let narrow = |values: Vec<u32>, what: &str| -> Result<Vec<u8>, FormatError> {
+                    values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
+                };
+                let silhouette_normals = match accessor("silhouetteNormals") {
+                    Some(a) => read_scalars(&doc, a, data()?)?
+                        .into_iter()
+                        .map(|v| u16::try_from(v).map_err(|_| bad("silhouetteNormals above 16 bits")))
+                        .collect::<Result<_, _>>()?,
+                    None => Vec::new(),
+                };
+                let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
+                    Some(a) => narrow(read_scalars(&doc, a as usize, data()?)?, "hardEdgeClasses above 8 bits")?,
+                    None => Vec::new(),
+                };
+                primitive_edges.push((
+                    m as u32,
+                    p as u32,
+                    PrimitiveEdges {
+                        visibility: narrow(read_scalars(&doc, visibility, data()?)?, "visibility above 8 bits")?,
+                        silhouette_normals,
+                        hard_edge_classes,
+                    },
+                ));
             }
         }
+        let Some(ext) = mesh.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
+        let ext: MeshExtension = serde_json::from_value(ext.clone())?;
+        if let Some(s) = ext.silhouettes {
+            let data = data()?;
+            let u32s = |a: u32| read_scalars(&doc, a as usize, data);
+            let f32s = |a: u32| read_floats(&doc, a as usize, data);
+            let silhouettes = MeshSilhouettes {
+                candidate_corners: u32s(s.candidate_corners)?,
+                candidate_normals: f32s(s.candidate_normals)?,
+                orthographic: s.orthographic,
+                perspective: s.perspective,
+                gauss_map: match s.gauss_map {
+                    Some(g) => Some(GaussMapData {
+                        base: g.base,
+                        max_depth: g.max_depth,
+                        node_caps: f32s(g.node_caps)?,
+                        nodes: u32s(g.nodes)?,
+                        order: u32s(g.order)?,
+                    }),
+                    None => None,
+                },
+                cone_bvh: match s.cone_bvh {
+                    Some(b) => Some(ConeBvhData {
+                        node_boxes: f32s(b.node_boxes)?,
+                        node_cones: f32s(b.node_cones)?,
+                        nodes: u32s(b.nodes)?,
+                        order: u32s(b.order)?,
+                    }),
+                    None => None,
+                },
+            };
+            if silhouettes.candidate_corners.len() != s.candidates as usize
+                || silhouettes.candidate_normals.len() != 6 * s.candidates as usize
+            {
+                return Err(FormatError::Invalid(format!(
+                    "/meshes/{m}: {} candidates, but {} corners and {} normal components",
+                    s.candidates,
+                    silhouettes.candidate_corners.len(),
+                    silhouettes.candidate_normals.len()
+                )));
+            }
+            mesh_silhouettes.push((m as u32, silhouettes));
+        }
     }
-    Ok(BakedFile { root, nodes, primitive_labels })
+    Ok(BakedFile { root, nodes, primitive_labels, primitive_edges, mesh_silhouettes })
+}
+
+/// The bytes of a tightly packed SCALAR accessor with components of `size` bytes.
+fn accessor_bytes<'a>(doc: &Value, accessor: usize, buffer: &'a [u8], size: usize) -> Result<&'a [u8], FormatError> {
+    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
+    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
+    let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
+    let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
+    let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))? as usize;
+    let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize
+        + a.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+    count
+        .checked_mul(size)
+        .and_then(|n| buffer.get(start..start.checked_add(n)?))
+        .ok_or_else(|| bad("data outside the buffer"))
+}
+
+/// Reads a FLOAT SCALAR accessor (tightly packed) from the single buffer.
+pub fn read_floats(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<f32>, FormatError> {
+    let component = doc.get("accessors").and_then(|a| a.get(accessor)).and_then(|a| a.get("componentType"));
+    if component.and_then(Value::as_u64) != Some(5126) {
+        return Err(FormatError::Invalid(format!("/accessors/{accessor}: not a FLOAT accessor")));
+    }
+    let bytes = accessor_bytes(doc, accessor, buffer, 4)?;
+    Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
 }
 
 /// Reads an unsigned SCALAR accessor (tightly packed) from the single buffer.
 pub fn read_scalars(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<u32>, FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
     let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
-    let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
-    let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))? as usize;
     let size = match a.get("componentType").and_then(Value::as_u64) {
         Some(5121) => 1,
         Some(5123) => 2,
         Some(5125) => 4,
         _ => return Err(bad("not an unsigned integer type")),
     };
-    let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize
-        + a.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-    let bytes = count
-        .checked_mul(size)
-        .and_then(|n| buffer.get(start..start.checked_add(n)?))
-        .ok_or_else(|| bad("data outside the buffer"))?;
+    let bytes = accessor_bytes(doc, accessor, buffer, size)?;
     Ok(bytes
         .chunks_exact(size)
         .map(|c| match size {
@@ -116,5 +281,90 @@ pub fn read_scalars(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<u
             2 => u16::from_le_bytes([c[0], c[1]]) as u32,
             _ => u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
         })
+        .collect())
+}
+
+/// The two sets of vertex normals of one primitive of a baked file (the paper's toggle, Cignoni et
+/// al. 2005): one entry per vertex of the primitive, in its vertex order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrimitiveNormals {
+    pub mesh: u32,
+    pub primitive: u32,
+    /// The crease-aware normals of the original shading.
+    pub normals: Vec<[f32; 3]>,
+    /// The enhanced normals.
+    pub enhanced: Vec<[f32; 3]>,
+}
+
+/// Both normal sets of every primitive that declares an enhanced-normal attribute
+/// (`DRAFTER_illustration.enhancedNormal`, normally `_ENHANCED_NORMAL`), in mesh then primitive
+/// order, sorted out by the root's `normals.enhancedInNormal` (when true, `NORMAL` holds the enhanced
+/// set and the attribute the crease-aware one). Empty for a file baked without normals.
+/// `external` loads a .gltf's buffer, as for [`read`].
+pub fn read_normal_sets(
+    bytes: &[u8],
+    external: &dyn Fn(&str) -> Option<Vec<u8>>,
+) -> Result<Vec<PrimitiveNormals>, FormatError> {
+    let (json, bin) = split_container(bytes)?;
+    let doc: Value = serde_json::from_slice(json)?;
+    let root_value = doc
+        .get("extensions")
+        .and_then(|e| e.get(EXTENSION))
+        .ok_or_else(|| FormatError::NotBaked(format!("no {EXTENSION} extension on the root")))?;
+    let root: RootExtension = serde_json::from_value(root_value.clone())?;
+    let swapped = root.normals.as_ref().is_some_and(|n| n.enhanced_in_normal);
+    let mut buffer = None;
+    let mut sets = Vec::new();
+    for (m, mesh) in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
+        for (p, prim) in
+            mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate()
+        {
+            let Some(ext) = prim.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
+            let ext: PrimitiveExtension = serde_json::from_value(ext.clone())?;
+            let Some(name) = ext.enhanced_normal else { continue };
+            let bad = |what: &str| FormatError::Invalid(format!("/meshes/{m}/primitives/{p}: {what}"));
+            let attribute = |key: &str| {
+                prim.get("attributes")
+                    .and_then(|a| a.get(key))
+                    .and_then(Value::as_u64)
+                    .ok_or_else(|| bad(&format!("enhancedNormal names {name}, but the primitive has no {key}")))
+            };
+            let (normal_accessor, other_accessor) = (attribute("NORMAL")?, attribute(&name)?);
+            if buffer.is_none() {
+                buffer = Some(
+                    load_buffer(&doc, bin, external)?
+                        .ok_or_else(|| FormatError::Invalid("accessors but no buffer".into()))?,
+                );
+            }
+            let data = buffer.as_deref().unwrap_or_default();
+            let normal = read_vec3s(&doc, normal_accessor as usize, data)?;
+            let other = read_vec3s(&doc, other_accessor as usize, data)?;
+            if normal.len() != other.len() {
+                return Err(bad(&format!("NORMAL has {} entries but {name} has {}", normal.len(), other.len())));
+            }
+            let (normals, enhanced) = if swapped { (other, normal) } else { (normal, other) };
+            sets.push(PrimitiveNormals { mesh: m as u32, primitive: p as u32, normals, enhanced });
+        }
+    }
+    Ok(sets)
+}
+
+/// Reads a FLOAT VEC3 accessor (tightly packed, or with a 12-byte stride) from the single buffer.
+fn read_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[f32; 3]>, FormatError> {
+    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
+    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
+    if a.get("componentType").and_then(Value::as_u64) != Some(5126)
+        || a.get("type").and_then(Value::as_str) != Some("VEC3")
+    {
+        return Err(bad("not a FLOAT VEC3 accessor"));
+    }
+    let view = a.get("bufferView").and_then(Value::as_u64).and_then(|v| doc.get("bufferViews")?.get(v as usize));
+    if view.and_then(|v| v.get("byteStride")).and_then(Value::as_u64).is_some_and(|s| s != 12) {
+        return Err(bad("interleaved (byteStride other than 12)"));
+    }
+    let bytes = accessor_bytes(doc, accessor, buffer, 12)?;
+    Ok(bytes
+        .chunks_exact(12)
+        .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
         .collect())
 }

@@ -13,7 +13,7 @@ use crate::FormatError;
 use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER, UNSIGNED_BYTE, UNSIGNED_INT, UNSIGNED_SHORT};
 use crate::ext::{
     ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, GaussMapRecord, MeshExtension,
-    NodeExtension, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord,
+    NodeExtension, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord, TexturesRecord,
 };
 
 /// Everything a bake produced, ready to write.
@@ -31,6 +31,62 @@ pub struct BakeOutput<'a> {
     pub primitive_edges: Vec<Vec<Option<PrimitiveEdges>>>,
     /// For each scene mesh, its silhouette candidates and hierarchies.
     pub mesh_silhouettes: Vec<Option<MeshSilhouettes>>,
+    /// The NPR lookup textures to embed (`None`: none).
+    pub textures: Option<EmbeddedTextures>,
+}
+
+/// PNG images to embed and the extension's record of them. The record's indices are positions in
+/// `images`; the writer appends the images after the input's own `images`/`textures` and rewrites
+/// the indices to the glTF texture indices. Every image must be referenced exactly once (an
+/// unreferenced texture would be an unused object).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EmbeddedTextures {
+    pub record: TexturesRecord,
+    pub images: Vec<TextureImage>,
+}
+
+/// One PNG image with the sampler it is read with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureImage {
+    /// Written as the image's and the texture's `name`.
+    pub name: String,
+    /// The PNG file's bytes.
+    pub png: Vec<u8>,
+    pub sampler: SamplerDesc,
+}
+
+/// How a texture is sampled; written as a glTF `sampler` (identical ones are shared).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SamplerDesc {
+    /// `true`: `REPEAT` in u; `false`: `CLAMP_TO_EDGE`.
+    pub repeat_u: bool,
+    /// The same in v.
+    pub repeat_v: bool,
+    /// `true`: `LINEAR` magnification; `false`: `NEAREST`.
+    pub linear: bool,
+    /// `true`: minification filters between mip levels (`LINEAR_MIPMAP_LINEAR` or
+    /// `NEAREST_MIPMAP_NEAREST`); `false`: within the image only.
+    pub mipmaps: bool,
+}
+
+impl SamplerDesc {
+    /// The glTF sampler object.
+    fn to_json(self) -> Value {
+        const NEAREST: u32 = 9728;
+        const LINEAR: u32 = 9729;
+        const NEAREST_MIPMAP_NEAREST: u32 = 9984;
+        const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+        const CLAMP_TO_EDGE: u32 = 33071;
+        const REPEAT: u32 = 10497;
+        let wrap = |repeat: bool| if repeat { REPEAT } else { CLAMP_TO_EDGE };
+        let (mag, min) = match (self.linear, self.mipmaps) {
+            (true, true) => (LINEAR, LINEAR_MIPMAP_LINEAR),
+            (true, false) => (LINEAR, LINEAR),
+            (false, true) => (NEAREST, NEAREST_MIPMAP_NEAREST),
+            (false, false) => (NEAREST, NEAREST),
+        };
+        json!({"magFilter": mag, "minFilter": min, "wrapS": wrap(self.repeat_u), "wrapT": wrap(self.repeat_v)})
+    }
 }
 
 /// One primitive's edges: `EXT_mesh_primitive_edge_visibility` data plus the class of each hard
@@ -43,6 +99,29 @@ pub struct PrimitiveEdges {
     pub silhouette_normals: Vec<u16>,
     /// [`crate::ext::HardEdgeClass`] code of each edge encoded as 2, in encoding order.
     pub hard_edge_classes: Vec<u8>,
+}
+
+impl PrimitiveEdges {
+    /// The 2-bit value of triangle edge `slot` (`3·t + k`: edge v_k → v_(k+1) of the primitive's
+    /// triangle t), packed from the least significant bits; 0 past the end.
+    pub fn value(&self, slot: usize) -> u8 {
+        self.visibility.get(slot / 4).map_or(0, |b| (b >> (2 * (slot % 4))) & 3)
+    }
+
+    /// Every hard edge once: the slot encoded 2 and its class code (from `hard_edge_classes`, in
+    /// encoding order; 0 where the list is short). Slots encoded 3 repeat an edge and are skipped.
+    pub fn hard_edges(&self) -> impl Iterator<Item = (u32, u8)> + '_ {
+        (0..self.visibility.len() * 4)
+            .filter(|&slot| self.value(slot) == 2)
+            .enumerate()
+            .map(|(n, slot)| (slot as u32, self.hard_edge_classes.get(n).copied().unwrap_or(0)))
+    }
+
+    /// The slots encoded 1 (silhouette candidates), in encoding order: candidate i has the oct16
+    /// normals `silhouette_normals[2i..2i + 2]`.
+    pub fn silhouette_slots(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.visibility.len() * 4).filter(|&slot| self.value(slot) == 1).map(|slot| slot as u32)
+    }
 }
 
 /// A mesh's silhouette candidates and hierarchies, as flat arrays.
@@ -212,7 +291,11 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             extension_slot(mesh_json).insert(EXTENSION.into(), ext);
         }
     }
-    let root_ext = serde_json::to_value(&out.root)?;
+    let mut root = out.root.clone();
+    if let Some(textures) = &out.textures {
+        root.textures = Some(write_textures(&mut doc, textures)?);
+    }
+    let root_ext = serde_json::to_value(&root)?;
     let root = doc.json.entry("extensions").or_insert_with(|| json!({}));
     if let Value::Object(map) = root {
         map.insert(EXTENSION.into(), root_ext);
@@ -229,6 +312,50 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             Ok(Written { main, bin: Some(bin), notes })
         }
     }
+}
+
+/// Appends the PNG images (buffer views), their samplers and textures after the document's own,
+/// and returns the record with glTF texture indices.
+fn write_textures(doc: &mut Doc, textures: &EmbeddedTextures) -> Result<TexturesRecord, FormatError> {
+    let mut record = textures.record.clone();
+    let mut referenced = vec![0usize; textures.images.len()];
+    for &i in &record.indices() {
+        let slot = referenced
+            .get_mut(i as usize)
+            .ok_or_else(|| FormatError::Inconsistent(format!("texture record refers to missing image {i}")))?;
+        *slot += 1;
+    }
+    if let Some(i) = referenced.iter().position(|&n| n != 1) {
+        return Err(FormatError::Inconsistent(format!(
+            "embedded image {i} is referenced {} times, not once",
+            referenced[i]
+        )));
+    }
+    let image_base = doc.array("images").len();
+    let texture_base = doc.array("textures").len();
+    let sampler_base = doc.array("samplers").len();
+    let mut samplers: Vec<SamplerDesc> = Vec::new();
+    for (i, image) in textures.images.iter().enumerate() {
+        let view = doc.push_view(&image.png, None, None);
+        doc.array_mut("images").push(json!({"bufferView": view, "mimeType": "image/png", "name": image.name}));
+        let sampler = match samplers.iter().position(|s| *s == image.sampler) {
+            Some(s) => s,
+            None => {
+                samplers.push(image.sampler);
+                doc.array_mut("samplers").push(image.sampler.to_json());
+                samplers.len() - 1
+            }
+        };
+        doc.array_mut("textures").push(json!({
+            "sampler": sampler_base + sampler,
+            "source": image_base + i,
+            "name": image.name
+        }));
+    }
+    for index in record.indices_mut() {
+        *index += texture_base as u32;
+    }
+    Ok(record)
 }
 
 /// Replaces a primitive's vertex attributes and indices by the new layout of `vd`, restricted to

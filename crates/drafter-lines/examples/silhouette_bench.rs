@@ -9,8 +9,8 @@
 //! brute-force ns/view on one thread (and M candidates/s), hierarchy ns/view, speedup, mean
 //! silhouette count and the number of views whose sets differ, for random orthographic directions
 //! and for random eyes outside the bounding box; then what the [`SilhouetteIndex`] chose and the
-//! Gauss-map per-level histogram (Table 2 style). Each view runs every method three times in turn
-//! and keeps the fastest of each (the machines are shared).
+//! Gauss-map per-level histogram (Table 2 style). Timing warm and cold as in
+//! [`drafter_lines::measure`]; `drafter bench silhouettes` measures any model the same way.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use common::*;
 use drafter_core::{PartId, Topology, Weld};
+use drafter_lines::measure::{Warmth, time_per_view};
 use drafter_lines::*;
 use glam::Vec3;
 
@@ -85,47 +86,6 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-/// Nanoseconds per view of each of `methods` over `views`, "warm": for every view each method runs
-/// three times in a row and its fastest run counts (as in an interactive loop, where consecutive
-/// frames see nearly the same view). Per-view minima make the figure robust to preemption on
-/// this shared machine.
-fn time_per_view_warm<const N: usize>(views: &[View], methods: [&dyn Fn(View); N]) -> [f64; N] {
-    let mut total = [0f64; N];
-    for &v in views {
-        for (k, m) in methods.iter().enumerate() {
-            let mut best = f64::INFINITY;
-            for _ in 0..3 {
-                let t = Instant::now();
-                m(v);
-                best = best.min(t.elapsed().as_nanos() as f64);
-            }
-            total[k] += best;
-        }
-    }
-    total.map(|t| t / views.len().max(1) as f64)
-}
-
-/// Nanoseconds per view of each of `methods` over `views`: every view runs every method in turn,
-/// three times, and keeps each method's fastest run, "cold": each run starts with the caches
-/// holding the previous method's data, the worst case for a hierarchy that jumps around in memory.
-fn time_per_view_interleaved<const N: usize>(views: &[View], methods: [&dyn Fn(View); N]) -> [f64; N] {
-    let mut total = [0f64; N];
-    for &v in views {
-        let mut best = [f64::INFINITY; N];
-        for _ in 0..3 {
-            for (k, m) in methods.iter().enumerate() {
-                let t = Instant::now();
-                m(v);
-                best[k] = best[k].min(t.elapsed().as_nanos() as f64);
-            }
-        }
-        for k in 0..N {
-            total[k] += best[k];
-        }
-    }
-    total.map(|t| t / views.len().max(1) as f64)
-}
-
 struct Row {
     mode: &'static str,
     brute_ns: f64,
@@ -157,18 +117,17 @@ fn measure(
         total += a.count();
         mismatches += usize::from(a != b);
     }
-    let a = std::cell::RefCell::new(a);
-    let b = std::cell::RefCell::new(b);
-    let [brute_ns, brute_parallel_ns, hierarchy_ns] = time_per_view_warm(
-        views,
-        [&|v| brute.query_serial(v, &mut a.borrow_mut()), &|v| brute.query(v, &mut a.borrow_mut()), &|v| {
-            hierarchy(v, &mut b.borrow_mut())
-        }],
-    );
-    let [brute_cold_ns, hierarchy_cold_ns] = time_per_view_interleaved(
-        views,
-        [&|v| brute.query_serial(v, &mut a.borrow_mut()), &|v| hierarchy(v, &mut b.borrow_mut())],
-    );
+    let warm = time_per_view(views.len(), 3, Warmth::Warm, |k, v| match k {
+        0 => brute.query_serial(views[v], &mut a),
+        1 => brute.query(views[v], &mut a),
+        _ => hierarchy(views[v], &mut b),
+    });
+    let (brute_ns, brute_parallel_ns, hierarchy_ns) = (warm[0], warm[1], warm[2]);
+    let cold = time_per_view(views.len(), 2, Warmth::Cold, |k, v| match k {
+        0 => brute.query_serial(views[v], &mut a),
+        _ => hierarchy(views[v], &mut b),
+    });
+    let (brute_cold_ns, hierarchy_cold_ns) = (cold[0], cold[1]);
     let n = views.len().max(1);
     counts.nodes_entered /= n;
     counts.bounds_tested /= n;

@@ -205,17 +205,35 @@ impl OrthoBlocks {
 
     /// The orthographic predicate on blocks `b0..b1`; hits set their storage positions in `out`.
     #[inline]
-    pub fn test(&self, b0: usize, b1: usize, u: Vec3, out: &mut [u64]) {
+    pub fn test(&self, b0: usize, b1: usize, u: Vec3, out: &mut [u64], dirty: &mut Vec<u32>) {
         let (ux, uy, uz) = (Vec4::splat(u.x), Vec4::splat(u.y), Vec4::splat(u.z));
         let Some(all) = self.quads.get(6 * b0..6 * b1) else { return };
+        // Hits gather in a register and go to memory once per word (16 blocks): ORing every
+        // block into `out` would chain each block's store to the next block's load.
+        let mut word = b0 / 16;
+        let mut bits = 0u64;
         for (k, r) in all.chunks_exact(6).enumerate() {
             let a = Vec4::from(r[0]) * ux + Vec4::from(r[1]) * uy + Vec4::from(r[2]) * uz;
             let c = Vec4::from(r[3]) * ux + Vec4::from(r[4]) * uy + Vec4::from(r[5]) * uz;
             let hit = (a.cmplt(Vec4::ZERO) & c.cmpgt(Vec4::ZERO)) | (a.cmpgt(Vec4::ZERO) & c.cmplt(Vec4::ZERO));
-            let position = 4 * (b0 + k);
-            if let Some(w) = out.get_mut(position / 64) {
-                *w |= u64::from(hit.bitmask()) << (position % 64);
+            let block = b0 + k;
+            bits |= u64::from(hit.bitmask()) << (4 * (block % 16));
+            if block % 16 == 15 {
+                if bits != 0
+                    && let Some(w) = out.get_mut(word)
+                {
+                    *w |= bits;
+                    dirty.push(word as u32);
+                }
+                word += 1;
+                bits = 0;
             }
+        }
+        if bits != 0
+            && let Some(w) = out.get_mut(word)
+        {
+            *w |= bits;
+            dirty.push(word as u32);
         }
     }
 }
@@ -471,8 +489,10 @@ mod tests {
             let u = unit_direction(d).unwrap();
             let mut positions = vec![0u64; n.div_ceil(64)];
             let nb = n.div_ceil(4);
-            blocks.test(0, nb / 2, u, &mut positions);
-            blocks.test(nb / 2, nb, u, &mut positions);
+            let mut dirty = Vec::new();
+            blocks.test(0, nb / 2, u, &mut positions, &mut dirty);
+            blocks.test(nb / 2, nb, u, &mut positions, &mut dirty);
+            assert!(positions.iter().enumerate().all(|(w, &x)| x == 0 || dirty.contains(&(w as u32))));
             brute.query_serial(View::Orthographic { direction: d }, &mut serial);
             let mapped: Vec<u32> =
                 (0..n).filter(|&k| positions[k / 64] >> (k % 64) & 1 == 1).map(|k| order[k]).collect::<Vec<_>>();

@@ -241,11 +241,9 @@ pub struct GaussMapArrays {
 pub struct GaussMapHierarchy {
     base: BaseSolid,
     max_depth: u8,
-    /// What a query reads about nodes.
-    nodes: Vec<GaussNode>,
-    /// Caps as structure of arrays (x, y, z, threshold), padded with 4 culled entries, so that
+    /// What a query reads about nodes, each with its cap, padded with 4 culled entries so that
     /// the up to 4 children of a node are tested in one SIMD pass.
-    cap_soa: [Vec<f32>; 4],
+    nodes: Vec<GaussNode>,
     /// The most nodes at one depth (sizes the walk's level buffers).
     widest: usize,
     /// The arcs in storage order, in blocks of 4.
@@ -261,10 +259,14 @@ pub struct GaussMapHierarchy {
     predicted_ns: f64,
 }
 
-/// A node as the query reads it.
+/// A node as the query reads it: its cap next to its record, 32 bytes, so that testing a node's
+/// children touches 2 cache lines (caps as 4 separate arrays touched 4 to 8, and the records
+/// another 1 or 2 at the next level).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 struct GaussNode {
+    /// Centre x, y, z and threshold `sin r + ε` (see the module docs).
+    cap: Vec4,
     first_child: u32,
     child_count: u32,
     /// The blocks covering the own arcs (the partial blocks at both ends also hold arcs of
@@ -276,29 +278,28 @@ struct GaussNode {
 /// What a query reads, built from the serialised form.
 struct Assembled {
     nodes: Vec<GaussNode>,
-    cap_soa: [Vec<f32>; 4],
     widest: usize,
     blocks: OrthoBlocks,
 }
 
 /// Query records, cap arrays and blocks of a breadth-first tree.
 fn assemble(flat: &[[u32; 4]], caps: &[[f32; 4]], order: &[u32], normals: &[[Vec3; 2]]) -> Assembled {
-    let nodes = flat
+    let mut nodes: Vec<GaussNode> = flat
         .iter()
-        .map(|&[first_child, child_count, start, end]| GaussNode {
+        .zip(caps)
+        .map(|(&[first_child, child_count, start, end], &cap)| GaussNode {
+            cap: Vec4::from(cap),
             first_child,
             child_count,
             block_start: start / 4,
             block_end: if end > start { end.div_ceil(4) } else { start / 4 },
         })
         .collect();
-    let mut cap_soa: [Vec<f32>; 4] = Default::default();
-    for (k, a) in cap_soa.iter_mut().enumerate() {
-        a.extend(caps.iter().map(|c| c[k]));
-        // Padding: threshold -1 is culled by any finite direction (and masked off anyway).
-        a.extend(std::iter::repeat_n(if k == 3 { -1.0 } else { 0.0 }, 4));
-    }
-    Assembled { nodes, cap_soa, widest: widest_level(flat), blocks: OrthoBlocks::new(order, normals) }
+    // Padding: threshold -1 is culled by any finite direction (and masked off anyway).
+    let pad =
+        GaussNode { cap: Vec4::new(0.0, 0.0, 0.0, -1.0), first_child: 0, child_count: 0, block_start: 0, block_end: 0 };
+    nodes.extend(std::iter::repeat_n(pad, 4));
+    Assembled { nodes, widest: widest_level(flat), blocks: OrthoBlocks::new(order, normals) }
 }
 
 /// Fixed view directions for estimating a hierarchy's cost (a Fibonacci sphere).
@@ -382,27 +383,45 @@ pub(crate) fn base_cells(base: BaseSolid) -> Vec<Cell> {
     cells
 }
 
-/// The cell at `level` containing `p` (descending by the most-inside child), as
-/// `base · 4^level + child digits` (most significant first).
-pub(crate) fn cell_key(p: DVec3, base: &[Cell], level: u8) -> u32 {
+/// Where the overlapping-bin rule stores the arc `n1`–`n2` (unit; zero for a degenerate face):
+/// the cells containing its midpoint, level after level, for as long as both endpoints lie in the
+/// cell's bin (the cap of `factor` circumradii around its centre), at most `level` splits below
+/// the base. Returns `(digits, cells)`: `cells` is how many cells the arc went down (0: it fits
+/// no base cell), `digits` the path as `base · 4^level + child digits` with unused digits 0.
+pub(crate) fn arc_path(n1: DVec3, n2: DVec3, base: &[Cell], level: u8, factor: f64) -> (u32, u8) {
+    let sum = n1 + n2;
+    if n1 == DVec3::ZERO || n2 == DVec3::ZERO || sum.length() <= 1e-9 {
+        return (0, 0);
+    }
+    let mid = sum.normalize();
+    let fits = |c: &Cell| {
+        let cos_bin = (c.cos_radius.clamp(-1.0, 1.0).acos() * factor.max(1.0)).min(std::f64::consts::PI).cos();
+        c.center.dot(n1) >= cos_bin && c.center.dot(n2) >= cos_bin
+    };
     let most_inside = |cells: &[Cell]| {
         cells
             .iter()
             .enumerate()
-            .map(|(k, c)| (k, c.score(p)))
+            .map(|(k, c)| (k, c.score(mid)))
             .fold((0, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
             .0
     };
     let b = most_inside(base);
-    let mut key = b as u32;
-    let mut cell = base[b];
+    if !fits(&base[b]) {
+        return (0, 0);
+    }
+    let (mut key, mut cells, mut cell) = (b as u32, 1u8, base[b]);
     for _ in 0..level {
         let children = cell.children();
         let k = most_inside(&children);
+        if !fits(&children[k]) {
+            break;
+        }
         key = key * 4 + k as u32;
+        cells += 1;
         cell = children[k];
     }
-    key
+    (key * 4u32.pow(u32::from(level + 1 - cells)), cells)
 }
 
 /// Unit endpoints and midpoint of an arc; `mid` is `None` for a zero or antipodal arc.
@@ -600,7 +619,6 @@ impl GaussMapHierarchy {
             base: options.base,
             max_depth,
             nodes: a.nodes,
-            cap_soa: a.cap_soa,
             widest: a.widest,
             blocks: a.blocks,
             identity: is_identity(&bfs_order),
@@ -675,13 +693,12 @@ impl GaussMapHierarchy {
     /// Bits of the nodes `first..first + 4` whose caps meet the great circle of `u`.
     #[inline(always)]
     fn meets4(&self, first: usize, u: Vec3) -> u32 {
-        let [x, y, z, t] = &self.cap_soa;
-        let r = first..first + 4;
-        let d = Vec4::from_slice(&x[r.clone()]) * u.x
-            + Vec4::from_slice(&y[r.clone()]) * u.y
-            + Vec4::from_slice(&z[r.clone()]) * u.z;
+        let Some(four) = self.nodes.get(first..first + 4) else { return 0 };
+        // Rows of the transpose: x, y, z and threshold of the 4 caps.
+        let m = glam::Mat4::from_cols(four[0].cap, four[1].cap, four[2].cap, four[3].cap).transpose();
+        let d = m.x_axis * u.x + m.y_axis * u.y + m.z_axis * u.z;
         // Culled iff |c·u| > threshold; NaN compares false and is entered.
-        d.abs().cmpgt(Vec4::from_slice(&t[r])).bitmask() ^ 0xF
+        d.abs().cmpgt(m.w_axis).bitmask() ^ 0xF
     }
 
     /// Answers in storage order (`into_storage_order`) go straight into `out`; otherwise through
@@ -691,10 +708,11 @@ impl GaussMapHierarchy {
         out.reset(self.len());
         let Some(u) = unit_direction(direction) else { return QueryCounts::default() };
         if self.identity {
-            return self.walk_into::<COUNT>(u, out.words_mut());
+            let (words, dirty) = out.words_and_dirty();
+            return self.walk_into::<COUNT>(u, words, dirty);
         }
         let mut storage = vec![0u64; self.len().div_ceil(64)];
-        let counts = self.walk_into::<COUNT>(u, &mut storage);
+        let counts = self.walk_into::<COUNT>(u, &mut storage, &mut Vec::new());
         for (w, &word) in storage.iter().enumerate() {
             let mut bits = word;
             while bits != 0 {
@@ -709,9 +727,9 @@ impl GaussMapHierarchy {
     /// Breadth-first walk: for the nodes of a level, test their children's caps (4 at a time)
     /// into the next level, then test their own arcs; hits set storage positions in `words`.
     #[inline]
-    fn walk_into<const COUNT: bool>(&self, u: Vec3, words: &mut [u64]) -> QueryCounts {
+    fn walk_into<const COUNT: bool>(&self, u: Vec3, words: &mut [u64], dirty: &mut Vec<u32>) -> QueryCounts {
         let mut counts = QueryCounts { bounds_tested: usize::from(COUNT), ..Default::default() };
-        if self.nodes.is_empty() || self.meets4(0, u) & 1 == 0 {
+        if self.flat.is_empty() || self.meets4(0, u) & 1 == 0 {
             return counts;
         }
         with_levels(self.widest + 4, |level, next| {
@@ -739,7 +757,7 @@ impl GaussMapHierarchy {
                 for &i in &level[..width] {
                     let n = &self.nodes[i as usize];
                     if n.block_start < n.block_end {
-                        self.blocks.test(n.block_start as usize, n.block_end as usize, u, words);
+                        self.blocks.test(n.block_start as usize, n.block_end as usize, u, words, dirty);
                         if COUNT {
                             let [_, _, start, end] = self.flat[i as usize];
                             counts.ranges += 1;
@@ -839,7 +857,6 @@ impl GaussMapHierarchy {
             base,
             max_depth,
             nodes: a.nodes,
-            cap_soa: a.cap_soa,
             widest: a.widest,
             blocks: a.blocks,
             identity: is_identity(&arrays.order),

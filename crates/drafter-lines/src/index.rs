@@ -234,6 +234,16 @@ impl SilhouetteIndex {
         }
     }
 
+    /// [`SilhouetteIndex::query`] on the calling thread only (brute force included): what a
+    /// benchmark compares with [`BruteForce::query_serial`].
+    pub fn query_serial(&self, view: View, out: &mut EdgeSet) {
+        match (view, &self.gauss, &self.bvh) {
+            (View::Orthographic { direction }, Some(g), _) => g.query(direction, out),
+            (View::Perspective { eye }, _, Some(b)) => b.query(eye, out),
+            _ => self.brute.query_serial(view, out),
+        }
+    }
+
     /// Topology edge ids of the members of `set`, increasing.
     pub fn edge_ids<'a>(&'a self, set: &'a EdgeSet) -> impl Iterator<Item = u32> + 'a {
         set.iter().filter_map(|c| self.candidate_edges.get(c as usize).copied())

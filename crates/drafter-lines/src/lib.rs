@@ -26,10 +26,11 @@
 //!    deepest cell whose overlapping bin holds it (Gooch et al. §5.1.2, Fig. 8, Table 2); each
 //!    node has a data-dependent bounding cap; a query enters only the nodes whose cap the view's
 //!    great circle meets. [`LevelHistogram`] is the paper's Table 2.
-//! 5. [`ConeBvh`] (perspective): candidates split by normal (Gauss-map cells), then an `obvhs`
-//!    BVH over their points, with a box and a normal cone per node and the exact anchored-cone
-//!    test (Sander et al. 2000, "Silhouette Clipping"; Johnson & Cohen 2001, "Spatialized Normal
-//!    Cone Hierarchies").
+//! 5. [`ConeBvh`] (perspective): candidates split by normal (the Gauss-map cell their arc is
+//!    stored in), then an `obvhs` BVH over their points stretched along the normal, with a box, a
+//!    normal cone and the range of face-plane offsets per node, culled by an exact plane-offset
+//!    test (anchored cones as in Sander et al. 2000, "Silhouette Clipping"; Johnson & Cohen 2001,
+//!    "Spatialized Normal Cone Hierarchies").
 //! 6. [`SilhouetteIndex`] builds the hierarchies, keeps each only if the [`CostModel`] predicts a
 //!    speedup of at least [`DEFAULT_MIN_SPEEDUP`] (none below [`DEFAULT_MIN_HIERARCHY_CANDIDATES`]),
 //!    says what it chose and why ([`HierarchyChoice`]), and converts to and from flat `u32`/`f32`
@@ -84,6 +85,7 @@ mod cost;
 mod error;
 mod gauss;
 mod index;
+pub mod measure;
 mod set;
 mod tree;
 mod visibility;

@@ -150,7 +150,15 @@ impl GBufferPass {
     }
 
     /// Clears the G-buffer and draws every batch once, instanced.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets, scene: &SceneGpu) {
+    /// Draws every batch of `scene`, with its enhanced normals when `enhanced_normals` is set and
+    /// the batch has them.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        scene: &SceneGpu,
+        enhanced_normals: bool,
+    ) {
         encoder.push_debug_group(LABEL);
         {
             let clear = Some(wgpu::Color::TRANSPARENT);
@@ -174,7 +182,7 @@ impl GBufferPass {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &scene.gbuffer_bind_group, &[]);
             for batch in &scene.batches {
-                pass.set_vertex_buffer(0, batch.vertices.slice(..));
+                pass.set_vertex_buffer(0, batch.vertices_for(enhanced_normals).slice(..));
                 pass.set_index_buffer(batch.indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..batch.index_count, 0, batch.instances.clone());
             }

@@ -1,5 +1,5 @@
 //! The render passes, in frame order (Lux et al. 2013, Algorithm 1, extended with Gooch et al.'s
-//! drop shadow): [`gbuffer`] → [`shadow`] → [`enhance`] → [`lines`] (hook) → [`display`]. Each pass
+//! drop shadow): [`gbuffer`] → [`shadow`] → [`enhance`] → [`display`] → [`lines`]. Each pass
 //! is one module with its WGSL beside it, owns its pipelines, and records its work inside a debug
 //! group named after it.
 

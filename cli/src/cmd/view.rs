@@ -1,0 +1,63 @@
+//! `drafter view FILE [--style S] [--size WxH] [--view AZ,EL] [--edges] [--lines] [--shadow S]
+//! [--ortho]`: the interactive window (winit). Drag turns the object, the wheel zooms, right or
+//! middle drag pans, `1`–`7`/`S` switch the style, `E`/`L`/`H` toggle edges, lines and the shadow,
+//! a click picks a part (printed and shown in the title), `P` saves a screenshot; see
+//! `drafter_viewer::window`. Without a display it fails with one line (exit code 2).
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use drafter_viewer::window::WindowError;
+use drafter_viewer::{Enhancements, RenderOptions, View};
+
+use crate::cmd::render::{ShadowArg, StyleArg, load};
+use crate::exit::BadInput;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The model to show: a baked .glb/.gltf, or any glTF, OBJ, STL, OFF, PLY.
+    pub file: PathBuf,
+    /// Shading style to start with.
+    #[arg(long, value_enum, default_value_t = StyleArg::Gradient)]
+    pub style: StyleArg,
+    /// Initial window size in pixels, WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = crate::cmd::render::parse_size)]
+    pub size: (u32, u32),
+    /// Initial view: azimuth and elevation in degrees.
+    #[arg(long, value_name = "AZ,EL", default_value = "35,25", value_parser = crate::cmd::render::parse_view, allow_hyphen_values = true)]
+    pub view: (f32, f32),
+    /// Start with image-space edges on.
+    #[arg(long)]
+    pub edges: bool,
+    /// Start with the baked lines on.
+    #[arg(long)]
+    pub lines: bool,
+    /// Start with this drop shadow.
+    #[arg(long, value_enum, default_value_t = ShadowArg::None)]
+    pub shadow: ShadowArg,
+    /// Start with an orthographic camera.
+    #[arg(long)]
+    pub ortho: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let options = RenderOptions {
+        size: args.size,
+        style: args.style.into(),
+        view: View { azimuth_deg: args.view.0, elevation_deg: args.view.1 },
+        orthographic: args.ortho,
+        enhancements: if args.edges { Enhancements::ALL } else { Enhancements::default() },
+        lines: args.lines,
+        shadow: args.shadow.into(),
+        ..RenderOptions::default()
+    };
+    options.validate().map_err(BadInput)?;
+    let model = load(&args.file)?;
+    for notice in &model.notices {
+        eprintln!("  note: {notice}");
+    }
+    drafter_viewer::window::run(model, &args.file, options).map_err(|e| match e {
+        WindowError::NoDisplay(_) => anyhow::Error::from(BadInput(e.to_string())),
+        other => anyhow::Error::from(other),
+    })
+}

@@ -1,0 +1,22 @@
+//! `drafter view` without a display: one line on stderr, exit code 2, no panic (the window's event
+//! handling itself is unit-tested in `drafter_viewer::window`).
+
+mod common;
+
+#[test]
+fn view_without_a_display_fails_with_one_line() {
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb");
+    let out = common::drafter()
+        .args(["view", sample.to_str().expect("utf-8 path")])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .expect("drafter runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("drafter: error")).collect();
+    assert_eq!(errors.len(), 1, "stderr: {stderr}");
+    assert!(errors[0].contains("cannot open a window"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

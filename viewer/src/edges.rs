@@ -1,0 +1,333 @@
+//! The baked edges of a model, ready for the lines pass, and the per-frame silhouette query.
+//!
+//! # What a baked file gives
+//! Per glTF primitive, `EXT_mesh_primitive_edge_visibility` marks every triangle edge with 2 bits
+//! (0 hidden, 1 silhouette candidate, 2 hard edge, 3 hard edge already written) and our
+//! `hardEdgeClasses` gives each hard edge its class (crease, boundary, part border, non-manifold).
+//! Per mesh, `DRAFTER_illustration.silhouettes` lists every candidate as a triangle corner `3·t + k`
+//! with its two face normals in full precision, plus the hierarchies drafter-lines chose to store:
+//! a Gauss-map arc hierarchy for orthographic views and a normal-cone BVH for eye points (Gooch et
+//! al. 1999, §5.1; ../shared/papers/001_*). [`ModelLines::from_scene`] turns both into object-space
+//! segments; the hierarchies are loaded with drafter-lines' own `SilhouetteIndex::from_arrays`
+//! (which validates every bound), so their layout stays drafter-lines' business.
+//!
+//! # The query, per frame
+//! A silhouette edge is one whose two faces point to opposite sides of the eye: with `a = n1·w`,
+//! `b = n2·w` (`w` the view direction, or `e − v` from the edge's point `v` to the eye `e`) of
+//! strictly opposite signs. The test is invariant under the instance transform — `n` maps by the
+//! inverse transpose and `w` by the matrix, so `n_world·w_world = n_object·w_object`, and a mirror
+//! flips both normals, which keeps "opposite" — so each instance queries its mesh's index with the
+//! eye (or direction) taken into object space in f64 ([`instance_view`]), and gets exactly the set
+//! drafter-lines' brute force selects there. Instances whose object-space direction is bit-identical
+//! (translated copies under an orthographic camera) share one query.
+//!
+//! Limits: a mesh whose stored hierarchy does not validate against the file's candidates is
+//! queried by brute force (and [`ModelLines::notices`] says so); candidate points are the file's
+//! positions of each corner's first vertex, which the bake uses too.
+
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+use drafter_core::Scene;
+use drafter_format::{BakedFile, HardEdgeClass, MeshSilhouettes};
+use drafter_lines::{
+    BruteForceReason, ConeBvhArrays, EdgeSet, GaussMapArrays, HierarchyChoice, SilhouetteArrays, SilhouetteIndex,
+    View as LinesView,
+};
+use glam::{DMat4, DVec3, Vec3};
+
+use crate::gpu_types::LineSegmentGpu;
+
+/// Class of a drawn line (`lines.wgsl`: `CLASS_*`). Codes 1–4 are the file's `hardEdgeClasses`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum LineClass {
+    Crease = HardEdgeClass::Crease as u32,
+    Boundary = HardEdgeClass::Boundary as u32,
+    PartBorder = HardEdgeClass::PartBorder as u32,
+    NonManifold = HardEdgeClass::NonManifold as u32,
+    /// A silhouette of the current view.
+    Silhouette = 5,
+}
+
+impl LineClass {
+    /// The class of a `hardEdgeClasses` code; unknown codes are drawn as boundaries (black).
+    pub fn from_hard_code(code: u8) -> LineClass {
+        match code {
+            1 => LineClass::Crease,
+            3 => LineClass::PartBorder,
+            4 => LineClass::NonManifold,
+            _ => LineClass::Boundary,
+        }
+    }
+}
+
+/// One mesh's candidates: the loaded index and the object-space segment of each candidate.
+#[derive(Clone, Debug)]
+pub struct MeshSilhouetteLines {
+    pub index: SilhouetteIndex,
+    /// The corner `3·t + k` of each candidate, in the index's candidate order.
+    pub corners: Vec<u32>,
+    /// Object-space endpoints of each candidate, in the index's candidate order.
+    pub segments: Vec<[Vec3; 2]>,
+}
+
+/// The edges of one mesh and the instances that draw it.
+#[derive(Clone, Debug)]
+pub struct MeshLines {
+    /// Scene mesh index.
+    pub mesh: u32,
+    /// Range of [`crate::Model::instances`] drawing this mesh.
+    pub instances: Range<u32>,
+    /// Hard edges: object-space endpoints and class.
+    pub hard: Vec<([Vec3; 2], LineClass)>,
+    pub silhouettes: Option<MeshSilhouetteLines>,
+}
+
+/// Every mesh's edges, with what the per-frame query needs about the instances.
+#[derive(Clone, Debug, Default)]
+pub struct ModelLines {
+    pub meshes: Vec<MeshLines>,
+    /// Per model instance, the inverse of its `world_from_object` (f64).
+    pub object_from_world: Vec<DMat4>,
+    /// What could not be used as stored (one line each).
+    pub notices: Vec<String>,
+}
+
+/// Where the camera is, in world space, for the silhouette query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WorldView {
+    /// Central projection from this world point.
+    Perspective { eye: DVec3 },
+    /// Parallel projection along this world direction (either sign: the test is symmetric).
+    Orthographic { direction: DVec3 },
+}
+
+/// A silhouette the lines pass draws: which instance, and which candidate of its mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct DrawnSilhouette {
+    /// Index into [`crate::Model::instances`].
+    pub instance: u32,
+    /// Scene mesh index.
+    pub mesh: u32,
+    /// The candidate's corner `3·t + k` (edge v_k → v_(k+1) of mesh triangle t).
+    pub corner: u32,
+}
+
+/// One frame's silhouettes.
+#[derive(Clone, Debug, Default)]
+pub struct SilhouetteFrame {
+    /// What the lines pass uploads, one per drawn silhouette.
+    pub segments: Vec<LineSegmentGpu>,
+    /// The same edges by identity, in upload order.
+    pub drawn: Vec<DrawnSilhouette>,
+    /// Queries run (instances sharing an object-space direction share one).
+    pub queries: usize,
+    /// Wall time of the queries and of building the segment list.
+    pub elapsed: Duration,
+}
+
+/// The view in an instance's object space (see the module docs), rounded to f32 once.
+pub fn instance_view(view: WorldView, object_from_world: &DMat4) -> LinesView {
+    match view {
+        WorldView::Perspective { eye } => {
+            LinesView::Perspective { eye: object_from_world.transform_point3(eye).as_vec3() }
+        }
+        WorldView::Orthographic { direction } => {
+            LinesView::Orthographic { direction: object_from_world.transform_vector3(direction).as_vec3() }
+        }
+    }
+}
+
+impl ModelLines {
+    /// The edges of `scene` (the import of the baked file) from `baked`. `instance_meshes[i]` and
+    /// `world_from_object[i]` describe model instance `i`; instances of a mesh are contiguous.
+    pub fn from_scene(scene: &Scene, baked: &BakedFile, instance_meshes: &[u32], world_from_object: &[DMat4]) -> Self {
+        let mut notices = Vec::new();
+        let mut meshes = Vec::new();
+        let mut bad_slots = 0usize;
+        for (m, mesh) in scene.meshes.iter().enumerate() {
+            let first = instance_meshes.iter().position(|&x| x as usize == m);
+            let Some(first) = first else { continue };
+            let count = instance_meshes[first..].iter().take_while(|&&x| x as usize == m).count();
+            let instances = first as u32..(first + count) as u32;
+            let position = |t: usize, k: usize| -> Option<Vec3> {
+                let tri = mesh.triangles.get(t)?;
+                mesh.positions.get(tri[k % 3] as usize).copied()
+            };
+            let mut hard = Vec::new();
+            for (_, p, edges) in baked.primitive_edges.iter().filter(|(mm, _, _)| *mm as usize == m) {
+                let Some(group) = mesh.groups.iter().find(|g| g.primitive == Some(*p)) else {
+                    bad_slots += 1;
+                    continue;
+                };
+                for (slot, class) in edges.hard_edges() {
+                    let (t, k) = ((slot / 3) as usize, (slot % 3) as usize);
+                    if t >= group.count as usize {
+                        bad_slots += 1;
+                        continue;
+                    }
+                    let t = group.start as usize + t;
+                    match (position(t, k), position(t, k + 1)) {
+                        (Some(a), Some(b)) => hard.push(([a, b], LineClass::from_hard_code(class))),
+                        _ => bad_slots += 1,
+                    }
+                }
+            }
+            let silhouettes = baked
+                .mesh_silhouettes
+                .iter()
+                .find(|(mm, _)| *mm as usize == m)
+                .and_then(|(_, s)| load_silhouettes(m, s, &position, &mut notices));
+            if hard.is_empty() && silhouettes.is_none() {
+                continue;
+            }
+            meshes.push(MeshLines { mesh: m as u32, instances, hard, silhouettes });
+        }
+        if bad_slots > 0 {
+            notices.push(format!("{bad_slots} baked edges do not match the file's triangles: not drawn"));
+        }
+        let object_from_world = world_from_object
+            .iter()
+            .map(|w| if w.determinant().abs() > 1e-300 { w.inverse() } else { DMat4::IDENTITY })
+            .collect();
+        ModelLines { meshes, object_from_world, notices }
+    }
+
+    /// Whether the file had any edges to draw.
+    pub fn is_empty(&self) -> bool {
+        self.meshes.is_empty()
+    }
+
+    /// Hard edges of every instance, in render space coordinates of their instance (object-space
+    /// endpoints plus the instance index the shader transforms them with).
+    pub fn hard_segments(&self) -> Vec<LineSegmentGpu> {
+        let mut out = Vec::new();
+        for mesh in &self.meshes {
+            for instance in mesh.instances.clone() {
+                out.extend(mesh.hard.iter().map(|&([a, b], class)| LineSegmentGpu::new(a, b, instance, class)));
+            }
+        }
+        out
+    }
+
+    /// Candidates of every mesh (for reports).
+    pub fn candidate_count(&self) -> usize {
+        self.meshes.iter().filter_map(|m| m.silhouettes.as_ref()).map(|s| s.index.len()).sum()
+    }
+
+    /// The silhouettes of `view`: every instance of every mesh with candidates, queried in its
+    /// object space by the mesh's index (hierarchy or brute force, identical answers).
+    pub fn silhouettes(&self, view: WorldView) -> SilhouetteFrame {
+        let start = Instant::now();
+        let mut frame = SilhouetteFrame::default();
+        let mut set = EdgeSet::new(0);
+        for mesh in &self.meshes {
+            let Some(s) = &mesh.silhouettes else { continue };
+            let mut last: Option<LinesView> = None;
+            for instance in mesh.instances.clone() {
+                let object_from_world = self.object_from_world.get(instance as usize).unwrap_or(&DMat4::IDENTITY);
+                let local = instance_view(view, object_from_world);
+                // Translated copies see the same direction: reuse the answer.
+                let same = matches!((last, local), (Some(LinesView::Orthographic { direction: d0 }), LinesView::Orthographic { direction: d1 }) if d0.to_array().map(f32::to_bits) == d1.to_array().map(f32::to_bits));
+                if !same {
+                    set.reset(s.index.len());
+                    s.index.query(local, &mut set);
+                    frame.queries += 1;
+                }
+                last = Some(local);
+                for c in set.iter() {
+                    let [a, b] = s.segments[c as usize];
+                    frame.segments.push(LineSegmentGpu::new(a, b, instance, LineClass::Silhouette));
+                    frame.drawn.push(DrawnSilhouette { instance, mesh: mesh.mesh, corner: s.corners[c as usize] });
+                }
+            }
+        }
+        frame.elapsed = start.elapsed();
+        frame
+    }
+}
+
+/// The index of one mesh's stored candidates and hierarchies; `None` (with a notice) when the
+/// candidates do not match the mesh.
+fn load_silhouettes(
+    m: usize,
+    s: &MeshSilhouettes,
+    position: &dyn Fn(usize, usize) -> Option<Vec3>,
+    notices: &mut Vec<String>,
+) -> Option<MeshSilhouetteLines> {
+    let mut segments = Vec::with_capacity(s.candidate_corners.len());
+    for &corner in &s.candidate_corners {
+        let (t, k) = ((corner / 3) as usize, (corner % 3) as usize);
+        match (position(t, k), position(t, k + 1)) {
+            (Some(a), Some(b)) => segments.push([a, b]),
+            _ => {
+                notices
+                    .push(format!("mesh {m}: silhouette candidate corner {corner} is not a triangle edge: none drawn"));
+                return None;
+            }
+        }
+    }
+    // What answers each kind of view, as the file records it (node counts and predicted speedups
+    // are not stored; a mesh the bake gave no hierarchy reads as brute force by choice).
+    let none = HierarchyChoice::BruteForce(BruteForceReason::Disabled);
+    let orthographic = match (s.orthographic.as_str(), &s.gauss_map) {
+        ("gaussMap", Some(g)) => {
+            HierarchyChoice::GaussMap { max_depth: g.max_depth.min(255) as u8, nodes: 0, predicted_speedup: 0.0 }
+        }
+        _ => none,
+    };
+    let perspective = match (s.perspective.as_str(), &s.cone_bvh) {
+        ("coneBvh", Some(_)) => HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 },
+        _ => none,
+    };
+    let arrays = |gauss: bool, bvh: bool| SilhouetteArrays {
+        candidate_edges: s.candidate_corners.clone(),
+        candidate_normals: s.candidate_normals.clone(),
+        candidate_points: segments.iter().flat_map(|[a, _]| a.to_array()).collect(),
+        gauss_map: s.gauss_map.as_ref().filter(|_| gauss).map(|g| GaussMapArrays {
+            base: g.base,
+            max_depth: g.max_depth,
+            node_caps: g.node_caps.clone(),
+            nodes: g.nodes.clone(),
+            order: g.order.clone(),
+        }),
+        cone_bvh: s.cone_bvh.as_ref().filter(|_| bvh).map(|b| ConeBvhArrays {
+            node_boxes: b.node_boxes.clone(),
+            node_cones: b.node_cones.clone(),
+            nodes: b.nodes.clone(),
+            order: b.order.clone(),
+        }),
+        orthographic: if gauss { orthographic } else { none },
+        perspective: if bvh { perspective } else { none },
+    };
+    let index = match SilhouetteIndex::from_arrays(&arrays(true, true)) {
+        Ok(index) => index,
+        Err(e) => {
+            // Keep what validates; brute force answers the rest (same sets, slower).
+            let fallback = [(true, false), (false, true), (false, false)]
+                .into_iter()
+                .find_map(|(g, b)| SilhouetteIndex::from_arrays(&arrays(g, b)).ok().map(|i| (i, g, b)));
+            match fallback {
+                Some((index, g, b)) => {
+                    let dropped = match (g, b) {
+                        (true, false) => "cone BVH",
+                        (false, true) => "Gauss map",
+                        _ => "hierarchies",
+                    };
+                    notices.push(format!("mesh {m}: stored {dropped} does not validate ({e}): brute force instead"));
+                    index
+                }
+                None => {
+                    notices.push(format!("mesh {m}: silhouette candidates do not load ({e}): none drawn"));
+                    return None;
+                }
+            }
+        }
+    };
+    if index.len() != segments.len() {
+        notices.push(format!("mesh {m}: silhouette index and candidates disagree: none drawn"));
+        return None;
+    }
+    Some(MeshSilhouetteLines { index, corners: s.candidate_corners.clone(), segments })
+}
