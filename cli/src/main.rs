@@ -43,6 +43,8 @@ fn main() -> ExitCode {
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,
+        // The reader of our output stopped early (`| head`): not a failure.
+        Ok(Err(err)) if err.is::<cmd::StdoutClosed>() => ExitCode::SUCCESS,
         Ok(Err(err)) => exit::report(&err),
         Err(_) => {
             eprintln!("drafter: internal error (a panic, reported above); this is a bug");

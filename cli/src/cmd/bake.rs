@@ -5,6 +5,7 @@
 //! written atomically (a temporary file beside it, then a rename): a failed or interrupted bake
 //! leaves no partial output.
 
+use crate::cmd::out;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -165,7 +166,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     progress.finish();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&baked.report)?);
+        out!("{}", serde_json::to_string_pretty(&baked.report)?);
     }
 
     if !args.quiet {

@@ -10,6 +10,7 @@
 //! `illustration`, the full frame: gradient shading, edges, lines and a soft shadow. The CPU
 //! silhouette query of the line frames is timed on its own too (median per frame).
 
+use crate::cmd::out;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -191,9 +192,9 @@ fn render(args: RenderArgs) -> Result<()> {
         silhouette_query_ms: round3(silhouette_query_ms),
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!(
+        out!(
             "{}: {} triangles, {} parts, {}x{}, median of {} frames on {}",
             args.file.display(),
             report.triangles,
@@ -204,11 +205,14 @@ fn render(args: RenderArgs) -> Result<()> {
             report.device
         );
         for ((name, _), ms) in cases.iter().zip(&medians) {
-            println!("  {name:<13} {ms:8.2} ms  {:5.2}× phong", ms / phong);
+            out!("  {name:<13} {ms:8.2} ms  {:5.2}× phong", ms / phong);
         }
-        println!(
+        out!(
             "  lines: {} hard-edge segments, {} silhouettes of {} candidates; silhouette query {:.3} ms per frame (CPU, median)",
-            report.hard_edges, report.silhouettes, report.silhouette_candidates, report.silhouette_query_ms
+            report.hard_edges,
+            report.silhouettes,
+            report.silhouette_candidates,
+            report.silhouette_query_ms
         );
     }
     Ok(())
@@ -290,17 +294,21 @@ fn parts(args: PartsArgs) -> Result<()> {
         ratios,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!(
+        out!(
             "{} triangles as 10 or 1000 spheres, {}x{}, median of {} frames on {}",
-            report.triangles, args.size.0, args.size.1, args.frames, report.device
+            report.triangles,
+            args.size.0,
+            args.size.1,
+            args.frames,
+            report.device
         );
         for (name, row) in &report.cases {
-            println!("  {name:<12} {row}");
+            out!("  {name:<12} {row}");
         }
         for (name, ratio) in &report.ratios {
-            println!("  1000 / 10 parts, {name:<16} {ratio}×");
+            out!("  1000 / 10 parts, {name:<16} {ratio}×");
         }
     }
     Ok(())

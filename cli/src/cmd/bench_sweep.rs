@@ -5,6 +5,7 @@
 //! `DIR/bench.json` (`--png` adds PNG copies for a quick look). `--json` also prints the JSON;
 //! `--replot` redraws the charts from a saved `bench.json` (given as FILE) without measuring.
 
+use crate::cmd::out;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -73,7 +74,7 @@ pub fn run(args: Args) -> Result<()> {
         std::fs::create_dir_all(&args.out)
             .map_err(|e| BadInput(format!("{}: cannot create: {e}", args.out.display())))?;
         let written = drafter_bench::write_outputs(&report, &args.out, args.png)?;
-        println!("wrote {} in {}", written.join(", "), args.out.display());
+        out!("wrote {} in {}", written.join(", "), args.out.display());
         return Ok(());
     }
     let imported = drafter_io::import(&file)?;
@@ -101,30 +102,39 @@ pub fn run(args: Args) -> Result<()> {
         other => anyhow::Error::from(other),
     })?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print_summary(&report);
-        println!("wrote {} in {}", written.join(", "), args.out.display());
+        print_summary(&report)?;
+        out!("wrote {} in {}", written.join(", "), args.out.display());
     }
     Ok(())
 }
 
-fn print_summary(r: &sweep::SweepReport) {
-    println!(
+fn print_summary(r: &sweep::SweepReport) -> anyhow::Result<()> {
+    out!(
         "{}: {} triangles ({} unique), {} meshes, {} instances, {} threads",
-        r.model.name, r.model.triangles, r.model.unique_triangles, r.model.meshes, r.model.instances, r.threads
+        r.model.name,
+        r.model.triangles,
+        r.model.unique_triangles,
+        r.model.meshes,
+        r.model.instances,
+        r.threads
     );
-    println!("oriented boxes over {} of {} parts (one thread):", r.obb.measured_parts, r.obb.parts);
+    out!("oriented boxes over {} of {} parts (one thread):", r.obb.measured_parts, r.obb.parts);
     for m in &r.obb.methods {
-        println!(
+        out!(
             "  {:<8} {:9.3} ms/part (median {:.3})  volume {:.4}× best (worst {:.4}×)",
-            m.method, m.mean_ms, m.median_ms, m.mean_relative_volume, m.max_relative_volume
+            m.method,
+            m.mean_ms,
+            m.median_ms,
+            m.mean_relative_volume,
+            m.max_relative_volume
         );
     }
     let n = &r.normals;
-    println!("normal enhancement over {} faces, {} crease edges:", n.faces, n.crease_edges);
+    out!("normal enhancement over {} faces, {} crease edges:", n.faces, n.crease_edges);
     for p in n.by_iterations.iter().chain(&n.by_strength) {
-        println!(
+        out!(
             "  iterations {:3} k {:4.2}: {:9.1} ms, {:7.3}° from converged, {:5.1}% creases sharper ({:+.2}°)",
             p.iterations,
             p.strength,
@@ -135,12 +145,16 @@ fn print_summary(r: &sweep::SweepReport) {
         );
     }
     if let Some(s) = &r.silhouettes {
-        println!(
+        out!(
             "silhouettes on mesh {} ({} candidates), µs per view; stored: {}; {}; {} mismatches",
-            s.mesh, s.candidates, s.chosen_orthographic, s.chosen_perspective, s.mismatches
+            s.mesh,
+            s.candidates,
+            s.chosen_orthographic,
+            s.chosen_perspective,
+            s.mismatches
         );
         for row in &s.by_size {
-            println!(
+            out!(
                 "  {:8} edges: brute {:9.1} / {:9.1} persp, gauss {:8.1} (strict {:8.1}), cone BVH {:8.1}",
                 row.candidates,
                 row.brute_ortho_us,
@@ -152,15 +166,16 @@ fn print_summary(r: &sweep::SweepReport) {
         }
     }
     let g = &r.segmentation;
-    println!("segmentation: {} parts with the defaults", g.default_parts);
+    out!("segmentation: {} parts with the defaults", g.default_parts);
     for p in &g.by_region_angle {
-        println!("  region angle {:5.1}°: {:6} parts in {:8.1} ms", p.value, p.parts, p.ms);
+        out!("  region angle {:5.1}°: {:6} parts in {:8.1} ms", p.value, p.parts, p.ms);
     }
     for p in &g.by_merge_fraction {
-        println!("  merge below {:6.3}: {:6} parts in {:8.1} ms", p.value, p.parts, p.ms);
+        out!("  merge below {:6.3}: {:6} parts in {:8.1} ms", p.value, p.parts, p.ms);
     }
     let b = &r.bake;
     let stages: Vec<String> = b.stages.iter().map(|(n, ms)| format!("{n} {ms:.0}")).collect();
     let bytes: Vec<String> = b.bytes.iter().map(|(n, v)| format!("{n} {v}")).collect();
-    println!("bake: {:.0} ms ({}); {} bytes ({})", b.total_ms, stages.join(", "), b.output_bytes, bytes.join(", "));
+    out!("bake: {:.0} ms ({}); {} bytes ({})", b.total_ms, stages.join(", "), b.output_bytes, bytes.join(", "));
+    Ok(())
 }

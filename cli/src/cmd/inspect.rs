@@ -1,5 +1,6 @@
 //! `drafter inspect FILE [--json]`: format, parts, totals, world bounds and welded topology.
 
+use crate::cmd::out;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -152,9 +153,9 @@ pub fn run(args: Args) -> Result<()> {
     let mut report = build_report(&args.file.display().to_string(), &imported.scene, imported.diagnostics, weld);
     report.baked = read_baked(&args.file, &bytes)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print_text(&report);
+        print_text(&report)?;
     }
     if args.strict && !report.diagnostics.is_empty() {
         return Err(BadInput(format!(
@@ -234,34 +235,52 @@ pub fn build_report(file: &str, scene: &Scene, diagnostics: Vec<Diagnostic>, wel
 /// Rows of the part and mesh tables printed before "... N more".
 const TABLE_ROWS: usize = 40;
 
-fn print_text(r: &Report) {
-    println!("{} ({})", r.file, r.format);
-    println!(
+fn print_text(r: &Report) -> anyhow::Result<()> {
+    out!("{} ({})", r.file, r.format);
+    out!(
         "  {} instances of {} meshes: {} triangles in the world ({} unique), {} vertices",
-        r.instances, r.meshes, r.triangles, r.unique_triangles, r.vertices
+        r.instances,
+        r.meshes,
+        r.triangles,
+        r.unique_triangles,
+        r.vertices
     );
     let f = |v: [f64; 3]| format!("({:.6}, {:.6}, {:.6})", v[0], v[1], v[2]);
-    println!("  world bounds {} .. {}  size {}", f(r.bounds.min), f(r.bounds.max), f(r.bounds.size));
+    out!("  world bounds {} .. {}  size {}", f(r.bounds.min), f(r.bounds.max), f(r.bounds.size));
     let t = &r.topology;
-    println!(
+    out!(
         "  topology (welded, per unique mesh, summed): {} welded vertices, {} edges, {} boundary, {} non-manifold, {} components, {} degenerate triangles",
-        t.welded_vertices, t.edges, t.boundary_edges, t.nonmanifold_edges, t.components, t.degenerate_triangles
+        t.welded_vertices,
+        t.edges,
+        t.boundary_edges,
+        t.nonmanifold_edges,
+        t.components,
+        t.degenerate_triangles
     );
-    println!("\n  {:<40} {:>6} {:>10} {:>10}", "part", "mesh", "vertices", "triangles");
+    out!("\n  {:<40} {:>6} {:>10} {:>10}", "part", "mesh", "vertices", "triangles");
     for p in r.parts.iter().take(TABLE_ROWS) {
         let mirrored = if p.mirrored { " (mirrored)" } else { "" };
-        println!("  {:<40} {:>6} {:>10} {:>10}{mirrored}", truncate(&p.name, 40), p.mesh.0, p.vertices, p.triangles);
+        out!("  {:<40} {:>6} {:>10} {:>10}{mirrored}", truncate(&p.name, 40), p.mesh.0, p.vertices, p.triangles);
     }
     if r.parts.len() > TABLE_ROWS {
-        println!("  ... {} more parts (--json lists all)", r.parts.len() - TABLE_ROWS);
+        out!("  ... {} more parts (--json lists all)", r.parts.len() - TABLE_ROWS);
     }
-    println!(
+    out!(
         "\n  {:<6} {:<28} {:>5} {:>9} {:>9} {:>8} {:>8} {:>6} {:>5} {:>5}",
-        "mesh", "name", "uses", "triangles", "welded v", "edges", "boundary", "nonman", "comp", "degen"
+        "mesh",
+        "name",
+        "uses",
+        "triangles",
+        "welded v",
+        "edges",
+        "boundary",
+        "nonman",
+        "comp",
+        "degen"
     );
     for m in r.mesh_topology.iter().take(TABLE_ROWS) {
         let t = &m.topology;
-        println!(
+        out!(
             "  {:<6} {:<28} {:>5} {:>9} {:>9} {:>8} {:>8} {:>6} {:>5} {:>5}",
             m.mesh.0,
             truncate(&m.name, 28),
@@ -276,11 +295,11 @@ fn print_text(r: &Report) {
         );
     }
     if r.mesh_topology.len() > TABLE_ROWS {
-        println!("  ... {} more meshes (--json lists all)", r.mesh_topology.len() - TABLE_ROWS);
+        out!("  ... {} more meshes (--json lists all)", r.mesh_topology.len() - TABLE_ROWS);
     }
     if let Some(b) = &r.baked {
         let input = &b.root.input;
-        println!(
+        out!(
             "\n  baked by {} (extension {} v{}) from {} ({}, sha256 {}…): {} parts, {} labelled primitives",
             b.root.generator,
             drafter_format::EXTENSION,
@@ -291,13 +310,21 @@ fn print_text(r: &Report) {
             b.root.part_count,
             b.labelled_primitives
         );
-        println!(
+        out!(
             "  {:>4} {:<28} {:>9} {:>8} {:>12} {:>24} {:>10} {:>14} {:>6}",
-            "id", "part", "triangles", "obb", "volume", "projector direction", "scale", "gradient q/f/p", "style"
+            "id",
+            "part",
+            "triangles",
+            "obb",
+            "volume",
+            "projector direction",
+            "scale",
+            "gradient q/f/p",
+            "style"
         );
         for p in b.parts.iter().take(TABLE_ROWS) {
             let d = p.projector.direction;
-            println!(
+            out!(
                 "  {:>4} {:<28} {:>9} {:>8} {:>12.4e} {:>24} {:>10.4} {:>14} {:>6}",
                 p.id,
                 truncate(&p.name, 28),
@@ -311,7 +338,7 @@ fn print_text(r: &Report) {
             );
         }
         if b.parts.len() > TABLE_ROWS {
-            println!("  ... {} more parts (--json lists all)", b.parts.len() - TABLE_ROWS);
+            out!("  ... {} more parts (--json lists all)", b.parts.len() - TABLE_ROWS);
         }
         if let Some(t) = &b.root.textures {
             let mut kinds = Vec::new();
@@ -320,15 +347,16 @@ fn print_text(r: &Report) {
             kinds.extend(t.cool_to_warm.iter().map(|c| format!("cool-to-warm #{}", c.index)));
             kinds.extend(t.hatching.as_ref().map(|h| format!("hatching ({} levels)", h.levels.len())));
             kinds.extend(t.metal.as_ref().map(|m| format!("metal ({} metal parts)", m.parts.len())));
-            println!("  textures: {}", kinds.join(", "));
+            out!("  textures: {}", kinds.join(", "));
         }
     }
     if !r.diagnostics.is_empty() {
-        println!("\n  input problems recovered from:");
+        out!("\n  input problems recovered from:");
         for d in &r.diagnostics {
-            println!("    {d}");
+            out!("    {d}");
         }
     }
+    Ok(())
 }
 
 fn truncate(s: &str, n: usize) -> String {

@@ -177,6 +177,35 @@ impl Soa {
     }
 }
 
+/// Cache lines [`prefetch`] asks for at the start of a range.
+const PREFETCH_LINES: usize = 8;
+
+/// How many blocks ahead of the one being tested [`Stream::perspective`] prefetches.
+const PREFETCH_BLOCKS: usize = 8;
+
+/// Asks the CPU to start loading the first `lines` cache lines of `quads`, so that a hierarchy walk
+/// overlaps the memory latency of data it will test soon with testing the current data. A walk's
+/// ranges are short (tens of blocks) and scattered over arrays far larger than the caches, so their
+/// first lines miss before the hardware prefetcher sees a stream; measured on the dragon (1.3 M
+/// candidates) this takes about a tenth off a query. A hint only: no effect on results, and
+/// nothing on targets without one. Hand-written because std has no safe prefetch.
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn prefetch(quads: &[[f32; 4]], lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // 4 quads per 64-byte line (the quads are 16-byte aligned, so a line may straddle two).
+        for line in quads.chunks(4).take(lines) {
+            // SAFETY: SSE is part of the x86_64 baseline, and a prefetch never faults (the
+            // pointer is in bounds anyway).
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line.as_ptr().cast()) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = quads;
+}
+
 /// A Gauss map's candidates in its storage order, in blocks of 4 lanes (array of structures of
 /// arrays: 6 quads `n1x, n1y, n1z, n2x, n2y, n2z` per block). Lane `k` of block `b` is storage
 /// position `4b + k`, so a block's hits are 4 bits ORed at once into the answer, no index needed.
@@ -201,6 +230,14 @@ impl OrthoBlocks {
             quads.extend_from_slice(&rows);
         }
         Self { quads }
+    }
+
+    /// Starts loading the first cache lines of blocks `b0..b1` (see [`prefetch`]).
+    #[inline(always)]
+    pub fn prefetch(&self, b0: usize, b1: usize) {
+        if let Some(range) = self.quads.get(6 * b0..6 * b1) {
+            prefetch(range, PREFETCH_LINES);
+        }
     }
 
     /// The orthographic predicate on blocks `b0..b1`; hits set their storage positions in `out`.
@@ -280,12 +317,26 @@ impl Stream {
         ids.len().div_ceil(4) as u32
     }
 
+    /// Starts loading the first cache lines of `count` blocks at quad `q` (see [`prefetch`]).
+    #[inline(always)]
+    pub fn prefetch(&self, q: usize, count: u32) {
+        if let Some(range) = self.quads.get(q..q + count as usize * 10) {
+            prefetch(range, PREFETCH_LINES);
+        }
+    }
+
     /// Perspective predicate over `count` blocks starting at quad `q` (blocks with points).
     #[inline]
     pub fn perspective(&self, q: usize, count: u32, e: Vec3, out: &mut [u64]) {
         let (ex, ey, ez) = (Vec4::splat(e.x), Vec4::splat(e.y), Vec4::splat(e.z));
         let Some(all) = self.quads.get(q..q + count as usize * 10) else { return };
-        for r in all.chunks_exact(10) {
+        for (k, r) in all.chunks_exact(10).enumerate() {
+            // A block is 2.5 cache lines; blocks with points stream slower than the hardware
+            // prefetcher follows them (see `prefetch`).
+            let ahead = q + (k + PREFETCH_BLOCKS) * 10;
+            if let Some(next) = self.quads.get(ahead..ahead + 10) {
+                prefetch(next, 3);
+            }
             let (wx, wy, wz) = (ex - Vec4::from(r[6]), ey - Vec4::from(r[7]), ez - Vec4::from(r[8]));
             let a = Vec4::from(r[0]) * wx + Vec4::from(r[1]) * wy + Vec4::from(r[2]) * wz;
             let c = Vec4::from(r[3]) * wx + Vec4::from(r[4]) * wy + Vec4::from(r[5]) * wz;

@@ -577,7 +577,12 @@ impl ConeBvh {
                         counts.bounds_tested += end - first;
                     }
                 }
-                for &i in &level[..width] {
+                for (j, &i) in level[..width].iter().enumerate() {
+                    // Start loading a later leaf while this one is tested (see `brute::prefetch`).
+                    if let Some(&ahead) = level[..width].get(j + crate::gauss::PREFETCH_AHEAD) {
+                        let a = &self.nodes[ahead as usize];
+                        self.stream.prefetch(a.quad as usize, a.blocks);
+                    }
                     let n = &self.nodes[i as usize];
                     if n.blocks > 0 {
                         self.stream.perspective(n.quad as usize, n.blocks, eye, words);

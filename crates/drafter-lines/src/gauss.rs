@@ -68,6 +68,9 @@ pub const CULL_MARGIN: f64 = 1e-5;
 /// Default bin size of [`Bins::Overlapping`], in cell circumradii.
 pub const DEFAULT_OVERLAP: f32 = 1.5;
 
+/// How many ranges ahead of the one being tested a walk prefetches.
+pub(crate) const PREFETCH_AHEAD: usize = 3;
+
 /// A threshold at or above which a cap is never culled.
 const NEVER_CULL: f32 = 2.0;
 
@@ -754,7 +757,12 @@ impl GaussMapHierarchy {
                         counts.bounds_tested += end - first;
                     }
                 }
-                for &i in &level[..width] {
+                for (j, &i) in level[..width].iter().enumerate() {
+                    // Start loading a later range while this one is tested (see `prefetch`).
+                    if let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
+                        let a = &self.nodes[ahead as usize];
+                        self.blocks.prefetch(a.block_start as usize, a.block_end as usize);
+                    }
                     let n = &self.nodes[i as usize];
                     if n.block_start < n.block_end {
                         self.blocks.test(n.block_start as usize, n.block_end as usize, u, words, dirty);
