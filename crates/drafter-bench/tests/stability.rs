@@ -564,13 +564,11 @@ fn sample_cad_parts_under_random_rotations() {
     assert!(parts_seen >= 8, "only {parts_seen} sample parts: is samples/ complete?");
 }
 
-/// Finding of this suite (drafter-normals, reported with issue 7): across a non-manifold edge the
-/// filter averages every wing, and evenly spread wings sum to about zero, so the low-pass normal
-/// (and with it the enhanced normal) points wherever rounding sends it: a rotation moves the
-/// enhanced normals of a 3-wing fan by 11–22°. Plain normals are stable. Run with `--ignored` to
-/// check a fix (e.g. treating non-manifold edges as filter boundaries).
+/// Finding of this suite (drafter-normals, issue 7), fixed: across a non-manifold edge the filter
+/// used to average every wing, and evenly spread wings sum to about zero, so the low-pass normal
+/// (and with it the enhanced normal) pointed wherever rounding sent it: a rotation moved the
+/// enhanced normals of a 3-wing fan by 11–22°. A non-manifold edge now bounds the filter.
 #[test]
-#[ignore = "known defect in drafter-normals: enhanced normals of a non-manifold fan are rounding noise"]
 fn enhanced_normals_of_a_nonmanifold_fan_follow_a_rotation() {
     let mut rng = Rng::new(2005);
     for wings in [3, 6] {

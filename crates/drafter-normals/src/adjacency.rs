@@ -3,7 +3,7 @@
 //! Built once from [`Topology`] (edge→faces or vertex→faces CSR) in parallel, in face order, so the
 //! result depends only on the input. Each row lists a face's neighbours in increasing face order with
 //! their weights; degenerate neighbours (no normal) are left out, so the inner loop never tests for
-//! them. Edge neighbourhoods of manifold meshes (at most three neighbours per face) are stored as
+//! them. Edge neighbourhoods (at most three neighbours per face: only manifold edges count) are stored as
 //! three padded face ids per face (plus three dampings only if some pair is damped); anything else as
 //! CSR. The low-pass is memory-bound, so bytes per face are what sets its speed.
 
@@ -27,8 +27,13 @@ pub const SCALE_REFERENCE_FACTOR: f32 = 2.0;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Neighborhood {
-    /// Faces sharing an edge (3 on a closed manifold; all the others on a non-manifold edge; none
-    /// across a boundary). The paper's and MeshLab's choice; the cheapest per iteration.
+    /// Faces sharing a manifold edge (3 on a closed manifold; none across a boundary or a
+    /// non-manifold edge, one with more than two non-degenerate faces). The paper's and MeshLab's choice; the cheapest per iteration. A
+    /// non-manifold edge bounds the filter like a boundary: the sheets that meet there are separate
+    /// surfaces (a CAD T-junction, a fin), and averaging across all of them is ill-posed. Evenly
+    /// spread wings sum to about zero, so their low-pass normal would point wherever rounding sends
+    /// it (the stability suite's rotated 3- and 6-wing fans moved by 11–22° before this rule).
+    /// MeshLab takes one arbitrary wing across such an edge.
     #[default]
     Edge,
     /// Faces sharing at least one vertex (about 12 on a regular mesh): smooths about twice as far per
@@ -73,11 +78,12 @@ pub struct FaceAdjacency {
 /// The rows, in one of two layouts with the same content and the same summation order.
 #[derive(Clone, Debug)]
 enum Rows {
-    /// At most three neighbours per face (edge neighbourhoods of manifold meshes), padded with the
+    /// At most three neighbours per face (edge neighbourhoods), padded with the
     /// index one past the last face, whose premultiplied normal is always zero. `dampings` is empty
     /// when no pair is damped.
     Packed { neighbors: Vec<[u32; 3]>, dampings: Vec<[f32; 3]> },
-    /// Any number of neighbours (vertex neighbourhoods, non-manifold edges): CSR.
+    /// Any number of neighbours (vertex neighbourhoods; edge neighbourhoods of duplicated faces):
+    /// CSR.
     General { offsets: Vec<u32>, neighbors: Vec<u32>, dampings: Vec<f32> },
 }
 
@@ -270,12 +276,20 @@ fn damping(distance: f32, reference_length: f32) -> f32 {
     }
 }
 
+/// Whether the filter averages across an edge with faces `faces`: unless more than two of them have a
+/// normal (a non-manifold edge, see [`Neighborhood::Edge`]). Degenerate faces have no vote, so a
+/// sliver lying on an edge does not make it a boundary.
+#[inline]
+fn filters_across(faces: &[u32], geometry: &FaceGeometry) -> bool {
+    faces.len() <= 2 || faces.iter().filter(|&&g| !geometry.is_degenerate(g as usize)).count() <= 2
+}
+
 /// Neighbour ids and centroid distances of packed rows.
 type PackedRows = (Vec<[u32; 3]>, Vec<[f32; 3]>);
 
 /// Edge neighbourhoods as packed rows (padded with the face count) and, `with_distances`, their
-/// centroid distances (0 for padding); `None` when some face has more than three neighbours
-/// (non-manifold edges).
+/// centroid distances (0 for padding); `None` when some face has more than three neighbours (which
+/// only edges listed twice in a face could cause; kept as a guard).
 fn build_packed(topology: &Topology, geometry: &FaceGeometry, with_distances: bool) -> Option<PackedRows> {
     let face_count = topology.faces.len();
     let padding = face_count as u32;
@@ -290,7 +304,11 @@ fn build_packed(topology: &Topology, geometry: &FaceGeometry, with_distances: bo
                 if e == EDGE_NONE {
                     continue;
                 }
-                for &g in topology.faces_of_edge(e as usize) {
+                let across = topology.faces_of_edge(e as usize);
+                if !filters_across(across, geometry) {
+                    continue;
+                }
+                for &g in across {
                     if g as usize == f || geometry.is_degenerate(g as usize) || row[..len].contains(&g) {
                         continue;
                     }
@@ -340,7 +358,7 @@ fn build_general(
                 match neighborhood {
                     Neighborhood::Edge => {
                         for e in topology.face_edges[f] {
-                            if e != EDGE_NONE {
+                            if e != EDGE_NONE && filters_across(topology.faces_of_edge(e as usize), geometry) {
                                 scratch.extend_from_slice(topology.faces_of_edge(e as usize));
                             }
                         }

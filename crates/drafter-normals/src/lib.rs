@@ -69,7 +69,8 @@
 //! Stanford bunny and 0.09° on the dragon (`bench/normals/compare_meshlab.py`, figures in
 //! `bench/normals/README.md`). Remaining differences, all deliberate: MeshLab does not weld (the dragon
 //! has 2,100 duplicate positions, which we weld), counts a face itself once more across each boundary
-//! edge, and takes one neighbour across a non-manifold edge (we take all); it leaves `n_E` unnormalised
+//! edge, and takes one neighbour across a non-manifold edge (we take none: such an edge bounds the
+//! filter, see [`Neighborhood::Edge`]); it leaves `n_E` unnormalised
 //! (same direction).
 //!
 //! # Limits

@@ -237,6 +237,11 @@ fn nonmanifold_and_boundary_edges_are_handled() {
     // A non-manifold edge is sharp: each fin keeps its own vertices.
     assert_eq!(result.layout.vertex_count(), 9);
     assert_flat(&fins, &result);
+    // The non-manifold edge bounds the filter and the other edges are boundaries: no fin has a
+    // neighbour, so none is enhanced (averaging the three would depend on rounding).
+    for (f, (e, n)) in result.faces.enhanced.iter().zip(&result.faces.geometry.normals).enumerate() {
+        assert!(e.abs_diff_eq(*n, 1e-6), "fin {f}: {e} vs {n}");
+    }
     for n in result.faces.enhanced.iter().chain(&result.enhanced_normals) {
         assert!((n.length() - 1.0).abs() < 1e-6);
     }
@@ -302,17 +307,19 @@ fn scale_dependent_weights_damp_far_neighbours() {
     let mut triangles = sphere.triangles.clone();
     let far = positions.len() as u32;
     positions.push(Vec3::new(30.0, 0.0, 1.0));
+    // Face 0 becomes a large face reaching far out; `near` is the small face across its edge a–b.
     let [a, b, _] = triangles[0];
-    triangles.push([b, a, far]);
+    triangles[0] = [a, b, far];
+    let near = triangles.iter().position(|t| t.contains(&a) && t.contains(&b) && *t != [a, b, far]).expect("a–b");
     let m = mesh("sphere+sliver", positions, triangles);
     let topology = Topology::build(&m, Weld::Exact);
     let geometry = FaceGeometry::compute(&topology);
     let area = FaceAdjacency::build(&topology, &geometry, Neighborhood::Edge, Weighting::Area);
     let scaled = FaceAdjacency::build(&topology, &geometry, Neighborhood::Edge, Weighting::ScaleDependent);
-    let big = (m.triangles.len() - 1) as u32;
-    let (row_area, row_scaled) = (area.row(0), scaled.row(0));
+    let big = 0u32;
+    let (row_area, row_scaled) = (area.row(near), scaled.row(near));
     assert_eq!(row_area.len(), row_scaled.len());
-    let k = row_area.iter().position(|&(g, _)| g == big).expect("face 0 borders the large face");
+    let k = row_area.iter().position(|&(g, _)| g == big).expect("`near` borders the large face");
     assert_eq!(row_scaled[k].0, big);
     assert!(row_scaled[k].1 < 0.01 * row_area[k].1, "{:?} vs {:?}", row_scaled[k], row_area[k]);
 }
@@ -469,8 +476,8 @@ fn refinement_survives_t_junctions() {
 }
 
 #[test]
-fn packed_and_general_rows_agree() {
-    // A non-manifold fin far away forces the general CSR rows; the sphere's faces must not notice.
+fn a_far_nonmanifold_fin_changes_nothing_else() {
+    // A non-manifold fin far away (its edge bounds the filter); the sphere's faces must not notice.
     let sphere = bumpy_sphere(24, 12, 0.3);
     let mut positions = sphere.positions.clone();
     let base = positions.len() as u32;
@@ -501,8 +508,9 @@ fn low_pass_matches_a_reference_jacobi() {
     let mut triangles = sphere.triangles.clone();
     let far = positions.len() as u32;
     positions.push(Vec3::new(6.0, 0.0, 0.5));
+    // Face 0 becomes a long face reaching far out (a manifold edge still joins it to the sphere).
     let [a, b, _] = triangles[0];
-    triangles.push([b, a, far]);
+    triangles[0] = [a, b, far];
     let uneven = mesh("sphere+far", positions, triangles);
     let topology = Topology::build(&uneven, Weld::Exact);
     let geometry = FaceGeometry::compute(&topology);
