@@ -49,7 +49,9 @@ pub struct PartGpu {
     pub projector_row: [f32; 4],
     /// The oriented box's axes (longest first), w unused. Metal bands run along `axes[0]`.
     pub axes: [[f32; 4]; 3],
-    /// Gradient `q`, `f`, `p` and the transfer curve's index in the transfer tables.
+    /// Gradient `q`, `f`, `p` and the transfer curve: its index in
+    /// [`drafter_core::gradient::TransferCurve::ALL`] in a [`crate::model::Part`], its row in the
+    /// bound γ atlas in the uploaded table ([`crate::Model::part_table`]).
     pub gradient: [f32; 4],
     /// Style hint ([`crate::Style::index`]) or [`NO_STYLE`].
     pub style_hint: u32,
@@ -101,6 +103,49 @@ pub const FLAG_CEL_SPECULAR: u32 = 1;
 pub const FLAG_SPLASH_BACK: u32 = 2;
 /// `FrameUniforms::flags` bit: hatch strokes fixed to the object instead of the screen.
 pub const FLAG_HATCH_OBJECT_SPACE: u32 = 4;
+
+/// The G-buffer's lookup textures (`gbuffer.wgsl`: `Lookups`): which are baked and how they are
+/// indexed. One per scene, rewritten each frame (the cel row and the hatching tile follow the
+/// frame's options).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LookupUniforms {
+    /// `LOOKUP_*` bits.
+    pub flags: u32,
+    /// `v` of the centre of the cel atlas row in use.
+    pub cel_row_v: f32,
+    /// The row's darkest step.
+    pub cel_min_level: f32,
+    /// The row's brightest diffuse step (1 without a specular band).
+    pub cel_diffuse_max: f32,
+    /// Hatching: the halftone tile's side in target pixels, the soft threshold's `c`; zw unused.
+    pub hatch: [f32; 4],
+    /// Cool-to-warm: the unit direction towards the light the map was baked for (eye space).
+    pub map_light: [f32; 4],
+    /// A unit vector orthogonal to `map_light`, leaning towards the viewer.
+    pub map_across: [f32; 4],
+    /// Metal: the stripe scale `s` of `u = s·(1 + n·w)/2`; yzw unused.
+    pub metal: [f32; 4],
+}
+
+/// `LookupUniforms::flags` bit: cel steps from the baked cel atlas.
+pub const LOOKUP_CEL: u32 = 1;
+/// `LookupUniforms::flags` bit: cool-to-warm from the baked map.
+pub const LOOKUP_COOL_TO_WARM: u32 = 2;
+/// `LookupUniforms::flags` bit: hatching from the baked halftone.
+pub const LOOKUP_HATCH: u32 = 4;
+/// `LookupUniforms::flags` bit: metal bands and highlights from the baked textures.
+pub const LOOKUP_METAL: u32 = 8;
+/// `LookupUniforms::flags` bit: the cel row ends in a specular band (values above `cel_diffuse_max`).
+pub const LOOKUP_CEL_SPECULAR: u32 = 16;
+/// `LookupUniforms::flags` bit: the cool-to-warm map is factored (`clamp(rgb + a·k_d)`), not a colour.
+pub const LOOKUP_COOL_TO_WARM_FACTORED: u32 = 32;
+/// `LookupUniforms::flags` bit: the cool-to-warm map includes the splash-back multiplier.
+pub const LOOKUP_COOL_TO_WARM_SPLASH: u32 = 64;
+/// `LookupUniforms::flags` bit: the cool-to-warm map is a normal sphere (else octahedral).
+pub const LOOKUP_COOL_TO_WARM_SPHERE: u32 = 128;
+/// `LookupUniforms::flags` bit: the metal highlight map is a normal sphere (else octahedral).
+pub const LOOKUP_METAL_SPHERE: u32 = 256;
 
 /// One shadow layer (`shadow.wgsl`: `ShadowLayer`), bound with a dynamic offset.
 #[repr(C)]
@@ -230,6 +275,7 @@ const _: () = {
     assert!(size_of::<PartGpu>() == 96);
     assert!(size_of::<MaterialGpu>() == 32);
     assert!(size_of::<FrameUniforms>() == 128 + 48 + 16 + 16);
+    assert!(size_of::<LookupUniforms>() == 80);
     assert!(size_of::<ShadowLayerGpu>() == 96);
     assert!(size_of::<ShadowResolveGpu>() == 176);
     assert!(size_of::<EnhanceUniforms>() == 32);

@@ -7,7 +7,9 @@
 //!
 //! 1. [`passes::gbuffer`]: every mesh drawn once, instanced; per-part projector, gradient and style
 //!    from a storage buffer indexed by part id; writes colour, normal, linear depth and part id.
-//!    Styles: [`Style`] (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`, `hatch`).
+//!    Styles: [`Style`] (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`, `hatch`), reading
+//!    the NPR lookup textures the file embeds ([`lookups`]: γ and cel tables, cool-to-warm map,
+//!    hatching halftone, metal bands and highlights), each computed procedurally where it has none.
 //! 2. [`passes::shadow`]: optional drop shadow on the ground plane (hard, umbra + penumbra, soft).
 //! 3. [`passes::enhance`]: the depth unsharp mask's blur; the image-space edges (part-id, depth and
 //!    normal discontinuities) it specifies are detected in the display pass, which reads the same
@@ -44,6 +46,7 @@ pub mod context;
 pub mod edges;
 pub mod gpu_types;
 pub mod image;
+pub mod lookups;
 pub mod model;
 pub mod passes;
 pub mod renderer;

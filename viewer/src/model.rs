@@ -22,6 +22,11 @@
 //! batch can be drawn with either ([`crate::RenderOptions::enhanced_normals`]); other files keep their
 //! imported normals.
 //!
+//! # Lookup textures
+//! A baked file's NPR lookup textures (`DRAFTER_illustration.textures`) are decoded on load into
+//! [`Model::lookups`] ([`crate::lookups`]); where the file has none, or one does not fit, the
+//! G-buffer computes that lookup procedurally, and a notice says which source is used.
+//!
 //! Positions are moved into *render space*, the world translated so that the centre of the
 //! scene's bounds is the origin: the transforms are composed in f64 and rounded once, so CAD
 //! coordinates far from the world origin keep their precision in f32.
@@ -30,12 +35,13 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::Path;
 
-use drafter_core::gradient::{DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZATION};
+use drafter_core::gradient::{DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZATION, TransferCurve};
 use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
 use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, PartGpu, Vertex};
+use crate::lookups::BakedLookups;
 use crate::style::{Style, transfer_index};
 
 /// Colour of triangles without a material (display values).
@@ -109,7 +115,10 @@ pub struct Model {
     pub fit_points: Vec<glam::Vec3>,
     /// Whether the file carried `DRAFTER_illustration` data.
     pub baked: bool,
-    /// What the viewer substituted or could not use (one line each).
+    /// The file's lookup textures (see [`Self::set_lookups`]).
+    lookups: BakedLookups,
+    /// What the viewer substituted or could not use, and where its lookup textures come from (one
+    /// line each).
     pub notices: Vec<String>,
     /// The importer's diagnostics.
     pub diagnostics: Vec<Diagnostic>,
@@ -135,6 +144,13 @@ impl Model {
         let mut model = Model::from_scene_with_normals(&imported.scene, baked.as_ref(), &normal_sets)
             .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
         model.diagnostics = imported.diagnostics;
+        if let Some(record) = baked.as_ref().and_then(|b| b.root.textures.as_ref()) {
+            let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+            let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+            let (lookups, notices) = BakedLookups::read(Some(record), bytes, &external);
+            model.notices.extend(notices);
+            model.set_lookups(lookups);
+        }
         Ok(model)
     }
 
@@ -308,7 +324,7 @@ impl Model {
             .unwrap_or_default();
         notices.extend(lines.notices.iter().cloned());
 
-        Some(Model {
+        let mut model = Model {
             batches,
             instances,
             instance_mesh,
@@ -321,9 +337,37 @@ impl Model {
             origin,
             fit_points,
             baked: baked.is_some(),
+            lookups: BakedLookups::default(),
             notices,
             diagnostics: Vec::new(),
-        })
+        };
+        // Procedural until the caller reads the file's textures ([`Self::load_bytes`]).
+        model.set_lookups(BakedLookups::default());
+        Some(model)
+    }
+
+    /// The lookup textures the G-buffer binds (what [`Self::load`] read from the file).
+    pub fn lookups(&self) -> &BakedLookups {
+        &self.lookups
+    }
+
+    /// Replaces the lookup textures (for a file read by other means, or a test's altered images).
+    /// A γ atlas that lacks some part's curve is dropped (procedural tables instead); the notices
+    /// say so and which source each lookup has.
+    pub fn set_lookups(&mut self, mut lookups: BakedLookups) {
+        // The curves of the parts drawn (ids no node uses get a placeholder that is never drawn).
+        let mut drawn = vec![false; self.parts.len()];
+        for &id in &self.label_to_part {
+            if let Some(d) = drawn.get_mut(id as usize) {
+                *d = true;
+            }
+        }
+        let curves = self.parts.iter().zip(drawn).filter(|(_, d)| *d).map(|(p, _)| part_curve(&p.gpu));
+        let dropped = lookups.require_curves(curves);
+        self.notices.retain(|n| !n.starts_with(crate::lookups::NOTICE_PREFIX));
+        self.notices.extend(dropped);
+        self.notices.push(lookups.notice());
+        self.lookups = lookups;
     }
 
     /// Whether some batch carries enhanced normals (the file was baked with them).
@@ -341,10 +385,26 @@ impl Model {
         self.parts.get(id as usize)
     }
 
-    /// Per-part GPU records, indexed by part id.
+    /// Per-part GPU records, indexed by part id, each with the row of its transfer curve in the γ
+    /// atlas the G-buffer binds (the file's when [`Self::lookups`] has one, else the procedural
+    /// atlas, whose rows are [`TransferCurve::ALL`]).
     pub fn part_table(&self) -> Vec<PartGpu> {
-        self.parts.iter().map(|p| p.gpu).collect()
+        self.parts
+            .iter()
+            .map(|p| {
+                let mut gpu = p.gpu;
+                if let Some(gamma) = &self.lookups.gamma {
+                    gpu.gradient[3] = gamma.row(part_curve(&p.gpu)).unwrap_or(0) as f32;
+                }
+                gpu
+            })
+            .collect()
     }
+}
+
+/// The transfer curve of a part record (`gradient.w` is its index in [`TransferCurve::ALL`]).
+fn part_curve(gpu: &PartGpu) -> TransferCurve {
+    TransferCurve::ALL.get(gpu.gradient[3] as usize).copied().unwrap_or_default()
 }
 
 /// Reads the `DRAFTER_illustration` data of a glTF/GLB; `None` for other formats and plain glTF.

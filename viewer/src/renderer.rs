@@ -118,7 +118,7 @@ impl Renderer {
         let device = &self.gpu.device;
         let queue = &self.gpu.queue;
         let (gpu, lines) = scoped(device, || {
-            let gpu = SceneGpu::upload(device, model, &self.gbuffer, &self.shadow, &self.frame_uniforms);
+            let gpu = SceneGpu::upload(device, queue, model, &self.gbuffer, &self.shadow, &self.frame_uniforms);
             let lines =
                 self.lines.scene(device, queue, model.lines.clone(), &self.frame_uniforms, &gpu.buffers.instances);
             (gpu, lines)
@@ -201,6 +201,7 @@ impl Renderer {
         };
         let queue = &self.gpu.queue;
         queue.write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&frame));
+        self.gbuffer.prepare(queue, &scene.gpu.lookups, options);
         let mask_size = (size.0.div_ceil(SHADOW_REDUCTION), size.1.div_ceil(SHADOW_REDUCTION));
         let plan = shadow::plan(options.shadow, &layers, camera.clip_from_render(), &scene.fit_points, mask_size);
         self.shadow.prepare(queue, &plan);

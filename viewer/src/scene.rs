@@ -1,5 +1,5 @@
-//! A [`Model`] uploaded to the GPU: one vertex and index buffer per batch, and the storage buffers
-//! the passes index (instances, label → part, parts, materials).
+//! A [`Model`] uploaded to the GPU: one vertex and index buffer per batch, the storage buffers
+//! the passes index (instances, label → part, parts, materials) and the G-buffer's lookup textures.
 
 use std::ops::Range;
 
@@ -7,6 +7,7 @@ use wgpu::util::DeviceExt;
 
 use crate::gpu_types::{MaterialGpu, PartGpu};
 use crate::model::Model;
+use crate::passes::gbuffer::LookupsGpu;
 
 /// One draw of the G-buffer and shadow passes.
 #[derive(Debug)]
@@ -33,6 +34,8 @@ pub struct SceneBuffers {
 pub struct SceneGpu {
     pub batches: Vec<BatchGpu>,
     pub buffers: SceneBuffers,
+    /// The model's lookup textures (baked, or the procedural fallbacks).
+    pub lookups: LookupsGpu,
     pub gbuffer_bind_group: wgpu::BindGroup,
     pub shadow_bind_group: wgpu::BindGroup,
 }
@@ -50,6 +53,7 @@ impl BatchGpu {
 impl SceneGpu {
     pub fn upload(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         model: &Model,
         gbuffer: &crate::passes::gbuffer::GBufferPass,
         shadow: &crate::passes::shadow::ShadowPass,
@@ -103,8 +107,9 @@ impl SceneGpu {
                 instances: b.instances.clone(),
             })
             .collect();
-        let gbuffer_bind_group = gbuffer.bind_group(device, frame, &buffers);
+        let lookups = LookupsGpu::upload(device, queue, model.lookups());
+        let gbuffer_bind_group = gbuffer.bind_group(device, frame, &buffers, &lookups);
         let shadow_bind_group = shadow.scene_bind_group(device, &buffers);
-        SceneGpu { batches, buffers, gbuffer_bind_group, shadow_bind_group }
+        SceneGpu { batches, buffers, lookups, gbuffer_bind_group, shadow_bind_group }
     }
 }

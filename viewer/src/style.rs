@@ -126,8 +126,16 @@ pub const SPLASH_BACK_ALPHA: f32 = 0.76;
 pub const SPLASH_BACK_BETA: f32 = 0.78;
 /// Default of [`RenderOptions::hatch_period_px`].
 pub const DEFAULT_HATCH_PERIOD_PX: f32 = 5.0;
-/// Freudenberg's scale `c > 1` of the soft threshold `clamp(c·(1 − (T + I)))`.
+/// Freudenberg's scale `c > 1` of the soft threshold `clamp(c·(1 − (T + I)))` of the procedural
+/// strokes (a baked halftone brings its own `c`).
 pub const HATCH_SHARPNESS: f32 = 6.0;
+/// Level-0 texels between neighbouring strokes of one family in drafter-textures' default halftone
+/// (`128 / (8·√2)`: 8 diagonal lines per 128-texel tile). A baked halftone's tile is drawn so that
+/// this many texels span [`RenderOptions::hatch_period_px`], as far as its mip chain allows.
+pub const HALFTONE_STROKE_SPACING_TEXELS: f32 = 11.313_708;
+/// The stripe scale `s ≥ 1` of the baked metal bands, `u = s·(1 + n·w)/2`: 1 spreads the band table
+/// once over each half turn around the axis (16 streaks with drafter-textures' defaults).
+pub const METAL_STRIPE_SCALE: f32 = 1.0;
 /// Default of [`RenderOptions::background`]: near-white paper.
 pub const DEFAULT_BACKGROUND: [f32; 3] = [1.0, 1.0, 1.0];
 /// Default of [`RenderOptions::shadow_color`]: a cool grey-blue, as illustrators colour shadows.
@@ -207,9 +215,13 @@ pub struct RenderOptions {
     pub cel_steps: u32,
     /// A white specular band on cel shading. Default true.
     pub cel_specular: bool,
-    /// Gooch's splash-back multiplier `(α|cos θ| + (1 − α))^β` (α = 0.76, β = 0.78). Default false.
+    /// Gooch's splash-back multiplier (α = 0.76, β = 0.78): `(α|cos θ| + (1 − α))^β` procedurally,
+    /// the paper's `|α cos θ + (1 − α)|^β` with a baked cool-to-warm map (unless the map has it
+    /// already). Default false.
     pub splash_back: bool,
-    /// Hatch stroke period in output pixels. Default [`DEFAULT_HATCH_PERIOD_PX`] (5).
+    /// Hatch stroke period in output pixels. Default [`DEFAULT_HATCH_PERIOD_PX`] (5). A baked
+    /// halftone keeps its strokes' spacing in target pixels at each mip level, so below about 11
+    /// target pixels (supersampling 1) the strokes stay that far apart rather than alias.
     pub hatch_period_px: f32,
     /// Part id to highlight (the display pass tints it). Default none.
     pub selected_part: Option<u32>,
@@ -301,8 +313,9 @@ impl RenderOptions {
 }
 
 /// Every transfer curve γ as 128 texels `γ(k / 127)`, one row per curve in the order of
-/// [`TransferCurve::ALL`] (a curve's row is its index there): the table the G-buffer pass samples
-/// with linear interpolation, exactly as [`drafter_core::gradient::IntensityTransfer::sample`].
+/// [`TransferCurve::ALL`] (a curve's row is its index there), as
+/// [`drafter_core::gradient::IntensityTransfer::sample`] interpolates them: the procedural γ atlas
+/// ([`crate::lookups::procedural_gamma`]).
 pub fn transfer_tables() -> Vec<f32> {
     TransferCurve::ALL.iter().flat_map(|&c| IntensityTransfer::from_curve(c).texels().to_vec()).collect()
 }
@@ -318,8 +331,9 @@ pub const METAL_TABLE_LEN: usize = 32;
 
 /// Gooch et al. 1999, §5.2.1: a periodic table of random intensities `b + r^e` (b = −0.1,
 /// r uniform in [0, 1], e = 1.4), each entry filtered with its neighbours 1-5-1 and clamped to
-/// [0, 1]. The G-buffer pass wraps it around each part's principal axis. Deterministic (a fixed
-/// xorshift seed) so that images are reproducible.
+/// [0, 1]. The G-buffer pass wraps it around each part's principal axis when the file has no
+/// baked `metal_bands` (procedural fallback). Deterministic (a fixed xorshift seed) so that images
+/// are reproducible.
 pub fn metal_table() -> Vec<f32> {
     let mut state: u32 = 0x9e37_79b9;
     let mut next = || {

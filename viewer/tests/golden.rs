@@ -1,5 +1,6 @@
-//! Golden images: the baked sample assembly in every style (with edges and a shadow), a few option
-//! variants, and models from ../shared/models, compared with the committed references in
+//! Golden images: the baked sample assembly in every style (with edges and a shadow; the styles read
+//! the file's lookup textures), a few option variants, and models from ../shared/models (an unbaked
+//! one in the procedural metal), compared with the committed references in
 //! `tests/golden/` within the tolerance of `common` (mean |Δ| ≤ 0.02, ≤ 1 % of pixels off by more
 //! than 8 levels). `DRAFTER_UPDATE_GOLDEN=1 cargo test -p drafter-viewer --test golden` rewrites
 //! them; look at every one before committing.
@@ -42,6 +43,11 @@ fn run_cases(model: &drafter_viewer::Model, cases: &[(String, RenderOptions)]) {
 fn sample_assembly_in_every_style() {
     let model = common::sample();
     assert_eq!(model.parts.len(), 15);
+    // Every style reads the baked lookup textures (the sample's metallic parts bring the metal ones),
+    // except cel_ortho_top's 4 steps, which the baked 3-step table does not have.
+    let l = model.lookups();
+    let baked = [l.gamma.is_some(), l.cel.is_some(), l.cool_to_warm.is_some(), l.hatching.is_some(), l.metal.is_some()];
+    assert_eq!(baked, [true; 5], "{:?}", model.notices);
     let mut cases: Vec<(String, RenderOptions)> =
         Style::ALL.iter().map(|&s| (format!("assembly_{s}"), options(s))).collect();
     cases.push((
@@ -91,6 +97,7 @@ fn corpus_models() {
     let fandisk = drafter_viewer::Model::load(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"))
         .expect("fandisk loads");
     assert!(!fandisk.baked && !fandisk.notices.is_empty());
+    assert_eq!(*fandisk.lookups(), drafter_viewer::lookups::BakedLookups::default(), "procedural metal");
     run_cases(&fandisk, &[("fandisk_unbaked_metal".into(), options(Style::Metal))]);
 }
 

@@ -15,21 +15,69 @@
 //! # Styles (see `gbuffer.wgsl`)
 //! `gradient` (projective texturing with ω(i, q, f, p) and the γ table), `phong`, `cel` (2–4 steps,
 //! optional specular band), `gooch` (cool-to-warm, optional splash-back), `goochel`, `metal` (Gooch
-//! metal bands around the principal axis + icosahedron highlights; procedural until baked textures
-//! exist) and `hatch` (Freudenberg's soft threshold, screen-space strokes). A part's baked style
-//! hint wins over the scene style unless [`crate::RenderOptions::use_part_styles`] is off.
+//! metal bands around the principal axis + icosahedron highlights) and `hatch` (Freudenberg's soft
+//! threshold `ink = clamp(c·(1 − (T + I)))`, screen-space as ten Bosch's "simple hatching"). A
+//! part's baked style hint wins over the scene style unless [`crate::RenderOptions::use_part_styles`]
+//! is off.
+//!
+//! # Lookup textures
+//! The styles read the lookup textures a baked file embeds (drafter-textures' images, decoded by
+//! [`crate::lookups`]) and fall back, lookup by lookup, to the viewer's own where the file has none
+//! (plain glTF). Six textures and two samplers (clamped linear; repeating trilinear) are bound
+//! whatever the source; [`LookupUniforms`] flags which are baked, and the shader computes the others:
+//!
+//! * **γ atlas** (gradient): always a texture, the file's (8-bit) or the procedural one (32-bit
+//!   float: exactly the tables drafter-core interpolates), texel `k` = γ(k/127) interpolated
+//!   linearly in the part's row ([`crate::Model::part_table`] maps the part's curve to the row).
+//!   Equivalent to the spec's `u = (0.5 + 127·p)/128` with linear filtering, done with two
+//!   `textureLoad`s because core WebGPU cannot filter 32-bit floats.
+//! * **cel atlas** (cel, goochel; ten Bosch 2005): the row whose steps and specular band match
+//!   [`crate::RenderOptions::cel_steps`] and `cel_specular` (the bake's default table matches the
+//!   default options); with other options the procedural steps. Cel: `x = max(n·l, 0)`, the diffuse
+//!   steps scale the base colour relative to the brightest one, values above it (the row's specular
+//!   band) are drawn towards white. Goochel: `x = (1 + n·l)/2`, the steps rescaled to [0, 1] are the
+//!   cool-to-warm blend.
+//! * **cool-to-warm map** (gooch, goochel; Gooch et al. 1999, Fig. 10): indexed by an eye-space
+//!   normal. The map depends on the normal only through `n·l_map` (drafter-textures' `cool_warm`),
+//!   so it is read at the normal `c·l_map + √(1 − c²)·a` (`a` ⟂ `l_map`, leaning to the viewer) with
+//!   `c` the frame's `n·l`: exactly the map's shading for the viewer's light, which the other
+//!   styles and the drop shadow share. Goochel reads it at `c = 2t − 1` for the stepped blend `t`.
+//!   Factored maps give `clamp(rgb + a·k_d)`; splash-back, when asked for and not in the map, is
+//!   multiplied in (`|0.76·c + 0.24|^0.78`). Limit: a normal-sphere map stores the front
+//!   hemisphere only, so for `c` below `−√(1 − l_z²)` the mirrored texel is read.
+//! * **halftone** (hatch; Freudenberg 2002): `T` sampled at `pixel / tile` with the stored mip
+//!   levels (trilinear, explicit gradients), `ink = clamp(c·(1 − (T + I)))` with the file's `c`.
+//!   The tile is scaled so that [`crate::style::HALFTONE_STROKE_SPACING_TEXELS`] (the default
+//!   halftone's stroke spacing) spans `hatch_period_px` (times the supersampling); since each level
+//!   keeps the strokes' width and spacing in texels, a period below that spacing in target pixels
+//!   moves to a coarser level rather than packing strokes closer (as tonal art maps do): with
+//!   supersampling 2 the default 5 px period is met, without it the strokes are about 10 px apart.
+//! * **metal** (Gooch et al. 1999, §5.2.1): bands at `u = s·(1 + n·w)/2`, `w` the part's
+//!   `obb.axes[1]` (⟂ the principal axis, so the bands run along it), `s` =
+//!   [`crate::style::METAL_STRIPE_SCALE`], repeat; highlights from the map by the eye-space normal.
+//!   Colour `tint·mix(0.4, 1, band)·(0.75 + 0.25·max(n·l, 0)) + highlight`: the spec's
+//!   `base·band + highlight` with the band lifted so no streak is black and a little diffuse light
+//!   so flat faces read apart. Procedural: the viewer's 32-entry table by the angle around the axis
+//!   and six of the icosahedron's lights, Blinn–Phong.
 //!
 //! # Limits
-//! Enhanced normals are not in baked files yet: every style uses the file's normals, or the face
-//! normal (from screen-space derivatives) where a mesh has none. No back-face culling: open
-//! surfaces show their inner side, turned towards the viewer.
+//! Enhanced normals come from the file when baked ([`crate::RenderOptions::enhanced_normals`]);
+//! otherwise every style uses the file's normals, or the face normal (from screen-space
+//! derivatives) where a mesh has none. No back-face culling: open surfaces show their inner side,
+//! turned towards the viewer. One cool-to-warm map is used (the file's first).
 
+use drafter_format::CelTableRecord;
+use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use crate::gpu_types::Vertex;
-use crate::passes::{color_attachment, storage_entry, uniform_entry};
+use crate::gpu_types::{
+    LOOKUP_CEL, LOOKUP_CEL_SPECULAR, LOOKUP_COOL_TO_WARM, LOOKUP_COOL_TO_WARM_FACTORED, LOOKUP_COOL_TO_WARM_SPHERE,
+    LOOKUP_COOL_TO_WARM_SPLASH, LOOKUP_HATCH, LOOKUP_METAL, LOOKUP_METAL_SPHERE, LookupUniforms, Vertex,
+};
+use crate::lookups::{self, BakedLookups, EnvMapping, LookupFormat, LookupImage};
+use crate::passes::{FILTERABLE, FLOAT, color_attachment, sampler_entry, storage_entry, texture_entry, uniform_entry};
 use crate::scene::SceneGpu;
-use crate::style::{metal_table, transfer_tables};
+use crate::style::{HALFTONE_STROKE_SPACING_TEXELS, METAL_STRIPE_SCALE, RenderOptions};
 use crate::targets::{COLOR_FORMAT, DEPTH_FORMAT, LINEAR_DEPTH_FORMAT, NORMAL_FORMAT, PART_ID_FORMAT, Targets};
 
 pub const LABEL: &str = "gbuffer";
@@ -46,29 +94,178 @@ pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     }
 }
 
+/// Bindings of the lookup textures (keep in sync with `gbuffer.wgsl`).
+const LOOKUP_BINDINGS: std::ops::Range<u32> = 6..12;
+
 #[derive(Debug)]
 pub struct GBufferPass {
     pub bind_group_layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
-    transfer_tables: wgpu::Buffer,
-    metal_table: wgpu::Buffer,
+    /// Linear, clamp to edge, one level: the tables and environment maps.
+    clamp_sampler: wgpu::Sampler,
+    /// Trilinear, repeat: the halftone (its stored mip chain) and the metal bands.
+    repeat_sampler: wgpu::Sampler,
+}
+
+/// What the per-frame [`LookupUniforms`] are made of: the baked lookups' parameters, without
+/// their texels.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LookupPlan {
+    /// The cel atlas's tables (row order); empty: procedural steps.
+    pub cel_tables: Vec<CelTableRecord>,
+    /// The cool-to-warm map: mapping, factored, light in eye space, splash-back included.
+    pub cool_to_warm: Option<(EnvMapping, bool, Vec3, bool)>,
+    /// The halftone: level-0 side in texels, the file's `c`.
+    pub hatching: Option<(u32, f32)>,
+    /// The metal highlight map's mapping.
+    pub metal: Option<EnvMapping>,
+}
+
+impl LookupPlan {
+    pub fn of(lookups: &BakedLookups) -> LookupPlan {
+        LookupPlan {
+            cel_tables: lookups.cel.as_ref().map(|c| c.tables.clone()).unwrap_or_default(),
+            cool_to_warm: lookups.cool_to_warm.as_ref().map(|c| (c.mapping, c.factored, c.light_in_eye, c.splash_back)),
+            hatching: lookups.hatching.as_ref().map(|h| (h.image.width, h.contrast)),
+            metal: lookups.metal.as_ref().map(|m| m.mapping),
+        }
+    }
+}
+
+/// The uniforms of one frame (module docs, "Lookup textures").
+pub fn lookup_uniforms(plan: &LookupPlan, options: &RenderOptions) -> LookupUniforms {
+    let mut u = LookupUniforms { cel_diffuse_max: 1.0, ..Default::default() };
+    let row = plan.cel_tables.iter().position(|t| t.steps == options.cel_steps && t.specular == options.cel_specular);
+    if let Some(r) = row {
+        let t = &plan.cel_tables[r];
+        u.flags |= LOOKUP_CEL;
+        u.cel_row_v = (r as f32 + 0.5) / plan.cel_tables.len() as f32;
+        u.cel_min_level = t.min_level as f32;
+        if t.specular {
+            u.flags |= LOOKUP_CEL_SPECULAR;
+            u.cel_diffuse_max = t.diffuse_max as f32;
+        }
+    }
+    if let Some((mapping, factored, light, splash)) = plan.cool_to_warm {
+        u.flags |= LOOKUP_COOL_TO_WARM;
+        if factored {
+            u.flags |= LOOKUP_COOL_TO_WARM_FACTORED;
+        }
+        if splash {
+            u.flags |= LOOKUP_COOL_TO_WARM_SPLASH;
+        }
+        if mapping == EnvMapping::NormalSphere {
+            u.flags |= LOOKUP_COOL_TO_WARM_SPHERE;
+        }
+        let across =
+            (Vec3::Z - Vec3::Z.dot(light) * light).try_normalize().unwrap_or_else(|| light.any_orthonormal_vector());
+        u.map_light = light.extend(0.0).to_array();
+        u.map_across = across.extend(0.0).to_array();
+    }
+    if let Some((side, contrast)) = plan.hatching {
+        u.flags |= LOOKUP_HATCH;
+        let period = options.hatch_period_px * options.supersample.max(1) as f32;
+        let tile = side as f32 * period / HALFTONE_STROKE_SPACING_TEXELS;
+        u.hatch = [tile, contrast, 0.0, 0.0];
+    }
+    if let Some(mapping) = plan.metal {
+        u.flags |= LOOKUP_METAL;
+        if mapping == EnvMapping::NormalSphere {
+            u.flags |= LOOKUP_METAL_SPHERE;
+        }
+    }
+    u.metal = [METAL_STRIPE_SCALE, 0.0, 0.0, 0.0];
+    u
+}
+
+/// A scene's lookup textures on the GPU, with their uniforms.
+#[derive(Debug)]
+pub struct LookupsGpu {
+    /// γ atlas, cel atlas, cool-to-warm, halftone, metal bands, metal highlights (binding order).
+    textures: Vec<wgpu::Texture>,
+    views: Vec<wgpu::TextureView>,
+    uniforms: wgpu::Buffer,
+    plan: LookupPlan,
+}
+
+impl LookupsGpu {
+    /// Uploads `lookups`, with the procedural γ atlas and metal table and 1 × 1 placeholders where
+    /// a lookup is not baked.
+    pub fn upload(device: &wgpu::Device, queue: &wgpu::Queue, lookups: &BakedLookups) -> LookupsGpu {
+        let gamma = lookups.gamma.as_ref().map_or_else(|| lookups::procedural_gamma().image, |g| g.image.clone());
+        let or_placeholder = |image: Option<&LookupImage>, name: &str, format| {
+            image.cloned().unwrap_or_else(|| lookups::placeholder(name, format))
+        };
+        let images = [
+            gamma,
+            or_placeholder(lookups.cel.as_ref().map(|c| &c.image), "cel atlas", LookupFormat::R8),
+            or_placeholder(lookups.cool_to_warm.as_ref().map(|c| &c.image), "cool-to-warm", LookupFormat::Rgba8),
+            or_placeholder(lookups.hatching.as_ref().map(|h| &h.image), "hatching", LookupFormat::R8),
+            lookups.metal.as_ref().map_or_else(lookups::procedural_metal_bands, |m| m.bands.clone()),
+            or_placeholder(lookups.metal.as_ref().map(|m| &m.highlights), "metal highlights", LookupFormat::R8),
+        ];
+        let textures: Vec<wgpu::Texture> = images.iter().map(|image| upload_image(device, queue, image)).collect();
+        let views = textures.iter().map(|t| t.create_view(&wgpu::TextureViewDescriptor::default())).collect();
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gbuffer lookup uniforms"),
+            size: size_of::<LookupUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        LookupsGpu { textures, views, uniforms, plan: LookupPlan::of(lookups) }
+    }
+
+    /// The textures, in binding order (their labels name the images).
+    pub fn textures(&self) -> &[wgpu::Texture] {
+        &self.textures
+    }
+}
+
+/// One lookup image as a 2D texture with its stored mip levels (`*Unorm`: the texels are data).
+fn upload_image(device: &wgpu::Device, queue: &wgpu::Queue, image: &LookupImage) -> wgpu::Texture {
+    let format = match image.format {
+        LookupFormat::R8 => wgpu::TextureFormat::R8Unorm,
+        LookupFormat::Rgba8 => wgpu::TextureFormat::Rgba8Unorm,
+        LookupFormat::R32Float => wgpu::TextureFormat::R32Float,
+    };
+    let data: Vec<u8> = image.levels.concat();
+    device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some(&format!("gbuffer lookup {}", image.name)),
+            size: wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 },
+            mip_level_count: image.levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &data,
+    )
 }
 
 impl GBufferPass {
     pub fn new(device: &wgpu::Device) -> GBufferPass {
         let module = device.create_shader_module(wgpu::include_wgsl!("gbuffer.wgsl"));
         use wgpu::ShaderStages as S;
+        let mut entries = vec![
+            uniform_entry(0, S::VERTEX_FRAGMENT, false),
+            storage_entry(1, S::VERTEX),
+            storage_entry(2, S::VERTEX),
+            storage_entry(3, S::FRAGMENT),
+            storage_entry(4, S::FRAGMENT),
+            uniform_entry(5, S::FRAGMENT, false),
+        ];
+        // The γ atlas is read with `textureLoad` (its procedural form is 32-bit float, which
+        // core WebGPU cannot filter); the others with the samplers.
+        entries.push(texture_entry(LOOKUP_BINDINGS.start, FLOAT));
+        entries.extend((LOOKUP_BINDINGS.start + 1..LOOKUP_BINDINGS.end).map(|b| texture_entry(b, FILTERABLE)));
+        entries.extend([sampler_entry(LOOKUP_BINDINGS.end), sampler_entry(LOOKUP_BINDINGS.end + 1)]);
         let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer bind group layout"),
-            entries: &[
-                uniform_entry(0, S::VERTEX_FRAGMENT, false),
-                storage_entry(1, S::VERTEX),
-                storage_entry(2, S::VERTEX),
-                storage_entry(3, S::FRAGMENT),
-                storage_entry(4, S::FRAGMENT),
-                storage_entry(5, S::FRAGMENT),
-                storage_entry(6, S::FRAGMENT),
-            ],
+            entries: &entries,
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer pipeline layout"),
@@ -113,45 +310,73 @@ impl GBufferPass {
             multiview_mask: None,
             cache: None,
         });
-        let transfer_tables = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("gbuffer transfer tables"),
-            contents: bytemuck::cast_slice(&transfer_tables()),
-            usage: wgpu::BufferUsages::STORAGE,
+        let clamp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("gbuffer lookup sampler, clamped"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
         });
-        let metal_table = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("gbuffer metal table"),
-            contents: bytemuck::cast_slice(&metal_table()),
-            usage: wgpu::BufferUsages::STORAGE,
+        let repeat_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("gbuffer lookup sampler, repeating"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
         });
-        GBufferPass { bind_group_layout, pipeline, transfer_tables, metal_table }
+        GBufferPass { bind_group_layout, pipeline, clamp_sampler, repeat_sampler }
     }
 
     /// The bind group of a scene: frame uniforms, instances, label → part, parts, materials and the
-    /// lookup tables.
+    /// lookup textures.
     pub fn bind_group(
         &self,
         device: &wgpu::Device,
         frame: &wgpu::Buffer,
         scene: &crate::scene::SceneBuffers,
+        lookups: &LookupsGpu,
     ) -> wgpu::BindGroup {
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: scene.instances.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: scene.label_to_part.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 3, resource: scene.parts.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 4, resource: scene.materials.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 5, resource: lookups.uniforms.as_entire_binding() },
+        ];
+        entries.extend(LOOKUP_BINDINGS.zip(&lookups.views).map(|(binding, view)| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        }));
+        entries.extend([
+            wgpu::BindGroupEntry {
+                binding: LOOKUP_BINDINGS.end,
+                resource: wgpu::BindingResource::Sampler(&self.clamp_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: LOOKUP_BINDINGS.end + 1,
+                resource: wgpu::BindingResource::Sampler(&self.repeat_sampler),
+            },
+        ]);
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer bind group"),
             layout: &self.bind_group_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: scene.instances.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: scene.label_to_part.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: scene.parts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: scene.materials.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: self.transfer_tables.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: self.metal_table.as_entire_binding() },
-            ],
+            entries: &entries,
         })
     }
 
-    /// Clears the G-buffer and draws every batch once, instanced.
-    /// Draws every batch of `scene`, with its enhanced normals when `enhanced_normals` is set and
-    /// the batch has them.
+    /// Writes the scene's lookup uniforms for a frame of `options`.
+    pub fn prepare(&self, queue: &wgpu::Queue, lookups: &LookupsGpu, options: &RenderOptions) {
+        let uniforms = lookup_uniforms(&lookups.plan, options);
+        queue.write_buffer(&lookups.uniforms, 0, bytemuck::bytes_of(&uniforms));
+    }
+
+    /// Clears the G-buffer and draws every batch of `scene` once, instanced, with its enhanced
+    /// normals when `enhanced_normals` is set and the batch has them.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -188,5 +413,53 @@ impl GBufferPass {
             }
         }
         encoder.pop_debug_group();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(steps: u32, specular: bool) -> CelTableRecord {
+        CelTableRecord { steps, specular, min_level: 0.3, specular_threshold: 0.95, diffuse_max: 0.8 }
+    }
+
+    #[test]
+    fn cel_rows_follow_the_options() {
+        let plan = LookupPlan { cel_tables: vec![table(2, false), table(3, true)], ..Default::default() };
+        let o = RenderOptions::default(); // 3 steps with a specular band
+        let u = lookup_uniforms(&plan, &o);
+        assert_eq!(u.flags & (LOOKUP_CEL | LOOKUP_CEL_SPECULAR), LOOKUP_CEL | LOOKUP_CEL_SPECULAR);
+        assert_eq!((u.cel_row_v, u.cel_min_level, u.cel_diffuse_max), (0.75, 0.3, 0.8));
+        let u = lookup_uniforms(&plan, &RenderOptions { cel_steps: 2, cel_specular: false, ..o.clone() });
+        assert_eq!((u.flags & LOOKUP_CEL, u.cel_row_v, u.cel_diffuse_max), (LOOKUP_CEL, 0.25, 1.0));
+        // No row with four steps: the procedural steps.
+        let u = lookup_uniforms(&plan, &RenderOptions { cel_steps: 4, ..o });
+        assert_eq!(u.flags & LOOKUP_CEL, 0);
+    }
+
+    #[test]
+    fn the_cool_to_warm_frame_is_orthonormal_and_faces_the_viewer() {
+        for light in [Vec3::new(1.0, 1.0, 0.5).normalize(), Vec3::Z, Vec3::NEG_Z, Vec3::X] {
+            let plan =
+                LookupPlan { cool_to_warm: Some((EnvMapping::Octahedral, true, light, false)), ..Default::default() };
+            let u = lookup_uniforms(&plan, &RenderOptions::default());
+            let (l, a) = (Vec3::from_slice(&u.map_light), Vec3::from_slice(&u.map_across));
+            assert!((l.length() - 1.0).abs() < 1e-6 && (a.length() - 1.0).abs() < 1e-6 && l.dot(a).abs() < 1e-6);
+            assert!(a.z >= 0.0, "{light}: {a}");
+        }
+    }
+
+    #[test]
+    fn the_hatching_tile_scales_with_period_and_supersampling() {
+        let plan = LookupPlan { hatching: Some((128, 4.0)), ..Default::default() };
+        // The stroke spacing spans one period: 128 texels over 5 / 11.31 pixels per texel.
+        let o = RenderOptions { hatch_period_px: HALFTONE_STROKE_SPACING_TEXELS, ..Default::default() };
+        let u = lookup_uniforms(&plan, &o);
+        assert_eq!(u.hatch[1], 4.0);
+        assert!((u.hatch[0] - 128.0).abs() < 1e-3, "{}", u.hatch[0]);
+        let o = RenderOptions { supersample: 2, hatch_period_px: 2.0 * HALFTONE_STROKE_SPACING_TEXELS, ..o };
+        assert!((lookup_uniforms(&plan, &o).hatch[0] - 512.0).abs() < 1e-3);
+        assert_eq!(lookup_uniforms(&LookupPlan::default(), &o).flags, 0);
     }
 }

@@ -1,6 +1,8 @@
 // G-buffer pass: rasterises every mesh once (instanced) and shades it in the style of its part.
 // Outputs colour, view-space normal, linear view depth and part id + 1 (0 = background).
-// Keep the structs in sync with gpu_types.rs; style numbers with Style::index in style.rs.
+// Keep the structs in sync with gpu_types.rs; style numbers with Style::index in style.rs; the
+// lookup bindings with LOOKUP_BINDINGS in gbuffer.rs. Lookups: baked textures where the file has
+// them (flags in `lookups`), the procedural formulas otherwise (gbuffer.rs, "Lookup textures").
 
 struct Frame {
     clip_from_render: mat4x4<f32>,
@@ -38,6 +40,17 @@ struct Part {
     pad2: u32,
 }
 
+struct Lookups {
+    flags: u32,
+    cel_row_v: f32,
+    cel_min_level: f32,
+    cel_diffuse_max: f32,
+    hatch: vec4<f32>, // tile side (target px), contrast c
+    map_light: vec4<f32>,
+    map_across: vec4<f32>,
+    metal: vec4<f32>, // stripe scale s
+}
+
 struct Material {
     base_color: vec4<f32>,
     metallic: f32,
@@ -58,7 +71,16 @@ const NO_STYLE: u32 = 0xffffffffu;
 const FLAG_CEL_SPECULAR: u32 = 1u;
 const FLAG_SPLASH_BACK: u32 = 2u;
 
-const TRANSFER_TEXELS: u32 = 128u; // drafter_core::gradient::INTENSITY_TABLE_LEN
+const LOOKUP_CEL: u32 = 1u;
+const LOOKUP_COOL_TO_WARM: u32 = 2u;
+const LOOKUP_HATCH: u32 = 4u;
+const LOOKUP_METAL: u32 = 8u;
+const LOOKUP_CEL_SPECULAR: u32 = 16u;
+const LOOKUP_COOL_TO_WARM_FACTORED: u32 = 32u;
+const LOOKUP_COOL_TO_WARM_SPLASH: u32 = 64u;
+const LOOKUP_COOL_TO_WARM_SPHERE: u32 = 128u;
+const LOOKUP_METAL_SPHERE: u32 = 256u;
+
 const PI: f32 = 3.14159265358979;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -66,8 +88,15 @@ const PI: f32 = 3.14159265358979;
 @group(0) @binding(2) var<storage, read> label_to_part: array<u32>;
 @group(0) @binding(3) var<storage, read> parts: array<Part>;
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
-@group(0) @binding(5) var<storage, read> transfer_tables: array<f32>;
-@group(0) @binding(6) var<storage, read> metal_table: array<f32>;
+@group(0) @binding(5) var<uniform> lookups: Lookups;
+@group(0) @binding(6) var gamma_atlas: texture_2d<f32>;
+@group(0) @binding(7) var cel_atlas: texture_2d<f32>;
+@group(0) @binding(8) var cool_to_warm: texture_2d<f32>;
+@group(0) @binding(9) var hatching: texture_2d<f32>;
+@group(0) @binding(10) var metal_bands: texture_2d<f32>;
+@group(0) @binding(11) var metal_highlights: texture_2d<f32>;
+@group(0) @binding(12) var clamp_sampler: sampler;
+@group(0) @binding(13) var repeat_sampler: sampler;
 
 struct VertexIn {
     @location(0) position_in_object: vec3<f32>,
@@ -128,24 +157,65 @@ fn omega(i_in: f32, q_in: f32, f_in: f32, p_in: f32) -> f32 {
     return (iq - r) * (1.0 - mf) + (iq + r) * mf;
 }
 
-// γ(p): the 128-texel table of curve `curve`, linearly interpolated (texel k holds γ(k / 127)).
-fn transfer(p: f32, curve: u32) -> f32 {
-    let x = clamp(p, 0.0, 1.0) * f32(TRANSFER_TEXELS - 1u);
-    let k = min(u32(floor(x)), TRANSFER_TEXELS - 1u);
-    let next = min(k + 1u, TRANSFER_TEXELS - 1u);
-    let w = x - f32(k);
-    let base = curve * TRANSFER_TEXELS;
-    return transfer_tables[base + k] * (1.0 - w) + transfer_tables[base + next] * w;
+fn has(flag: u32) -> bool {
+    return (lookups.flags & flag) != 0u;
 }
 
-// The periodic metal table at u (wraps), linearly interpolated.
-fn metal(u: f32) -> f32 {
-    let n = arrayLength(&metal_table);
-    let x = fract(u) * f32(n);
-    let k = min(u32(floor(x)), n - 1u);
-    let next = (k + 1u) % n;
-    let w = x - f32(k);
-    return metal_table[k] * (1.0 - w) + metal_table[next] * w;
+// A table row read at x ∈ [0, 1]: texel k holds the value at x = k / (w − 1), so
+// u = (0.5 + (w − 1)·x) / w; linear, clamped (the cel atlas).
+fn table_row(atlas: texture_2d<f32>, x: f32, v: f32) -> f32 {
+    let w = f32(textureDimensions(atlas).x);
+    let u = (0.5 + (w - 1.0) * clamp(x, 0.0, 1.0)) / w;
+    return textureSampleLevel(atlas, clamp_sampler, vec2<f32>(u, v), 0.0).r;
+}
+
+// γ(p): row `row` of the γ atlas (baked or procedural), linearly interpolated (texel k holds
+// γ(k / (w − 1))); read with textureLoad, as the procedural atlas is 32-bit float.
+fn transfer(p: f32, row: u32) -> f32 {
+    let w = textureDimensions(gamma_atlas).x;
+    let x = clamp(p, 0.0, 1.0) * f32(w - 1u);
+    let k = min(u32(floor(x)), w - 1u);
+    let next = min(k + 1u, w - 1u);
+    let a = textureLoad(gamma_atlas, vec2<u32>(k, row), 0).r;
+    let b = textureLoad(gamma_atlas, vec2<u32>(next, row), 0).r;
+    return mix(a, b, x - f32(k));
+}
+
+// The baked cel row at x.
+fn cel_table(x: f32) -> f32 {
+    return table_row(cel_atlas, x, lookups.cel_row_v);
+}
+
+// Texture coordinate of an eye-space normal in an environment map (drafter-textures' envmap).
+fn env_uv(n_in: vec3<f32>, sphere: bool) -> vec2<f32> {
+    let n = normalize(n_in);
+    if sphere {
+        return vec2<f32>(0.5 + 0.5 * n.x, 0.5 - 0.5 * n.y);
+    }
+    var p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z < 0.0 {
+        p = (1.0 - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+    }
+    return vec2<f32>(0.5 + 0.5 * p.x, 0.5 - 0.5 * p.y);
+}
+
+// The baked cool-to-warm map at n·l = c: read at the normal c·l_map + √(1 − c²)·a, which has that
+// cosine with the map's light (the map depends on nothing else).
+fn cool_to_warm_at(c_in: f32, base: vec3<f32>) -> vec3<f32> {
+    let c = clamp(c_in, -1.0, 1.0);
+    let n = c * lookups.map_light.xyz + sqrt(max(1.0 - c * c, 0.0)) * lookups.map_across.xyz;
+    let texel = textureSampleLevel(cool_to_warm, clamp_sampler, env_uv(n, has(LOOKUP_COOL_TO_WARM_SPHERE)), 0.0);
+    if has(LOOKUP_COOL_TO_WARM_FACTORED) {
+        return clamp(texel.rgb + texel.a * base, vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    return texel.rgb;
+}
+
+// The procedural metal table at x (entry k at x = k / n, periodic): texel centres are half a texel
+// further.
+fn metal_table(x: f32) -> f32 {
+    let n = f32(textureDimensions(metal_bands).x);
+    return textureSampleLevel(metal_bands, repeat_sampler, vec2<f32>(x + 0.5 / n, 0.5), 0.0).r;
 }
 
 // Gooch et al. 1998 cool and warm tones: k_cool = (0, 0, b) + α k_d, k_warm = (y, y, 0) + β k_d with
@@ -191,6 +261,17 @@ fn shade_gradient(s: Surface, part: Part) -> vec3<f32> {
 }
 
 fn shade_cel(s: Surface) -> vec3<f32> {
+    if has(LOOKUP_CEL) {
+        // The baked row: diffuse steps scale the base colour relative to the brightest one; the
+        // specular band above it goes towards white.
+        let value = cel_table(max(dot(s.n, s.l), 0.0));
+        let top = lookups.cel_diffuse_max;
+        var c = s.base * (min(value, top) / top);
+        if has(LOOKUP_CEL_SPECULAR) {
+            c = mix(c, vec3<f32>(1.0), 0.8 * clamp((value - top) / max(1.0 - top, 1e-3), 0.0, 1.0));
+        }
+        return c;
+    }
     let level = cel_level(max(dot(s.n, s.l), 0.0));
     var c = s.base * mix(0.35, 1.0, level);
     if (frame.flags & FLAG_CEL_SPECULAR) != 0u {
@@ -204,33 +285,65 @@ fn shade_cel(s: Surface) -> vec3<f32> {
 
 fn shade_gooch(s: Surface) -> vec3<f32> {
     let nl = dot(s.n, s.l);
-    var c = gooch_tones(s.base, 0.5 * (1.0 + nl));
-    if (frame.flags & FLAG_SPLASH_BACK) != 0u {
-        // Gooch et al. 1999, §3.2: (α|cos θ| + (1 − α))^β darkens the terminator and lets light
-        // splash back opposite the key light.
-        let alpha = frame.style_params.x;
-        let beta = frame.style_params.y;
-        c = c * pow(alpha * abs(nl) + (1.0 - alpha), beta);
+    let splash = (frame.flags & FLAG_SPLASH_BACK) != 0u;
+    let alpha = frame.style_params.x;
+    let beta = frame.style_params.y;
+    var c: vec3<f32>;
+    if has(LOOKUP_COOL_TO_WARM) {
+        c = cool_to_warm_at(nl, s.base);
+        if splash && !has(LOOKUP_COOL_TO_WARM_SPLASH) {
+            // Gooch et al. 1999, §3.2, as drafter-textures bakes it: |α cos θ + (1 − α)|^β.
+            c = c * pow(abs(alpha * nl + (1.0 - alpha)), beta);
+        }
+    } else {
+        c = gooch_tones(s.base, 0.5 * (1.0 + nl));
+        if splash {
+            // Gooch et al. 1999, §3.2: (α|cos θ| + (1 − α))^β darkens the terminator and lets
+            // light splash back opposite the key light.
+            c = c * pow(alpha * abs(nl) + (1.0 - alpha), beta);
+        }
     }
     let h = normalize(s.l + s.v);
     let highlight = pow(max(dot(s.n, h), 0.0), 48.0) * step(0.0, nl);
     return min(c + vec3<f32>(0.5 * highlight), vec3<f32>(1.0));
 }
 
+// ten Bosch's Goochel: the cel steps of the full-range (1 + n·l)/2 as the cool-to-warm blend.
 fn shade_goochel(s: Surface) -> vec3<f32> {
-    return gooch_tones(s.base, cel_level(0.5 * (1.0 + dot(s.n, s.l))));
+    let x = 0.5 * (1.0 + dot(s.n, s.l));
+    var t: f32;
+    if has(LOOKUP_CEL) {
+        let low = lookups.cel_min_level;
+        let top = lookups.cel_diffuse_max;
+        t = clamp((min(cel_table(x), top) - low) / max(top - low, 1e-3), 0.0, 1.0);
+    } else {
+        t = cel_level(x);
+    }
+    if has(LOOKUP_COOL_TO_WARM) {
+        return cool_to_warm_at(2.0 * t - 1.0, s.base);
+    }
+    return gooch_tones(s.base, t);
 }
 
-// Gooch et al. 1999, §5.2.1: bands from the random table, indexed by the angle of the normal
-// around the part's principal axis (uniform around a cylinder), plus Phong highlights from lights in
-// the directions of an icosahedron's vertices (those facing the viewer), specular power 40,
-// coefficient 0.3.
+// Gooch et al. 1999, §5.2.1: bands from the random table around the part's principal axis, plus
+// Phong highlights from lights in the directions of an icosahedron's vertices, specular power 40,
+// coefficient 0.3. Baked: the band texture at u = s·(1 + n·w)/2 (w = obb.axes[1], the table
+// resampled as a cosine distribution) and the highlight map by the eye-space normal. Procedural:
+// the viewer's table by the angle around the axis, and the six lights facing the viewer.
 fn shade_metal(s: Surface, part: Part, normal_in_render: vec3<f32>) -> vec3<f32> {
-    let u = atan2(dot(normal_in_render, part.axis1.xyz), dot(normal_in_render, part.axis2.xyz)) / (2.0 * PI);
-    let band = metal(u * 2.0);
     let tint = mix(vec3<f32>(0.78, 0.80, 0.84), s.base, 0.25);
     // A little diffuse light so that flat faces (one band each) still read apart.
-    var c = tint * mix(0.4, 1.0, band) * (0.75 + 0.25 * max(dot(s.n, s.l), 0.0));
+    let diffuse = 0.75 + 0.25 * max(dot(s.n, s.l), 0.0);
+    if has(LOOKUP_METAL) {
+        let u = lookups.metal.x * 0.5 * (1.0 + dot(normal_in_render, part.axis1.xyz));
+        let band = textureSampleLevel(metal_bands, repeat_sampler, vec2<f32>(u, 0.5), 0.0).r;
+        let uv = env_uv(s.n, has(LOOKUP_METAL_SPHERE));
+        let highlight = textureSampleLevel(metal_highlights, clamp_sampler, uv, 0.0).r;
+        return min(tint * mix(0.4, 1.0, band) * diffuse + vec3<f32>(highlight), vec3<f32>(1.0));
+    }
+    let u = atan2(dot(normal_in_render, part.axis1.xyz), dot(normal_in_render, part.axis2.xyz)) / (2.0 * PI);
+    let band = metal_table(u * 2.0);
+    var c = tint * mix(0.4, 1.0, band) * diffuse;
     let phi = 1.618034;
     var lights = array<vec3<f32>, 6>(
         vec3<f32>(0.0, 1.0, phi), vec3<f32>(0.0, -1.0, phi), vec3<f32>(phi, 0.0, 1.0),
@@ -244,10 +357,18 @@ fn shade_metal(s: Surface, part: Part, normal_in_render: vec3<f32>) -> vec3<f32>
 }
 
 // Freudenberg's soft threshold: ink = clamp(c · (1 − (T + I))) of a halftone T against the
-// intensity I; a second, crossing set of strokes where the surface is darker. Screen-space strokes
-// (ten Bosch's "simple hatching").
+// intensity I, screen-space (ten Bosch's "simple hatching"). Baked: T from the halftone's mip chain
+// (the tile's screen size gives the gradients, so any control flow may sample it). Procedural: a
+// line pattern, and a second, crossing set of strokes where the surface is darker.
 fn shade_hatch(s: Surface) -> vec3<f32> {
     let intensity = 0.12 + 0.88 * max(dot(s.n, s.l), 0.0);
+    let paper = vec3<f32>(0.99, 0.98, 0.95);
+    let pen = vec3<f32>(0.08, 0.08, 0.1);
+    if has(LOOKUP_HATCH) {
+        let texel = 1.0 / lookups.hatch.x;
+        let t = textureSampleGrad(hatching, repeat_sampler, s.frag * texel, vec2<f32>(texel, 0.0), vec2<f32>(0.0, texel)).r;
+        return mix(paper, pen, clamp(lookups.hatch.y * (1.0 - (t + intensity)), 0.0, 1.0));
+    }
     let period = frame.style_params.z;
     let c = frame.style_params.w;
     let a = (s.frag.x + s.frag.y) * 0.70710678 / period;
@@ -257,8 +378,7 @@ fn shade_hatch(s: Surface) -> vec3<f32> {
     let ink1 = clamp(c * (1.0 - (t1 + intensity)), 0.0, 1.0);
     let ink2 = clamp(c * (1.0 - (t2 + intensity + 0.4)), 0.0, 1.0);
     let ink = max(ink1, ink2);
-    let paper = vec3<f32>(0.99, 0.98, 0.95);
-    return mix(paper, vec3<f32>(0.08, 0.08, 0.1), ink);
+    return mix(paper, pen, ink);
 }
 
 @fragment

@@ -37,7 +37,7 @@ pub(crate) fn storage_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgp
     }
 }
 
-/// A bind group layout entry for a 2D texture read with `textureLoad` in a fragment shader.
+/// A bind group layout entry for a 2D texture read in a fragment shader.
 pub(crate) fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -51,6 +51,18 @@ pub(crate) fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) 
     }
 }
 
+/// A bind group layout entry for a filtering sampler in a fragment shader.
+pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
+/// Filterable float texture (`texture_2d<f32>` read with a filtering sampler).
+pub(crate) const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
 /// Unfilterable float texture (`texture_2d<f32>` read with `textureLoad`).
 pub(crate) const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
 /// Unsigned integer texture (`texture_2d<u32>`).
