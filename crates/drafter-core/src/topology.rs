@@ -13,17 +13,21 @@
 //!   MeshLab count them), numbered in order of their first face;
 //! * degenerate triangles: a repeated welded vertex or an exactly zero area.
 //!
-//! How it is built, and why by hand: exact welding sorts vertex indices by their coordinate bits;
-//! edges are bucketed by their smaller vertex (a counting sort) and each bucket, a handful of
-//! entries, is sorted by the other vertex. No hash map is touched per edge, so the cost is linear
-//! apart from the weld sort, and the result (edge order included) depends only on the input.
+//! How it is built, and why by hand (this runs on every mesh before every stage, and on a
+//! 871k-triangle scan it was slower than the normal enhancement it feeds): welding is one pass in
+//! vertex order over an open-addressing hash table of cluster ids; a counting sort lists the
+//! corners around each welded vertex (the vertex→face CSR); one walk over the vertices in order
+//! then collects each vertex's edges to larger neighbours, a handful, sorts them with a small
+//! sorting network and emits them. Nothing is sorted globally and no hash map is touched per edge,
+//! so the cost is linear, and the result (edge order included) depends only on the input, never on
+//! the hash or the thread count. The degenerate flags and the components (a union-find) run beside
+//! the edge walk when rayon has a second thread.
 //!
 //! Degenerate faces with a repeated welded vertex contribute no edges: their collapsed edge has no
 //! direction and their other two edges would only double an existing one. Zero-area faces with three
 //! distinct vertices do contribute edges (they still close the surface topologically).
 
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 
 use crate::Mesh;
 
@@ -87,34 +91,26 @@ impl Topology {
 
     /// Same as [`Topology::build`] on raw arrays. Indices must be `< positions.len()`.
     pub fn from_triangles(positions: &[Vec3], triangles: &[[u32; 3]], weld: Weld) -> Topology {
-        let welded_of_vertex = match weld {
+        let Welded { of_vertex: welded_of_vertex, positions: welded_positions } = match weld {
             Weld::Exact => weld_exact(positions),
             Weld::Snap(fraction) => weld_snap(positions, fraction),
             Weld::Relative(fraction) => weld_tolerance(positions, fraction),
         };
-        let welded_count = welded_of_vertex.iter().map(|&w| w as usize + 1).max().unwrap_or(0);
-        let mut welded_positions = vec![Vec3::ZERO; welded_count];
-        // Walk backwards so the first original vertex of each cluster wins.
-        for (v, &w) in welded_of_vertex.iter().enumerate().rev() {
-            welded_positions[w as usize] = positions[v];
-        }
-        let faces: Vec<[u32; 3]> = triangles.par_iter().map(|t| t.map(|v| welded_of_vertex[v as usize])).collect();
-        let face_degenerate: Vec<bool> = faces
-            .par_iter()
-            .map(|&[a, b, c]| {
-                if a == b || b == c || c == a {
-                    return true;
-                }
-                let pa = welded_positions[a as usize].as_dvec3();
-                let pb = welded_positions[b as usize].as_dvec3();
-                let pc = welded_positions[c as usize].as_dvec3();
-                (pb - pa).cross(pc - pa) == DVec3::ZERO
-            })
-            .collect();
-
-        let (edges, edge_face_offsets, edge_faces, face_edges) = build_edges(welded_count, &faces);
-        let (vertex_face_offsets, vertex_faces) = build_vertex_faces(welded_count, &faces);
-        let (face_component, component_count) = build_components(welded_count, &faces);
+        let welded_count = welded_positions.len();
+        let WeldedFaces { faces, corner_counts, collapsed_faces } =
+            weld_faces(triangles, &welded_of_vertex, welded_count);
+        // Two independent halves: the degenerate flags and components read only `faces`, the
+        // adjacency tables are one chain. Each half is sequential, so the result does not depend on
+        // the thread count; with one thread `join` just runs them in turn.
+        let ((face_degenerate, (face_component, component_count)), adjacency) = rayon::join(
+            || {
+                let degenerate = faces.iter().map(|&face| is_degenerate(face, &welded_positions)).collect();
+                (degenerate, build_components(welded_count, &faces))
+            },
+            || build_adjacency(&faces, corner_counts, collapsed_faces),
+        );
+        let Adjacency { edges, edge_face_offsets, edge_faces, face_edges, vertex_face_offsets, vertex_faces } =
+            adjacency;
 
         Topology {
             welded_of_vertex,
@@ -208,6 +204,22 @@ impl Topology {
     }
 }
 
+/// A triangle whose welded vertices repeat, which therefore contributes no edges.
+#[inline]
+fn is_collapsed([a, b, c]: [u32; 3]) -> bool {
+    a == b || b == c || c == a
+}
+
+/// A repeated welded vertex or an exactly zero area (in f64, from the welded positions).
+#[inline]
+fn is_degenerate(face: [u32; 3], welded_positions: &[Vec3]) -> bool {
+    if is_collapsed(face) {
+        return true;
+    }
+    let [pa, pb, pc] = face.map(|v| welded_positions[v as usize].as_dvec3());
+    (pb - pa).cross(pc - pa) == DVec3::ZERO
+}
+
 /// Coordinate bits with -0.0 folded onto 0.0, so that the two zeros weld.
 #[inline]
 fn weld_key(p: Vec3) -> [u32; 3] {
@@ -220,12 +232,18 @@ impl Default for Weld {
     }
 }
 
-fn weld_exact(positions: &[Vec3]) -> Vec<u32> {
-    let keys: Vec<[u32; 3]> = positions.par_iter().map(|&p| weld_key(p)).collect();
-    weld_by_keys(&keys)
+/// Result of a weld: the cluster of each vertex, numbered in order of first occurrence, and the
+/// position of each cluster's first vertex.
+struct Welded {
+    of_vertex: Vec<u32>,
+    positions: Vec<Vec3>,
 }
 
-fn weld_snap(positions: &[Vec3], fraction: f64) -> Vec<u32> {
+fn weld_exact(positions: &[Vec3]) -> Welded {
+    weld_by_keys(positions, weld_key, |k| hash_words(k.map(u64::from)))
+}
+
+fn weld_snap(positions: &[Vec3], fraction: f64) -> Welded {
     let (lo, hi) =
         positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
             (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
@@ -236,52 +254,94 @@ fn weld_snap(positions: &[Vec3], fraction: f64) -> Vec<u32> {
     }
     // Rounding the coordinate itself (not relative to the box) keeps 0.0 at a cell centre, so noise
     // around zero welds.
-    let keys: Vec<[i64; 3]> =
-        positions.par_iter().map(|p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64)).collect();
-    weld_by_keys(&keys)
+    weld_by_keys(
+        positions,
+        |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64),
+        |k| hash_words(k.map(|c| c as u64)),
+    )
 }
 
 /// Welds vertices with equal keys; ids in order of first occurrence.
-fn weld_by_keys<K: Ord + Copy + Send + Sync>(keys: &[K]) -> Vec<u32> {
-    let n = keys.len();
-    let mut order: Vec<(K, u32)> = keys.par_iter().enumerate().map(|(i, &k)| (k, i as u32)).collect();
-    // Unique (key, index) pairs: the unstable sort is deterministic.
-    order.par_sort_unstable();
-    let mut representative = vec![0u32; n];
-    let mut start = 0;
-    while start < n {
-        let key = order[start].0;
-        let first = order[start].1;
-        let mut end = start;
-        while end < n && order[end].0 == key {
-            representative[order[end].1 as usize] = first;
-            end += 1;
-        }
-        start = end;
+///
+/// Written by hand for speed (it was a sort of (key, index) pairs, a quarter of the whole build on
+/// large meshes): one pass in vertex order over an open-addressing table (linear probing). A slot
+/// holds a cluster id and, in its spare high bits, a tag from the key's hash, so a probe compares
+/// keys (recomputed from the cluster's first position) only when the tags agree. A general hash
+/// map would store every key again and hash it with a slower general-purpose hasher. The result
+/// depends only on the input, not on the hash: a vertex joins the cluster of the first earlier
+/// vertex with an equal key, or opens the next cluster.
+fn weld_by_keys<K: Copy + PartialEq>(
+    positions: &[Vec3],
+    key_of: impl Fn(Vec3) -> K,
+    hash_of: impl Fn(K) -> u64,
+) -> Welded {
+    let n = positions.len();
+    // Load factor at most 1/2. A slot is 0 when empty, else `cluster id + 1` in the low `id_bits`
+    // and the tag above them (the hash's top bits pick the slot, its low bits make the tag).
+    let bits = (2 * n).next_power_of_two().max(16).trailing_zeros();
+    let mask = (1usize << bits) - 1;
+    let id_bits = u32::BITS - (n as u32).leading_zeros();
+    let id_mask = if id_bits >= 32 { u32::MAX } else { (1u32 << id_bits) - 1 };
+    let mut table = vec![0u32; 1 << bits];
+    let mut cluster_positions: Vec<Vec3> = Vec::with_capacity(n);
+    let mut of_vertex = Vec::with_capacity(n);
+    for &p in positions {
+        let key = key_of(p);
+        let hash = hash_of(key);
+        let tag = hash as u32 & !id_mask;
+        let mut slot = (hash >> (64 - bits)) as usize;
+        let id = loop {
+            let stored = table[slot];
+            if stored == 0 {
+                let id = cluster_positions.len() as u32;
+                table[slot] = tag | (id + 1);
+                cluster_positions.push(p);
+                break id;
+            }
+            let id = (stored & id_mask).wrapping_sub(1);
+            if stored & !id_mask == tag && key_of(cluster_positions[id as usize]) == key {
+                break id;
+            }
+            slot = (slot + 1) & mask;
+        };
+        of_vertex.push(id);
     }
-    number_clusters(&representative)
+    cluster_positions.shrink_to_fit();
+    Welded { of_vertex, positions: cluster_positions }
 }
 
-/// Turns "representative original vertex" into dense welded ids in order of first occurrence.
-/// Requires `representative[v] <= v`.
-fn number_clusters(representative: &[u32]) -> Vec<u32> {
-    let mut id = vec![0u32; representative.len()];
-    let mut next = 0u32;
+/// Multiply-rotate mixing of three key words (FxHash's step, plus a final fold so that the low
+/// half, used as a tag, also depends on every input bit).
+#[inline]
+fn hash_words(words: [u64; 3]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut h = 0u64;
+    for word in words {
+        h = (h.rotate_left(23) ^ word).wrapping_mul(K);
+    }
+    h ^ (h >> 32)
+}
+
+/// Turns "representative original vertex" into dense welded ids in order of first occurrence, and
+/// the representatives' positions. Requires `representative[v] <= v`.
+fn number_clusters(representative: &[u32], positions: &[Vec3]) -> Welded {
+    let mut of_vertex = vec![0u32; representative.len()];
+    let mut cluster_positions = Vec::new();
     for v in 0..representative.len() {
         let r = representative[v] as usize;
         if r == v {
-            id[v] = next;
-            next += 1;
+            of_vertex[v] = cluster_positions.len() as u32;
+            cluster_positions.push(positions[v]);
         } else {
-            id[v] = id[r];
+            of_vertex[v] = of_vertex[r];
         }
     }
-    id
+    Welded { of_vertex, positions: cluster_positions }
 }
 
-fn weld_tolerance(positions: &[Vec3], fraction: f64) -> Vec<u32> {
+fn weld_tolerance(positions: &[Vec3], fraction: f64) -> Welded {
     // Greedy clustering over a hash grid: a vertex joins the lowest-numbered earlier representative
-    // within the distance. Slower than the sort-based welds; for explicit tolerances only.
+    // within the distance. Slower than the key-based welds; for explicit tolerances only.
     let mut bounds_min = DVec3::splat(f64::INFINITY);
     let mut bounds_max = DVec3::splat(f64::NEG_INFINITY);
     for p in positions {
@@ -323,106 +383,222 @@ fn weld_tolerance(positions: &[Vec3], fraction: f64) -> Vec<u32> {
             }
         }
     }
-    number_clusters(&representative)
+    number_clusters(&representative, positions)
 }
 
-type EdgeTables = (Vec<[u32; 2]>, Vec<u32>, Vec<u32>, Vec<[u32; 3]>);
+/// The CSR tables of [`Topology`] derived from the welded faces.
+struct Adjacency {
+    edges: Vec<[u32; 2]>,
+    edge_face_offsets: Vec<u32>,
+    edge_faces: Vec<u32>,
+    face_edges: Vec<[u32; 3]>,
+    vertex_face_offsets: Vec<u32>,
+    vertex_faces: Vec<u32>,
+}
 
-fn build_edges(vertex_count: usize, faces: &[[u32; 3]]) -> EdgeTables {
-    // Counting sort of corners (f*3+k) by the smaller vertex of their edge.
-    let mut bucket_offsets = vec![0u32; vertex_count + 1];
-    let collapsed = |a: u32, b: u32, c: u32| a == b || b == c || c == a;
-    for &[a, b, c] in faces {
-        if collapsed(a, b, c) {
+/// The welded faces, and the number of faces around each welded vertex (each face counted once
+/// per distinct vertex) in `corner_counts[v + 2]`, the layout [`build_adjacency`] wants.
+struct WeldedFaces {
+    faces: Vec<[u32; 3]>,
+    corner_counts: Vec<u32>,
+    collapsed_faces: usize,
+}
+
+fn weld_faces(triangles: &[[u32; 3]], welded_of_vertex: &[u32], welded_count: usize) -> WeldedFaces {
+    let mut corner_counts = vec![0u32; welded_count + 2];
+    let mut collapsed_faces = 0usize;
+    let faces = triangles
+        .iter()
+        .map(|t| {
+            let face = t.map(|v| welded_of_vertex[v as usize]);
+            let [a, b, c] = face;
+            corner_counts[a as usize + 2] += 1;
+            if is_collapsed(face) {
+                collapsed_faces += 1;
+                // A vertex repeated within a collapsed face is listed once.
+                corner_counts[b as usize + 2] += u32::from(b != a);
+                corner_counts[c as usize + 2] += u32::from(c != a && c != b);
+            } else {
+                corner_counts[b as usize + 2] += 1;
+                corner_counts[c as usize + 2] += 1;
+            }
+            face
+        })
+        .collect();
+    WeldedFaces { faces, corner_counts, collapsed_faces }
+}
+
+/// Vertex→face CSR, then edges by walking it.
+///
+/// Written by hand for speed (the edge tables were half of the whole build): a counting sort lists
+/// the corners `3f + k` around each vertex in face order, once per distinct vertex of a face. Then
+/// one walk over the vertices in order collects, for vertex `v`, the face edges `{v, w}` with
+/// `w > v` (at most two per corner), sorts that handful by `(w, edge slot)` and emits the edges of
+/// `v`, while turning the corners back into face ids. So edges come out sorted by `(a, b)`, faces
+/// of an edge ascend, and nothing but the output is allocated per edge.
+fn build_adjacency(faces: &[[u32; 3]], corner_counts: Vec<u32>, collapsed_faces: usize) -> Adjacency {
+    // Counts are in `offsets[v + 2]`, so that after the prefix sum `offsets[v + 1]` is the start
+    // of `v`, used as its fill cursor; after filling it is the end of `v`, i.e. the CSR offset of
+    // `v + 1`. The extra entry is dropped.
+    let mut offsets = corner_counts;
+    let vertex_count = offsets.len() - 2;
+    for v in 2..offsets.len() {
+        offsets[v] += offsets[v - 1];
+    }
+    let mut vertex_faces = vec![0u32; offsets[vertex_count + 1] as usize];
+    for (f, &face) in faces.iter().enumerate() {
+        let [a, b, c] = face;
+        let corner = 3 * f as u32;
+        let mut put = |v: u32, k: u32| {
+            let cursor = &mut offsets[v as usize + 1];
+            vertex_faces[*cursor as usize] = corner + k;
+            *cursor += 1;
+        };
+        put(a, 0);
+        if !is_collapsed(face) {
+            put(b, 1);
+            put(c, 2);
+        } else {
+            if b != a {
+                put(b, 1);
+            }
+            if c != a && c != b {
+                put(c, 2);
+            }
+        }
+    }
+    offsets.pop();
+
+    // Every corner of a face that is not collapsed is one edge use, so `edge_faces` has exactly
+    // `corner_total` entries and there are at most that many edges. The tables are zeroed (pages
+    // untouched until written) and written by index, so the loop below has no data-dependent
+    // branches, which on a mesh are coin flips.
+    let corner_total = 3 * (faces.len() - collapsed_faces);
+    let mut edges = vec![[0u32; 2]; corner_total];
+    let mut edge_face_offsets = vec![0u32; corner_total + 1];
+    let mut edge_faces = vec![0u32; corner_total];
+    // Every slot is written: edges below, EDGE_NONE for collapsed faces.
+    let mut face_edges = vec![[0u32; 3]; faces.len()];
+    // The keys around a vertex: on the stack for all but the rare vertex with more faces.
+    let mut small = [u64::MAX; SMALL_KEYS];
+    let mut large: Vec<u64> = Vec::new();
+    let mut edge_count = 0usize;
+    let mut uses = 0usize;
+    let mut start = 0usize;
+    for (v, &end) in offsets[1..].iter().enumerate() {
+        let corners = &mut vertex_faces[start..end as usize];
+        start = end as usize;
+        let keys: &[u64] = if corners.len() < SMALL_KEYS / 2 {
+            small[..8].fill(u64::MAX);
+            let len = gather_keys(v as u32, corners, faces, &mut face_edges, &mut small);
+            sort_small(&mut small, len);
+            &small[..len]
+        } else {
+            large.clear();
+            large.resize((2 * corners.len() + 1).next_power_of_two(), u64::MAX);
+            let len = gather_keys(v as u32, corners, faces, &mut face_edges, &mut large);
+            large.truncate(len);
+            large.sort_unstable();
+            &large
+        };
+        // A new edge starts wherever the other end changes; `edge_face_offsets[edge_count]` is
+        // rewritten after every use, so it ends up at the end of the edge.
+        let mut last = u32::MAX;
+        for (&key, edge_face) in keys.iter().zip(&mut edge_faces[uses..uses + keys.len()]) {
+            let other = (key >> 32) as u32;
+            let slot = key as u32 as usize;
+            edge_count += usize::from(other != last);
+            last = other;
+            edges[edge_count - 1] = [v as u32, other];
+            face_edges[slot / 3][slot % 3] = (edge_count - 1) as u32;
+            *edge_face = (slot / 3) as u32;
+            uses += 1;
+            edge_face_offsets[edge_count] = uses as u32;
+        }
+    }
+    edges.truncate(edge_count);
+    edges.shrink_to_fit();
+    edge_face_offsets.truncate(edge_count + 1);
+    edge_face_offsets.shrink_to_fit();
+    Adjacency { edges, edge_face_offsets, edge_faces, face_edges, vertex_face_offsets: offsets, vertex_faces }
+}
+
+/// Room for the keys of a vertex with fewer than `SMALL_KEYS / 2` faces (two keys per face and a
+/// spare slot). A power of two, so that masked indices need no bounds checks.
+const SMALL_KEYS: usize = 64;
+
+/// Writes `w << 32 | edge slot 3f + k` into `keys` for the edges `{v, w}`, `w > v`, of the faces
+/// at the corners around `v`, turns those corners into face ids and returns the number of keys.
+/// Collapsed faces contribute nothing and get [`EDGE_NONE`] edges. `keys.len()` must be a power of
+/// two above twice the number of corners.
+#[inline(always)]
+fn gather_keys(
+    v: u32,
+    corners: &mut [u32],
+    faces: &[[u32; 3]],
+    face_edges: &mut [[u32; 3]],
+    keys: &mut [u64],
+) -> usize {
+    const NEXT: [usize; 3] = [1, 2, 0];
+    const PREV: [usize; 3] = [2, 0, 1];
+    let mask = keys.len() - 1;
+    let mut len = 0;
+    for corner in corners {
+        let (f, k) = (*corner as usize / 3, *corner as usize % 3);
+        *corner = f as u32;
+        let face = faces[f];
+        if is_collapsed(face) {
+            face_edges[f] = [EDGE_NONE; 3];
             continue;
         }
-        bucket_offsets[a.min(b) as usize + 1] += 1;
-        bucket_offsets[b.min(c) as usize + 1] += 1;
-        bucket_offsets[c.min(a) as usize + 1] += 1;
+        // Edge slot k is (v, next), slot k + 2 is (prev, v). Every key is written, and kept
+        // (`len` moves past it) only if the other end is larger.
+        let (next, prev) = (face[NEXT[k]], face[PREV[k]]);
+        keys[len & mask] = u64::from(next) << 32 | (3 * f + k) as u64;
+        len += usize::from(next > v);
+        keys[len & mask] = u64::from(prev) << 32 | (3 * f + PREV[k]) as u64;
+        len += usize::from(prev > v);
     }
-    for v in 0..vertex_count {
-        bucket_offsets[v + 1] += bucket_offsets[v];
-    }
-    let corner_total = bucket_offsets[vertex_count] as usize;
-    // Each entry: (larger vertex, corner).
-    let mut entries = vec![(0u32, 0u32); corner_total];
-    let mut cursor = bucket_offsets.clone();
-    for (f, &[a, b, c]) in faces.iter().enumerate() {
-        if collapsed(a, b, c) {
-            continue;
-        }
-        for (k, (u, w)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
-            let slot = &mut cursor[u.min(w) as usize];
-            entries[*slot as usize] = (u.max(w), (f * 3 + k) as u32);
-            *slot += 1;
-        }
-    }
-    // Sort within each bucket (tiny) by (other vertex, corner): corners ascend, so faces ascend.
-    let bucket_ranges: Vec<(usize, usize)> =
-        (0..vertex_count).map(|v| (bucket_offsets[v] as usize, bucket_offsets[v + 1] as usize)).collect();
-    {
-        let mut rest: &mut [(u32, u32)] = &mut entries;
-        let mut slices: Vec<&mut [(u32, u32)]> = Vec::with_capacity(vertex_count);
-        for &(s, e) in &bucket_ranges {
-            let (head, tail) = rest.split_at_mut(e - s);
-            slices.push(head);
-            rest = tail;
-        }
-        slices.par_iter_mut().with_min_len(4096).for_each(|s| s.sort_unstable());
-    }
-    let mut edges = Vec::with_capacity(corner_total / 2 + 1);
-    let mut edge_face_offsets = Vec::with_capacity(corner_total / 2 + 2);
-    let mut edge_faces = Vec::with_capacity(corner_total);
-    let mut face_edges = vec![[EDGE_NONE; 3]; faces.len()];
-    edge_face_offsets.push(0u32);
-    for (v, &(s, e)) in bucket_ranges.iter().enumerate() {
-        let mut i = s;
-        while i < e {
-            let other = entries[i].0;
-            let edge_id = edges.len() as u32;
-            edges.push([v as u32, other]);
-            while i < e && entries[i].0 == other {
-                let corner = entries[i].1 as usize;
-                let face = (corner / 3) as u32;
-                face_edges[corner / 3][corner % 3] = edge_id;
-                // A face appears at most once per edge unless it is collapsed (excluded above).
-                edge_faces.push(face);
-                i += 1;
-            }
-            edge_face_offsets.push(edge_faces.len() as u32);
-        }
-    }
-    (edges, edge_face_offsets, edge_faces, face_edges)
+    // The slot after the last key may hold a rejected one; the sorting networks need MAX there.
+    keys[len & mask] = u64::MAX;
+    len
 }
 
-fn build_vertex_faces(vertex_count: usize, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
-    let mut offsets = vec![0u32; vertex_count + 1];
-    for tri in faces {
-        for (k, &v) in tri.iter().enumerate() {
-            // A vertex repeated within a degenerate face is listed once.
-            if tri[..k].contains(&v) {
-                continue;
-            }
-            offsets[v as usize + 1] += 1;
-        }
+/// Sorts `keys[..len]`, the few edges around one vertex (typically 4 to 8); `keys[len..8]` must
+/// be `u64::MAX`. Up to 8 keys go through a fixed sorting network of branch-free min/max (Knuth's
+/// optimal ones for 4 and 8 inputs): the keys of a mesh are in no useful order, so the branches
+/// of an insertion sort would be mispredicted about once per key. (A 16-input network for the
+/// rarer longer lists measured no faster than the library sort.)
+#[inline]
+fn sort_small(keys: &mut [u64], len: usize) {
+    // One comparator, written out for every pair so that the network stays in registers.
+    macro_rules! network {
+        ($n:literal: $(($i:literal, $j:literal)),*) => {{
+            let Some(head) = keys.first_chunk_mut::<$n>() else { return };
+            let mut a = *head;
+            $(
+                let (x, y) = (a[$i], a[$j]);
+                a[$i] = x.min(y);
+                a[$j] = x.max(y);
+            )*
+            *head = a;
+        }};
     }
-    for v in 0..vertex_count {
-        offsets[v + 1] += offsets[v];
+    match len {
+        0..=1 => {}
+        2..=4 => network!(4: (0, 1), (2, 3), (0, 2), (1, 3), (1, 2)),
+        5..=8 => network!(8: (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7), (0, 1), (2, 3),
+                             (4, 5), (6, 7), (2, 4), (3, 5), (1, 4), (3, 6), (1, 2), (3, 4), (5, 6)),
+        _ => keys[..len].sort_unstable(),
     }
-    let mut cursor = offsets.clone();
-    let mut list = vec![0u32; offsets[vertex_count] as usize];
-    for (f, tri) in faces.iter().enumerate() {
-        for (k, &v) in tri.iter().enumerate() {
-            if tri[..k].contains(&v) {
-                continue;
-            }
-            list[cursor[v as usize] as usize] = f as u32;
-            cursor[v as usize] += 1;
-        }
-    }
-    (offsets, list)
 }
 
+/// Vertex-connected components, numbered in order of their first face.
+///
+/// Union-find over the welded vertices with the union towards the smaller root, so every parent is
+/// at most its child: after the unions, one pass in vertex order makes every vertex point at its
+/// root, without further finds. Within a face the first vertex's root follows each union, so all
+/// three vertex sets are joined.
 fn build_components(vertex_count: usize, faces: &[[u32; 3]]) -> (Vec<u32>, usize) {
     let mut parent: Vec<u32> = (0..vertex_count as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -434,27 +610,32 @@ fn build_components(vertex_count: usize, faces: &[[u32; 3]]) -> (Vec<u32>, usize
         x
     }
     for &[a, b, c] in faces {
-        let ra = find(&mut parent, a);
+        let mut ra = find(&mut parent, a);
         for v in [b, c] {
             let rv = find(&mut parent, v);
             if rv != ra {
-                // Union towards the smaller root keeps the structure deterministic.
                 let (lo, hi) = if ra < rv { (ra, rv) } else { (rv, ra) };
                 parent[hi as usize] = lo;
+                ra = lo;
             }
         }
     }
+    for v in 0..vertex_count {
+        parent[v] = parent[parent[v] as usize];
+    }
     let mut label = vec![u32::MAX; vertex_count];
     let mut count = 0u32;
-    let mut face_component = Vec::with_capacity(faces.len());
-    for &[a, _, _] in faces {
-        let root = find(&mut parent, a) as usize;
-        if label[root] == u32::MAX {
-            label[root] = count;
-            count += 1;
-        }
-        face_component.push(label[root]);
-    }
+    let face_component = faces
+        .iter()
+        .map(|&[a, _, _]| {
+            let root = parent[a as usize] as usize;
+            if label[root] == u32::MAX {
+                label[root] = count;
+                count += 1;
+            }
+            label[root]
+        })
+        .collect();
     (face_component, count as usize)
 }
 
@@ -608,6 +789,226 @@ mod tests {
             assert_eq!(topo.edges, reference.keys().copied().collect::<Vec<_>>());
             for (e, faces) in reference.values().enumerate() {
                 assert_eq!(topo.faces_of_edge(e), faces.as_slice());
+            }
+        }
+    }
+
+    /// The tables as a brute-force reading of the module docs would compute them, from given
+    /// welded ids: maps instead of counting sorts, a flood fill instead of union-find.
+    fn reference_tables(topo: &Topology, triangles: &[[u32; 3]]) {
+        let welded_count = topo.welded_positions.len();
+        let faces: Vec<[u32; 3]> = triangles.iter().map(|t| t.map(|v| topo.welded_of_vertex[v as usize])).collect();
+        assert_eq!(topo.faces, faces);
+
+        let collapsed = |&[a, b, c]: &[u32; 3]| a == b || b == c || c == a;
+        let degenerate: Vec<bool> = faces
+            .iter()
+            .map(|face| {
+                let [pa, pb, pc] = face.map(|v| topo.welded_positions[v as usize].as_dvec3());
+                collapsed(face) || (pb - pa).cross(pc - pa) == DVec3::ZERO
+            })
+            .collect();
+        assert_eq!(topo.face_degenerate, degenerate);
+
+        let mut uses: std::collections::BTreeMap<[u32; 2], Vec<(usize, usize)>> = Default::default();
+        for (f, face) in faces.iter().enumerate() {
+            if collapsed(face) {
+                continue;
+            }
+            for k in 0..3 {
+                let (u, w) = (face[k], face[(k + 1) % 3]);
+                uses.entry([u.min(w), u.max(w)]).or_default().push((f, k));
+            }
+        }
+        assert_eq!(topo.edges, uses.keys().copied().collect::<Vec<_>>());
+        let mut face_edges = vec![[EDGE_NONE; 3]; faces.len()];
+        let mut edge_face_offsets = vec![0u32];
+        let mut edge_faces = Vec::new();
+        for (e, list) in uses.values().enumerate() {
+            for &(f, k) in list {
+                face_edges[f][k] = e as u32;
+                edge_faces.push(f as u32);
+            }
+            edge_face_offsets.push(edge_faces.len() as u32);
+        }
+        assert_eq!(topo.face_edges, face_edges);
+        assert_eq!(topo.edge_face_offsets, edge_face_offsets);
+        assert_eq!(topo.edge_faces, edge_faces);
+
+        let mut vertex_face_offsets = vec![0u32];
+        let mut vertex_faces = Vec::new();
+        for v in 0..welded_count as u32 {
+            vertex_faces.extend((0..faces.len() as u32).filter(|&f| faces[f as usize].contains(&v)));
+            vertex_face_offsets.push(vertex_faces.len() as u32);
+        }
+        assert_eq!(topo.vertex_face_offsets, vertex_face_offsets);
+        assert_eq!(topo.vertex_faces, vertex_faces);
+
+        // Flood fill over faces sharing a vertex, started from each unlabelled face in order.
+        let mut face_component = vec![u32::MAX; faces.len()];
+        let mut count = 0;
+        for start in 0..faces.len() {
+            if face_component[start] != u32::MAX {
+                continue;
+            }
+            face_component[start] = count;
+            let mut stack = vec![start];
+            while let Some(f) = stack.pop() {
+                for g in 0..faces.len() {
+                    if face_component[g] == u32::MAX && faces[g].iter().any(|v| faces[f].contains(v)) {
+                        face_component[g] = count;
+                        stack.push(g);
+                    }
+                }
+            }
+            count += 1;
+        }
+        assert_eq!(topo.face_component, face_component);
+        assert_eq!(topo.component_count, count as usize);
+    }
+
+    /// Welded ids in order of first occurrence by key, and the first position of each.
+    fn reference_weld(positions: &[Vec3], key: impl Fn(Vec3) -> [i64; 3]) -> (Vec<u32>, Vec<Vec3>) {
+        let mut ids: std::collections::BTreeMap<[i64; 3], u32> = Default::default();
+        let mut welded_positions = Vec::new();
+        let of_vertex = positions
+            .iter()
+            .map(|&p| {
+                *ids.entry(key(p)).or_insert_with(|| {
+                    welded_positions.push(p);
+                    welded_positions.len() as u32 - 1
+                })
+            })
+            .collect();
+        (of_vertex, welded_positions)
+    }
+
+    /// Random meshes with duplicated positions (also -0.0 against 0.0 and snap-sized noise),
+    /// unreferenced vertices, repeated indices, zero-area and non-manifold faces, against
+    /// [`reference_tables`] and [`reference_weld`], for every weld.
+    #[test]
+    fn every_table_matches_a_brute_force_reference() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = |m: u32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % u64::from(m)) as u32
+        };
+        for _ in 0..400 {
+            let nv = 1 + rnd(40);
+            let grid = 1 + rnd(4);
+            let positions: Vec<Vec3> = (0..nv)
+                .map(|_| {
+                    let mut c = [0.0f32; 3].map(|_| rnd(grid) as f32);
+                    match rnd(8) {
+                        0 => c[0] = -c[0],
+                        1 => c[1] += 1e-12,
+                        _ => {}
+                    }
+                    Vec3::from(c)
+                })
+                .collect();
+            let triangles: Vec<[u32; 3]> = (0..rnd(60)).map(|_| [rnd(nv), rnd(nv), rnd(nv)]).collect();
+
+            let exact = Topology::from_triangles(&positions, &triangles, Weld::Exact);
+            let expected = reference_weld(&positions, |p| weld_key(p).map(i64::from));
+            assert_eq!((&exact.welded_of_vertex, &exact.welded_positions), (&expected.0, &expected.1));
+            reference_tables(&exact, &triangles);
+
+            let snap = Topology::from_triangles(&positions, &triangles, Weld::default());
+            let (lo, hi) = positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+            });
+            let cell = (hi - lo).length() * DEFAULT_SNAP_FRACTION;
+            let expected = if cell > 0.0 {
+                reference_weld(&positions, |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64))
+            } else {
+                reference_weld(&positions, |p| weld_key(p).map(i64::from))
+            };
+            assert_eq!((&snap.welded_of_vertex, &snap.welded_positions), (&expected.0, &expected.1));
+            reference_tables(&snap, &triangles);
+
+            reference_tables(&Topology::from_triangles(&positions, &triangles, Weld::Relative(0.3)), &triangles);
+        }
+    }
+
+    /// By the 0-1 principle a comparator network sorts everything if it sorts every 0/1 input.
+    #[test]
+    fn sorting_networks_sort_every_zero_one_input() {
+        for len in 0..=16 {
+            for bits in 0u32..1 << len.min(12) {
+                let mut keys = [u64::MAX; SMALL_KEYS];
+                for (i, key) in keys[..len].iter_mut().enumerate() {
+                    // Distinct keys, as in the walk: the 0/1 value on top, the index below.
+                    *key = u64::from(bits >> i & 1) << 32 | i as u64;
+                }
+                let mut expected = keys[..len].to_vec();
+                expected.sort_unstable();
+                sort_small(&mut keys, len);
+                assert_eq!(keys[..len], expected[..], "len {len}, input {bits:b}");
+            }
+        }
+    }
+
+    /// A face whose second vertex's set has a smaller root than the first's, and whose third's has
+    /// a smaller one still, must join all three sets (an earlier union-find joined only two).
+    #[test]
+    fn components_join_all_three_vertex_sets_of_a_face() {
+        let p: Vec<Vec3> = (0..8).map(|i| Vec3::new(i as f32, (i * i) as f32, 0.0)).collect();
+        let t = vec![[7, 6, 0], [3, 4, 6], [0, 1, 7]];
+        let topo = Topology::from_triangles(&p, &t, Weld::Exact);
+        assert_eq!(topo.component_count, 1);
+        assert_eq!(topo.face_component, vec![0, 0, 0]);
+    }
+
+    /// The same tables whatever the thread count, also on a mesh large enough for rayon to split.
+    #[test]
+    fn result_does_not_depend_on_the_thread_count() {
+        let n = 300u32;
+        let positions: Vec<Vec3> =
+            (0..n * n).map(|i| Vec3::new((i % n) as f32, (i / n) as f32, ((i * 7919) % 13) as f32)).collect();
+        let mut triangles = Vec::new();
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                let v = y * n + x;
+                triangles.push([v, v + 1, v + n]);
+                triangles.push([v + 1, v + n + 1, v + n]);
+            }
+        }
+        // Duplicates of existing positions used by a face, a third face on an edge and a collapsed
+        // face.
+        let mut positions = positions;
+        positions.extend_from_within(0..500);
+        triangles.push([n * n, n * n + 1, n * n + 2]);
+        triangles.push([1, n, 2 * n + 5]);
+        triangles.push([5, 5, 6]);
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+            pool.install(|| Topology::from_triangles(&positions, &triangles, Weld::default()))
+        };
+        let one = build(1);
+        reference_edges_only(&one);
+        for threads in [2, 4] {
+            let other = build(threads);
+            assert_eq!(one.welded_of_vertex, other.welded_of_vertex);
+            assert_eq!(one.edges, other.edges);
+            assert_eq!(one.edge_face_offsets, other.edge_face_offsets);
+            assert_eq!(one.edge_faces, other.edge_faces);
+            assert_eq!(one.face_edges, other.face_edges);
+            assert_eq!(one.vertex_face_offsets, other.vertex_face_offsets);
+            assert_eq!(one.vertex_faces, other.vertex_faces);
+            assert_eq!(one.face_component, other.face_component);
+            assert_eq!(one.face_degenerate, other.face_degenerate);
+        }
+    }
+
+    /// Edges sorted and each face's edges containing the face (a cheap check on a big mesh).
+    fn reference_edges_only(topo: &Topology) {
+        assert!(topo.edges.windows(2).all(|w| w[0] < w[1]));
+        for (f, ids) in topo.face_edges.iter().enumerate() {
+            for &e in ids.iter().filter(|&&e| e != EDGE_NONE) {
+                assert!(topo.faces_of_edge(e as usize).contains(&(f as u32)));
             }
         }
     }
