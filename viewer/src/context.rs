@@ -10,10 +10,17 @@ pub enum RenderError {
     /// No adapter: no GPU and no software Vulkan/GL driver.
     #[error(
         "no GPU adapter found ({0}); headless rendering needs a Vulkan or GL driver: on Debian/Ubuntu \
-         `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe, a CPU Vulkan device), or set \
-         WGPU_BACKEND=gl with Mesa's EGL installed"
+         `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe, a CPU Vulkan device)"
     )]
     NoAdapter(String),
+    /// An adapter was found but lacks a capability the passes need (e.g. Mesa's GLES fallback
+    /// cannot render to 32-bit float targets).
+    #[error(
+        "the GPU adapter {0} cannot be used: {1}; install a Vulkan driver (on Debian/Ubuntu \
+         `apt-get install mesa-vulkan-drivers libvulkan1`) or choose another adapter with \
+         WGPU_BACKEND / WGPU_ADAPTER_NAME"
+    )]
+    Unsupported(String, String),
     #[error("the GPU adapter refused a device: {0}")]
     Device(String),
     /// Options outside their documented ranges (the caller's fault).
@@ -67,6 +74,7 @@ impl Gpu {
 
     /// A device on `adapter` (the window chooses one compatible with its surface).
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
+        Self::check_capabilities(&adapter)?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("drafter device"),
             required_features: wgpu::Features::empty(),
@@ -75,6 +83,37 @@ impl Gpu {
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;
         Ok(Gpu { instance, adapter, device, queue })
+    }
+
+    /// Fails with a clear message, before any pipeline is made, when the adapter cannot render to
+    /// a target format the passes use (wgpu would otherwise report a validation error on the
+    /// first pipeline). GLES without `EXT_color_buffer_float` is the case seen in practice: wgpu
+    /// falls back to it when no Vulkan driver is installed.
+    fn check_capabilities(adapter: &wgpu::Adapter) -> Result<(), RenderError> {
+        let renderable = |format: wgpu::TextureFormat| {
+            adapter.get_texture_format_features(format).allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        };
+        use crate::targets::*;
+        let targets = [
+            COLOR_FORMAT,
+            NORMAL_FORMAT,
+            LINEAR_DEPTH_FORMAT,
+            PART_ID_FORMAT,
+            DEPTH_FORMAT,
+            BLUR_FORMAT,
+            SHADOW_MASK_FORMAT,
+            SHADOW_STENCIL_FORMAT,
+        ];
+        for format in targets {
+            if !renderable(format) {
+                let info = adapter.get_info();
+                return Err(RenderError::Unsupported(
+                    format!("'{}' ({:?})", info.name, info.backend),
+                    format!("it cannot render to {format:?} targets"),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// "name (backend, device type)", e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
