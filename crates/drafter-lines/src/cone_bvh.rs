@@ -64,6 +64,9 @@
 
 use std::time::Duration;
 
+/// How many leaves ahead of the one being tested a walk prefetches.
+const PREFETCH_AHEAD: usize = 3;
+
 use glam::{DVec3, Mat4, Vec3, Vec3A, Vec4};
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
@@ -579,7 +582,7 @@ impl ConeBvh {
                 }
                 for (j, &i) in level[..width].iter().enumerate() {
                     // Start loading a later leaf while this one is tested (see `brute::prefetch`).
-                    if let Some(&ahead) = level[..width].get(j + crate::gauss::PREFETCH_AHEAD) {
+                    if let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
                         let a = &self.nodes[ahead as usize];
                         self.stream.prefetch(a.quad as usize, a.blocks);
                     }
