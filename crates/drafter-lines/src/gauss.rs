@@ -62,7 +62,7 @@ use serde::{Deserialize, Serialize};
 use crate::brute::{OrthoBlocks, unit_direction};
 use crate::tree::{
     breadth_first, check_breadth_first, check_permutation, depths, for_each_in_subtrees, lanes, widest_level,
-    with_levels,
+    with_levels, with_ranges,
 };
 use crate::{ArraysError, CostModel, EdgeSet};
 
@@ -71,11 +71,6 @@ pub const CULL_MARGIN: f64 = 1e-5;
 
 /// Default bin size of [`Bins::Overlapping`], in cell circumradii.
 pub const DEFAULT_OVERLAP: f32 = 1.5;
-
-thread_local! {
-    /// The block ranges a walk collects before testing them (reused between queries).
-    static RANGES: std::cell::RefCell<Vec<[u32; 2]>> = const { std::cell::RefCell::new(Vec::new()) };
-}
 
 /// A threshold at or above which a cap is never culled.
 const NEVER_CULL: f32 = 2.0;
@@ -743,8 +738,7 @@ impl GaussMapHierarchy {
         if self.flat.is_empty() || self.meets4(0, u) & 1 == 0 {
             return counts;
         }
-        RANGES.with_borrow_mut(|ranges| {
-            ranges.clear();
+        with_ranges(|ranges| {
             with_levels(self.widest + 4, |level, next| {
                 level[0] = 0;
                 let mut width = 1;

@@ -38,6 +38,23 @@ pub(crate) fn with_levels<R>(len: usize, walk: impl FnOnce(&mut Vec<u32>, &mut V
     })
 }
 
+thread_local! {
+    /// The block ranges a walk collects before testing them (reused between queries).
+    static RANGES: RefCell<Vec<[u32; 2]>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Runs `walk` with an empty list for the block ranges `[first, end)` a walk collects, reusing
+/// this thread's allocation.
+pub(crate) fn with_ranges<R>(walk: impl FnOnce(&mut Vec<[u32; 2]>) -> R) -> R {
+    RANGES.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut ranges) => {
+            ranges.clear();
+            walk(&mut ranges)
+        }
+        Err(_) => walk(&mut Vec::new()),
+    })
+}
+
 /// Bits `0..k` set (k ≤ 4).
 #[inline(always)]
 pub(crate) fn lanes(k: usize) -> u32 {
