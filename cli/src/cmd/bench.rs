@@ -35,7 +35,7 @@ pub struct Args {
 pub enum What {
     /// Frame time per style, as a ratio to phong (median over N frames after warm-up).
     Render(RenderArgs),
-    /// Frame time of the same triangles in 10 and in 1000 parts (synthetic spheres), as parts of
+    /// Frame time of the same triangles (1000 synthetic spheres) in 10 and in 1000 parts, as parts of
     /// one mesh (per-triangle labels) and as separate meshes.
     Parts(PartsArgs),
     /// Silhouettes per view: brute force against the stored hierarchies, speedup, counts and
@@ -297,8 +297,9 @@ fn parts(args: PartsArgs) -> Result<()> {
         out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         out!(
-            "{} triangles as 10 or 1000 spheres, {}x{}, median of {} frames on {}",
+            "{} triangles ({} spheres) as 10 or 1000 parts, {}x{}, median of {} frames on {}",
             report.triangles,
+            spheres::SPHERES,
             args.size.0,
             args.size.1,
             args.frames,
@@ -314,8 +315,8 @@ fn parts(args: PartsArgs) -> Result<()> {
     Ok(())
 }
 
-/// Synthetic scenes for `bench parts`: `n` UV spheres on a square grid, sized so that together they
-/// cover about the same pixels at any `n`.
+/// Synthetic scenes for `bench parts`: the same UV spheres on a square grid, grouped into any
+/// number of parts.
 mod spheres {
     use drafter_core::{Instance, Mesh, MeshId, Node, NodeId, Scene, SourceFormat, TriangleGroup};
     use drafter_format::{BakedFile, NodeExtension, PartRecord, RootExtension};
@@ -382,29 +383,49 @@ mod spheres {
         }))?)
     }
 
-    /// `n` spheres with `triangles` in all: one mesh with a label per sphere (`labelled`), or one
-    /// mesh and one instance per sphere (unbaked: each instance is a part).
-    pub fn model(n: usize, triangles: usize, labelled: bool) -> anyhow::Result<Model> {
-        let side = (n as f64).sqrt().ceil() as usize;
+    /// The spheres of every scene: the same triangles whatever the part count.
+    pub const SPHERES: usize = 1000;
+
+    /// [`SPHERES`] spheres with `triangles` in all, grouped into `parts` parts of consecutive
+    /// spheres: one mesh with a label per part (`labelled`), or one mesh and one instance per part
+    /// (unbaked: each instance is a part). Only the grouping changes with `parts`.
+    pub fn model(parts: usize, triangles: usize, labelled: bool) -> anyhow::Result<Model> {
+        let side = (SPHERES as f64).sqrt().ceil() as usize;
         let spacing = 2.0 / side as f32;
         let radius = spacing * 0.45;
-        let per = triangles / n;
-        let centers: Vec<Vec3> = (0..n)
+        let per = triangles / SPHERES;
+        let centers: Vec<Vec3> = (0..SPHERES)
             .map(|i| Vec3::new((i % side) as f32 * spacing - 1.0, 0.0, (i / side) as f32 * spacing - 1.0))
+            .collect();
+        let parts = parts.clamp(1, SPHERES);
+        let members: Vec<Vec<usize>> =
+            (0..parts).map(|p| (0..SPHERES).filter(|i| i * parts / SPHERES == p).collect()).collect();
+        // Each part's centre (mean of its spheres) and the radius of a ball around it holding them.
+        let bounds: Vec<(Vec3, f32)> = members
+            .iter()
+            .map(|m| {
+                let c = m.iter().map(|&i| centers[i]).sum::<Vec3>() / m.len().max(1) as f32;
+                let r = m.iter().map(|&i| (centers[i] - c).length()).fold(0.0f32, f32::max) + radius;
+                (c, r)
+            })
             .collect();
         let mut scene = Scene::new(SourceFormat::Gltf);
         if labelled {
             let mut mesh = Mesh { name: "spheres".into(), ..Mesh::default() };
             let mut labels = Vec::new();
             let mut records = Vec::new();
-            for (i, &c) in centers.iter().enumerate() {
-                let (p, nrm, t) = sphere(c, radius, per);
-                let base = mesh.positions.len() as u32;
-                mesh.positions.extend(p);
-                mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
-                labels.extend(std::iter::repeat_n(i as u32, t.len()));
-                records.push(record(i as u32, c, radius, t.len())?);
-                mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+            for (p, m) in members.iter().enumerate() {
+                let first = mesh.triangles.len();
+                for &i in m {
+                    let (pos, nrm, t) = sphere(centers[i], radius, per);
+                    let base = mesh.positions.len() as u32;
+                    mesh.positions.extend(pos);
+                    mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
+                    mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+                }
+                let count = mesh.triangles.len() - first;
+                labels.extend(std::iter::repeat_n(p as u32, count));
+                records.push(record(p as u32, bounds[p].0, bounds[p].1, count)?);
             }
             let count = mesh.triangles.len() as u32;
             let vertex_count = mesh.positions.len() as u32;
@@ -436,7 +457,7 @@ mod spheres {
                 "generator": drafter_format::GENERATOR,
                 "input": { "name": "spheres", "format": "gltf", "sha256": "" },
                 "sceneCenter": [0.0, 0.0, 0.0],
-                "partCount": n
+                "partCount": parts
             }))?;
             let baked = BakedFile {
                 root,
@@ -447,28 +468,29 @@ mod spheres {
             };
             Model::from_scene(&scene, Some(&baked)).ok_or_else(|| anyhow::anyhow!("empty synthetic scene"))
         } else {
-            for (i, &c) in centers.iter().enumerate() {
-                let (positions, normals, t) = sphere(Vec3::ZERO, radius, per);
-                let count = t.len() as u32;
-                let vertex_count = positions.len() as u32;
-                scene.meshes.push(Mesh {
-                    name: format!("sphere_{i}"),
-                    positions,
-                    normals: Some(normals),
-                    triangles: t,
-                    uvs: None,
-                    groups: vec![TriangleGroup {
-                        start: 0,
-                        count,
-                        primitive: Some(0),
-                        first_vertex: 0,
-                        vertex_count,
-                        material: None,
-                    }],
+            for (p, m) in members.iter().enumerate() {
+                let (c, _) = bounds[p];
+                let mut mesh = Mesh { name: format!("part_{p}"), ..Mesh::default() };
+                for &i in m {
+                    let (pos, nrm, t) = sphere(centers[i] - c, radius, per);
+                    let base = mesh.positions.len() as u32;
+                    mesh.positions.extend(pos);
+                    mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
+                    mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+                }
+                let (count, vertex_count) = (mesh.triangles.len() as u32, mesh.positions.len() as u32);
+                mesh.groups.push(TriangleGroup {
+                    start: 0,
+                    count,
+                    primitive: Some(0),
+                    first_vertex: 0,
+                    vertex_count,
+                    material: None,
                 });
+                scene.meshes.push(mesh);
                 scene.instances.push(Instance {
-                    name: format!("sphere_{i}"),
-                    mesh: MeshId(i as u32),
+                    name: format!("part_{p}"),
+                    mesh: MeshId(p as u32),
                     node: None,
                     world_from_object: DMat4::from_translation(c.as_dvec3()),
                 });
