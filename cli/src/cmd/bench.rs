@@ -323,31 +323,42 @@ mod spheres {
     use drafter_viewer::Model;
     use glam::{DMat4, Vec3};
 
-    /// A UV sphere of about `triangles` triangles at `center`.
-    fn sphere(center: Vec3, radius: f32, triangles: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
+    /// Appends a UV sphere of about `triangles` triangles at `center` to `mesh`.
+    fn add_sphere(mesh: &mut Mesh, center: Vec3, radius: f32, triangles: usize) {
         let side = ((triangles as f64 / 2.0).sqrt().round() as u32).max(3);
         let (rows, cols) = (side, side);
-        let mut positions = Vec::new();
-        let mut normals = Vec::new();
+        let base = mesh.positions.len() as u32;
+        let normals = mesh.normals.get_or_insert_with(Vec::new);
         for r in 0..=rows {
             let theta = std::f32::consts::PI * r as f32 / rows as f32;
             for c in 0..=cols {
                 let phi = std::f32::consts::TAU * c as f32 / cols as f32;
                 let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-                positions.push(center + n * radius);
+                mesh.positions.push(center + n * radius);
                 normals.push(n);
             }
         }
-        let mut triangles = Vec::new();
         for r in 0..rows {
             for c in 0..cols {
-                let a = r * (cols + 1) + c;
+                let a = base + r * (cols + 1) + c;
                 let b = a + cols + 1;
-                triangles.push([a, b, a + 1]);
-                triangles.push([a + 1, b, b + 1]);
+                mesh.triangles.push([a, b, a + 1]);
+                mesh.triangles.push([a + 1, b, b + 1]);
             }
         }
-        (positions, normals, triangles)
+    }
+
+    /// Closes `mesh` with one triangle group (one glTF primitive) over all of it.
+    fn close(mut mesh: Mesh) -> Mesh {
+        mesh.groups.push(TriangleGroup {
+            start: 0,
+            count: mesh.triangles.len() as u32,
+            primitive: Some(0),
+            first_vertex: 0,
+            vertex_count: mesh.positions.len() as u32,
+            material: None,
+        });
+        mesh
     }
 
     fn record(id: u32, center: Vec3, radius: f32, triangles: usize) -> anyhow::Result<PartRecord> {
@@ -417,27 +428,13 @@ mod spheres {
             for (p, m) in members.iter().enumerate() {
                 let first = mesh.triangles.len();
                 for &i in m {
-                    let (pos, nrm, t) = sphere(centers[i], radius, per);
-                    let base = mesh.positions.len() as u32;
-                    mesh.positions.extend(pos);
-                    mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
-                    mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+                    add_sphere(&mut mesh, centers[i], radius, per);
                 }
                 let count = mesh.triangles.len() - first;
                 labels.extend(std::iter::repeat_n(p as u32, count));
                 records.push(record(p as u32, bounds[p].0, bounds[p].1, count)?);
             }
-            let count = mesh.triangles.len() as u32;
-            let vertex_count = mesh.positions.len() as u32;
-            mesh.groups.push(TriangleGroup {
-                start: 0,
-                count,
-                primitive: Some(0),
-                first_vertex: 0,
-                vertex_count,
-                material: None,
-            });
-            scene.meshes.push(mesh);
+            scene.meshes.push(close(mesh));
             scene.nodes.push(Node {
                 name: "spheres".into(),
                 parent: None,
@@ -472,22 +469,9 @@ mod spheres {
                 let (c, _) = bounds[p];
                 let mut mesh = Mesh { name: format!("part_{p}"), ..Mesh::default() };
                 for &i in m {
-                    let (pos, nrm, t) = sphere(centers[i] - c, radius, per);
-                    let base = mesh.positions.len() as u32;
-                    mesh.positions.extend(pos);
-                    mesh.normals.get_or_insert_with(Vec::new).extend(nrm);
-                    mesh.triangles.extend(t.into_iter().map(|[a, b, c]| [a + base, b + base, c + base]));
+                    add_sphere(&mut mesh, centers[i] - c, radius, per);
                 }
-                let (count, vertex_count) = (mesh.triangles.len() as u32, mesh.positions.len() as u32);
-                mesh.groups.push(TriangleGroup {
-                    start: 0,
-                    count,
-                    primitive: Some(0),
-                    first_vertex: 0,
-                    vertex_count,
-                    material: None,
-                });
-                scene.meshes.push(mesh);
+                scene.meshes.push(close(mesh));
                 scene.instances.push(Instance {
                     name: format!("part_{p}"),
                     mesh: MeshId(p as u32),

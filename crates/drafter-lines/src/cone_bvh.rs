@@ -75,7 +75,8 @@ use serde::{Deserialize, Serialize};
 use crate::brute::Stream;
 use crate::gauss::{BaseSolid, QueryCounts, arc_path, base_cells};
 use crate::tree::{
-    breadth_first, check_breadth_first, check_permutation, for_each_in_subtrees, lanes, widest_level, with_levels,
+    breadth_first, check_breadth_first, check_permutation, for_each_in_subtrees, push_children, widest_level,
+    with_levels,
 };
 use crate::{ArraysError, CostModel, EdgeSet};
 
@@ -566,15 +567,7 @@ impl ConeBvh {
                 for &i in &level[..width] {
                     let n = &self.nodes[i as usize];
                     let (first, end) = (n.first_child as usize, (n.first_child + n.child_count) as usize);
-                    let mut f = first;
-                    while f < end {
-                        let mask = !self.culls4(f, eye) & lanes(end - f);
-                        for lane in 0..4 {
-                            next[next_width] = (f + lane) as u32;
-                            next_width += ((mask >> lane) & 1) as usize;
-                        }
-                        f += 4;
-                    }
+                    push_children(next, &mut next_width, first, end, |f| !self.culls4(f, eye));
                     if COUNT {
                         counts.nodes_entered += 1;
                         counts.bounds_tested += end - first;

@@ -61,7 +61,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::{OrthoBlocks, unit_direction};
 use crate::tree::{
-    breadth_first, check_breadth_first, check_permutation, depths, for_each_in_subtrees, lanes, widest_level,
+    breadth_first, check_breadth_first, check_permutation, depths, for_each_in_subtrees, push_children, widest_level,
     with_levels, with_ranges,
 };
 use crate::{ArraysError, CostModel, EdgeSet};
@@ -747,25 +747,14 @@ impl GaussMapHierarchy {
                     for &i in &level[..width] {
                         let n = &self.nodes[i as usize];
                         let (first, end) = (n.first_child as usize, (n.first_child + n.child_count) as usize);
-                        let mut f = first;
-                        while f < end {
-                            let mask = self.meets4(f, u) & lanes(end - f);
-                            for lane in 0..4 {
-                                next[next_width] = (f + lane) as u32;
-                                next_width += ((mask >> lane) & 1) as usize;
-                            }
-                            f += 4;
+                        push_children(next, &mut next_width, first, end, |f| self.meets4(f, u));
+                        if n.block_start < n.block_end {
+                            ranges.push([n.block_start, n.block_end]);
                         }
                         if COUNT {
                             counts.nodes_entered += 1;
                             counts.bounds_tested += end - first;
-                        }
-                    }
-                    for &i in &level[..width] {
-                        let n = &self.nodes[i as usize];
-                        if n.block_start < n.block_end {
-                            ranges.push([n.block_start, n.block_end]);
-                            if COUNT {
+                            if n.block_start < n.block_end {
                                 let [_, _, start, end] = self.flat[i as usize];
                                 counts.ranges += 1;
                                 counts.blocks_tested += (n.block_end - n.block_start) as usize;

@@ -55,6 +55,28 @@ pub(crate) fn with_ranges<R>(walk: impl FnOnce(&mut Vec<[u32; 2]>) -> R) -> R {
     })
 }
 
+/// Appends to `next[*width..]` those of the children `first..end` whose bit is set in
+/// `mask4(f)`, the 4-lane mask of children `f..f + 4` (lanes past `end` are ignored): the step
+/// both hierarchy walks take from one level to the next, branch-free per child.
+#[inline(always)]
+pub(crate) fn push_children(
+    next: &mut [u32],
+    width: &mut usize,
+    first: usize,
+    end: usize,
+    mut mask4: impl FnMut(usize) -> u32,
+) {
+    let mut f = first;
+    while f < end {
+        let mask = mask4(f) & lanes(end - f);
+        for lane in 0..4 {
+            next[*width] = (f + lane) as u32;
+            *width += ((mask >> lane) & 1) as usize;
+        }
+        f += 4;
+    }
+}
+
 /// Bits `0..k` set (k ≤ 4).
 #[inline(always)]
 pub(crate) fn lanes(k: usize) -> u32 {
