@@ -99,8 +99,8 @@ pub use classify::{
     classify_edges, face_normals,
 };
 pub use cone_bvh::{
-    CONE_MARGIN, ConeBvh, ConeBvhArrays, ConeBvhOptions, DEFAULT_LEAF_SIZE, DEFAULT_SAMPLE_EYES, NormalSplit,
-    normal_level_for_count,
+    CONE_MARGIN, ConeBvh, ConeBvhArrays, ConeBvhOptions, DEFAULT_LEAF_SIZE, DEFAULT_SAMPLE_EYES, DUAL_NORMAL_WEIGHT,
+    NormalSplit, normal_level_for_count,
 };
 pub use cost::CostModel;
 pub use error::{ArraysError, LinesError};
