@@ -11,8 +11,8 @@
 //!   5°–20° cells, chosen by count). Short arcs thus land in fine cells with narrow cones, long
 //!   ones stay in coarse cells, instead of one long arc widening a fine cell's cone;
 //! * within each normal cell a binary tree is built top-down in the *dual space of face planes*
-//!   (Hertzmann & Zorin 2000, "Illustrating smooth surfaces", SIGGRAPH, §4, use the same duality
-//!   for their silhouette search): a plane is the 4D point `(k·n̂, n̂·(v − c))`, `c` the centre
+//!   (Hertzmann & Zorin 2000, "Illustrating smooth surfaces", SIGGRAPH, search silhouettes in
+//!   the same dual space, with an octree over the faces of the 4D hypercube): a plane is the 4D point `(k·n̂, n̂·(v − c))`, `c` the centre
 //!   of the bounding box and `k` = [`DUAL_NORMAL_WEIGHT`] half-diagonals, and an eye is the
 //!   hyperplane of the points on which `n̂·(e − v)` vanishes, so a group of candidates is cut
 //!   by the view exactly when that hyperplane crosses the 4D points of their planes. Splits are

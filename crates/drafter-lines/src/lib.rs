@@ -27,9 +27,10 @@
 //!    node has a data-dependent bounding cap; a query enters only the nodes whose cap the view's
 //!    great circle meets. [`LevelHistogram`] is the paper's Table 2.
 //! 5. [`ConeBvh`] (perspective): candidates split by normal (the Gauss-map cell their arc is
-//!    stored in), then an `obvhs` BVH over their points stretched along the normal, with a box, a
-//!    normal cone and the range of face-plane offsets per node, culled by an exact plane-offset
-//!    test (anchored cones as in Sander et al. 2000, "Silhouette Clipping"; Johnson & Cohen 2001,
+//!    stored in), then within each cell a binned-SAH tree in the dual space of face planes
+//!    (a plane is the 4D point `(k·n̂, n̂·(v − c))`, an eye a hyperplane through them; Hertzmann &
+//!    Zorin 2000), with a box, a normal cone and the range of face-plane offsets per node, culled
+//!    by an exact plane-offset test (anchored cones as in Sander et al. 2000, "Silhouette Clipping"; Johnson & Cohen 2001,
 //!    "Spatialized Normal Cone Hierarchies").
 //! 6. [`SilhouetteIndex`] builds the hierarchies, keeps each only if the [`CostModel`] predicts a
 //!    speedup of at least [`DEFAULT_MIN_SPEEDUP`] (none below [`DEFAULT_MIN_HIERARCHY_CANDIDATES`]),
@@ -74,6 +75,8 @@
 //!   (../shared/papers/001_*): §5.1 silhouettes, Gauss-map arcs, Tables 1–2.
 //! * Sander, Gu, Gortler, Hoppe, Snyder 2000, "Silhouette Clipping", SIGGRAPH: anchored cones.
 //! * Johnson, Cohen 2001, "Spatialized Normal Cone Hierarchies", I3D.
+//! * Hertzmann, Zorin 2000, "Illustrating Smooth Surfaces", SIGGRAPH: silhouettes as the
+//!   intersection of the dual surface of face planes with the eye's plane.
 //! * Cigolle, Donow, Evangelakos, Mara, McGuire, Meyer 2014, "A Survey of Efficient
 //!   Representations for Independent Unit Vectors", JCGT 3(2): oct16.
 //! * Khronos draft `EXT_mesh_primitive_edge_visibility` (../shared/specs).
