@@ -12,8 +12,8 @@
 //!   ones stay in coarse cells, instead of one long arc widening a fine cell's cone;
 //! * within each normal cell a binary tree is built top-down in the *dual space of face planes*
 //!   (Hertzmann & Zorin 2000, "Illustrating smooth surfaces", SIGGRAPH, search silhouettes in
-//!   the same dual space, with an octree over the faces of the 4D hypercube): a plane is the 4D point `(k·n̂, n̂·(v − c))`, `c` the centre
-//!   of the bounding box and `k` = [`DUAL_NORMAL_WEIGHT`] half-diagonals, and an eye is the
+//!   the same dual space, with an octree over the faces of the 4D hypercube): a plane is the 4D
+//!   point `(k·n̂, n̂·(v − c))`, `c` the centre of the bounding box and `k` = [`DUAL_NORMAL_WEIGHT`] half-diagonals, and an eye is the
 //!   hyperplane of the points on which `n̂·(e − v)` vanishes, so a group of candidates is cut
 //!   by the view exactly when that hyperplane crosses the 4D points of their planes. Splits are
 //!   chosen by a binned surface-area-style heuristic: the probability that a random hyperplane
@@ -1249,9 +1249,9 @@ mod tests {
             assert_eq!(seen, (0..n as u32).collect::<Vec<_>>(), "not a permutation");
             let bound = DUAL_SAH_DEPTH + 2 * (n as f64).log2().ceil() as u32 + 8;
             assert!(depths(&tree).into_iter().max().unwrap_or(0) <= bound);
-            for (i, &[start, end, _, is_leaf]) in tree.nodes.iter().enumerate() {
+            for &[start, end, _, is_leaf] in &tree.nodes {
                 if is_leaf == 1 {
-                    assert!(end - start <= leaf.max(1) || tree.children[i].is_empty());
+                    assert!(end - start <= leaf, "a leaf of {} candidates, leaf size {leaf}", end - start);
                 }
             }
         }

@@ -30,8 +30,8 @@
 //!    stored in), then within each cell a binned-SAH tree in the dual space of face planes
 //!    (a plane is the 4D point `(k·n̂, n̂·(v − c))`, an eye a hyperplane through them; Hertzmann &
 //!    Zorin 2000), with a box, a normal cone and the range of face-plane offsets per node, culled
-//!    by an exact plane-offset test (anchored cones as in Sander et al. 2000, "Silhouette Clipping"; Johnson & Cohen 2001,
-//!    "Spatialized Normal Cone Hierarchies").
+//!    by an exact plane-offset test (anchored cones as in Sander et al. 2000, "Silhouette
+//!    Clipping"; Johnson & Cohen 2001, "Spatialized Normal Cone Hierarchies").
 //! 6. [`SilhouetteIndex`] builds the hierarchies, keeps each only if the [`CostModel`] predicts a
 //!    speedup of at least [`DEFAULT_MIN_SPEEDUP`] (none below [`DEFAULT_MIN_HIERARCHY_CANDIDATES`]),
 //!    says what it chose and why ([`HierarchyChoice`]), and converts to and from flat `u32`/`f32`
