@@ -1,5 +1,5 @@
 //! `drafter bake [INPUT] [-o OUTPUT] [--config FILE] [--report FILE.json] [--json] [--textures-out DIR]
-//! [--segment MODE] [--obb METHOD] [--threads N] [--quiet]`.
+//! [--segment MODE] [--obb METHOD] [--threads N] [--quiet | --verbose]`.
 //!
 //! With no INPUT it bakes the embedded sample assembly into `./sample.baked.glb`. The output is
 //! written atomically (a temporary file beside it, then a rename): a failed or interrupted bake
@@ -62,8 +62,11 @@ pub struct Args {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Print nothing but errors.
-    #[arg(long, short)]
+    #[arg(long, short, conflicts_with = "verbose")]
     pub quiet: bool,
+    /// List every finding of every mesh instead of one line per kind.
+    #[arg(long, short)]
+    pub verbose: bool,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -93,7 +96,7 @@ pub fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let progress = Progress::new(!args.quiet && std::io::stderr().is_terminal());
 
-    progress.stage("reading");
+    progress.step(0, "reading");
     let (input_path, bytes) = match &args.input {
         Some(path) => {
             let bytes =
@@ -135,7 +138,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     config.container = container_for(&output)?;
 
-    progress.stage("importing");
+    progress.step(1, "importing");
     let imported = drafter_io::import_bytes(&input_path, &bytes)?;
     config.input = InputInfo {
         name: input_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
@@ -143,8 +146,8 @@ pub fn run(args: Args) -> Result<()> {
         sha256: sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect(),
     };
 
-    progress.stage("baking");
-    let mut baked = drafter_bake::bake(&imported.scene, &config).map_err(|e| match e {
+    let mut on_stage = |i: usize| progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
+    let mut baked = drafter_bake::bake_observed(&imported.scene, &config, &mut on_stage).map_err(|e| match e {
         BakeError::Config(_) | BakeError::Input(_) => {
             anyhow::Error::from(BadInput(format!("{}: {e}", input_path.display())))
         }
@@ -152,7 +155,6 @@ pub fn run(args: Args) -> Result<()> {
     })?;
     baked.report.diagnostics.extend(imported.diagnostics.iter().cloned());
 
-    progress.stage("writing");
     write_outputs(&output, &baked.written, &config.container)?;
     if let Some(report_path) = &args.report {
         let json = serde_json::to_vec_pretty(&baked.report)?;
@@ -185,8 +187,19 @@ pub fn run(args: Args) -> Result<()> {
             let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
             eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);
         }
-        for d in &r.diagnostics {
-            eprintln!("  note: {d}");
+        if args.verbose {
+            for d in &r.diagnostics {
+                eprintln!("  note: {}: {}: {}", d.kind.label(), drafter_core::thousands(d.count), d.first_example);
+            }
+        } else {
+            let summaries = drafter_core::summarize(&r.diagnostics);
+            let folded = summaries.iter().any(|s| s.entries > 1);
+            for s in &summaries {
+                eprintln!("  note: {s}");
+            }
+            if folded {
+                eprintln!("  (--verbose lists every place)");
+            }
         }
     }
     Ok(())
@@ -238,20 +251,41 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-/// A spinner with the current stage on a terminal; nothing otherwise.
+/// A bar over the bake's steps with the current stage's name, on a terminal only, and only once a
+/// bake has run for a second (`DRAFTER_PROGRESS_DELAY_MS` changes the delay, for tests): short
+/// bakes print nothing but their summary, and redirected output never gets escape codes.
 struct Progress(Option<indicatif::ProgressBar>);
+
+/// Steps the bar counts: reading and importing, then drafter-bake's stages.
+const PROGRESS_STEPS: usize = 2 + drafter_bake::STAGE_NAMES.len() - 1;
 
 impl Progress {
     fn new(enabled: bool) -> Self {
         Self(enabled.then(|| {
-            let bar = indicatif::ProgressBar::new_spinner();
-            bar.enable_steady_tick(Duration::from_millis(100));
+            let delay = std::env::var("DRAFTER_PROGRESS_DELAY_MS").ok().and_then(|v| v.parse().ok()).unwrap_or(1000);
+            let bar = indicatif::ProgressBar::with_draw_target(
+                Some(PROGRESS_STEPS as u64),
+                indicatif::ProgressDrawTarget::hidden(),
+            );
+            let style = indicatif::ProgressStyle::with_template("{spinner} [{bar:20}] {pos}/{len} {msg} ({elapsed})")
+                .map(|s| s.progress_chars("=> "))
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+            bar.set_style(style);
+            let shown = bar.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_millis(delay));
+                if !shown.is_finished() {
+                    shown.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                    shown.enable_steady_tick(Duration::from_millis(100));
+                }
+            });
             bar
         }))
     }
 
-    fn stage(&self, name: &'static str) {
+    fn step(&self, index: usize, name: &'static str) {
         if let Some(bar) = &self.0 {
+            bar.set_position(index as u64);
             bar.set_message(name);
         }
     }
@@ -260,5 +294,12 @@ impl Progress {
         if let Some(bar) = &self.0 {
             bar.finish_and_clear();
         }
+    }
+}
+
+impl Drop for Progress {
+    /// A failed bake clears the bar too, before its error line is printed.
+    fn drop(&mut self) {
+        self.finish();
     }
 }

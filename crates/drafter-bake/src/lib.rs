@@ -141,29 +141,42 @@ pub struct StageTiming {
     pub ms: f64,
 }
 
+/// The stages of a bake in the order they run, as [`bake_observed`] announces them.
+pub const STAGE_NAMES: [&str; 8] = ["topology", "segment", "bounds", "normals", "lines", "textures", "write", "done"];
+
 /// Runs every stage on `scene` and writes the extended glTF in memory.
 pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
+    bake_observed(scene, config, &mut |_| {})
+}
+
+/// [`bake`], calling `on_stage(i)` as stage [`STAGE_NAMES`]`[i]` starts (and with the last index
+/// when the bake is done), so a caller can show progress. The observer cannot change the output.
+pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMut(usize)) -> Result<Baked, BakeError> {
     if scene.instanced_triangle_count() == 0 {
         return Err(BakeError::Input("the scene has no triangles to bake".into()));
     }
     let mut stages = Vec::new();
     let mut timed =
         |name: &'static str, start: Instant| stages.push(StageTiming { name, ms: start.elapsed().as_secs_f64() * 1e3 });
+    let mut begin = |name: &str| {
+        on_stage(STAGE_NAMES.iter().position(|&n| n == name).unwrap_or(0));
+        Instant::now()
+    };
 
     // Welded topology of every mesh used by an instance, built once and shared by the stages.
-    let start = Instant::now();
+    let start = begin("topology");
     let topologies = build_topologies(scene, config.segment.weld);
     timed("topology", start);
 
-    let start = Instant::now();
+    let start = begin("segment");
     let (parts, mut diagnostics) = drafter_segment::segment_with_topologies(scene, &topologies, &config.segment);
     timed("segment", start);
 
-    let start = Instant::now();
+    let start = begin("bounds");
     let records = bound_parts(scene, &parts, config)?;
     timed("bounds", start);
 
-    let start = Instant::now();
+    let start = begin("normals");
     let (vertex_data, normals_summary) = if config.normals.enabled {
         let (data, summary, normal_diagnostics) = compute_normals(scene, &topologies, &config.normals);
         diagnostics.extend(normal_diagnostics);
@@ -173,7 +186,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     };
     timed("normals", start);
 
-    let start = Instant::now();
+    let start = begin("lines");
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
         let (edges, silhouettes, summary, line_diagnostics) = compute_lines(scene, &topologies, &parts, &config.lines);
         diagnostics.extend(line_diagnostics);
@@ -183,7 +196,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     };
     timed("lines", start);
 
-    let start = Instant::now();
+    let start = begin("textures");
     let metal_parts = textures::metal_parts(scene, &parts, &records, config.textures.metallic_threshold);
     let request = textures::request(&records, &metal_parts, &config.textures);
     let baked_textures = if request.is_empty() {
@@ -193,7 +206,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     };
     timed("textures", start);
 
-    let start = Instant::now();
+    let start = begin("write");
     let bounds = scene.world_bounds();
     let center = if bounds.is_empty() { DVec3::ZERO } else { (bounds.min + bounds.max) * 0.5 };
     let root = RootExtension {
@@ -240,7 +253,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
         .map_err(|e| BakeError::Internal { stage: "write", message: e.to_string() })?;
     let texture_images = output.textures.map(|t| t.images).unwrap_or_default();
     for note in &written.notes {
-        diagnostics.push(Diagnostic { kind: DiagnosticKind::Other, count: 1, first_example: note.clone() });
+        diagnostics.push(Diagnostic { kind: DiagnosticKind::Output, count: 1, first_example: note.clone() });
     }
     timed("write", start);
 
@@ -257,6 +270,7 @@ pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
         textures: textures_summary,
         diagnostics,
     };
+    begin("done");
     Ok(Baked { written, report, textures: texture_images })
 }
 
@@ -343,7 +357,7 @@ fn compute_lines(scene: &Scene, topologies: &[Topology], parts: &Parts, stage: &
                 Ok(f) => f,
                 Err(e) => {
                     let d = Diagnostic {
-                        kind: DiagnosticKind::Other,
+                        kind: DiagnosticKind::LinesSkipped,
                         count: 1,
                         first_example: format!("mesh {m}: lines skipped: {e}"),
                     };
@@ -369,7 +383,7 @@ fn compute_lines(scene: &Scene, topologies: &[Topology], parts: &Parts, stage: &
                         Ok(_) => None,
                         Err(e) => {
                             diagnostics.push(Diagnostic {
-                                kind: DiagnosticKind::Other,
+                                kind: DiagnosticKind::EdgesNotWritten,
                                 count: 1,
                                 first_example: format!("mesh {m}: edge visibility not written: {e}"),
                             });

@@ -19,7 +19,7 @@ mod param;
 mod scene;
 mod topology;
 
-pub use diagnostic::{Diagnostic, DiagnosticKind, Diagnostics};
+pub use diagnostic::{Diagnostic, DiagnosticKind, DiagnosticSummary, Diagnostics, summarize, thousands};
 pub use ids::{EdgeId, InstanceId, MaterialId, MeshId, NodeId, PartId};
 pub use param::ParamError;
 pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceDocument, SourceFormat, TriangleGroup};

@@ -26,8 +26,8 @@ pub use reader::{
     split_container,
 };
 pub use writer::{
-    BakeOutput, ConeBvhData, Container, EmbeddedTextures, GaussMapData, MeshSilhouettes, PrimitiveEdges, SamplerDesc,
-    TextureImage, VertexData, Written, write,
+    BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,
+    MeshSilhouettes, PrimitiveEdges, SamplerDesc, TextureImage, VertexData, Written, write,
 };
 
 /// `drafter <version>`, written as the generator.

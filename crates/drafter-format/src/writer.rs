@@ -540,25 +540,36 @@ fn rewrite_if_faces_dropped(
     Ok(())
 }
 
-/// A fresh document for input without one: materials, one mesh per scene mesh (one primitive per
-/// triangle group), one node per instance, one scene.
+/// The material given to primitives of a mesh input (OBJ without `usemtl`, STL, OFF, PLY) that
+/// name none: a neutral light grey dielectric. glTF's own default (white, fully metallic) renders
+/// washed out or dark in plain viewers, which have no environment to reflect.
+pub const DEFAULT_MATERIAL: drafter_core::Material =
+    drafter_core::Material { name: String::new(), base_color: [0.8, 0.8, 0.8, 1.0], metallic: 0.0, roughness: 0.5 };
+/// Its name in the output.
+pub const DEFAULT_MATERIAL_NAME: &str = "drafter default";
+
+/// A fresh document for input without one: materials (the input's, then [`DEFAULT_MATERIAL`] when
+/// some primitive names none), one mesh per scene mesh (one primitive per triangle group), one node
+/// per instance, one scene.
 fn synthesize(scene: &Scene) -> Doc {
     let mut doc = Doc::new(Map::new());
     doc.json.insert("asset".into(), json!({"version": "2.0", "generator": crate::GENERATOR}));
-    let materials: Vec<Value> = scene
-        .materials
-        .iter()
-        .map(|m| {
-            json!({
-                "name": m.name,
-                "pbrMetallicRoughness": {
-                    "baseColorFactor": m.base_color,
-                    "metallicFactor": m.metallic,
-                    "roughnessFactor": m.roughness
-                }
-            })
+    let material_json = |m: &drafter_core::Material, name: &str| {
+        json!({
+            "name": name,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": m.base_color,
+                "metallicFactor": m.metallic,
+                "roughnessFactor": m.roughness
+            }
         })
-        .collect();
+    };
+    let mut materials: Vec<Value> = scene.materials.iter().map(|m| material_json(m, &m.name)).collect();
+    let needs_default = scene.meshes.iter().flat_map(|m| &m.groups).any(|g| g.material.is_none());
+    let default_material = needs_default.then(|| {
+        materials.push(material_json(&DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME));
+        materials.len() - 1
+    });
     if !materials.is_empty() {
         doc.json.insert("materials".into(), Value::Array(materials));
     }
@@ -570,8 +581,8 @@ fn synthesize(scene: &Scene) -> Doc {
             .iter()
             .map(|group| {
                 let mut primitive = json!({"attributes": {}});
-                if let Some(material) = group.material {
-                    primitive["material"] = material.0.into();
+                if let Some(material) = group.material.map(|m| m.0 as usize).or(default_material) {
+                    primitive["material"] = material.into();
                 }
                 primitive
             })

@@ -514,7 +514,7 @@ fn build_scene(
     let roots: Vec<NodeId> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(s) => s.nodes().map(|n| NodeId::from(n.index())).collect(),
         None => {
-            diagnostics.push(DiagnosticKind::Other, 1, || "no scene: every parentless node is taken as a root".into());
+            diagnostics.push(DiagnosticKind::NoScene, 1, || "every parentless node is taken as a root".into());
             (0..node_count).filter(|&i| scene.nodes[i].parent.is_none()).map(NodeId::from).collect()
         }
     };

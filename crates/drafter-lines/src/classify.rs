@@ -177,10 +177,10 @@ impl FeatureEdges {
     /// Data problems as diagnostics (degenerate neighbours, inconsistent orientation).
     pub fn diagnostics(&self) -> Vec<Diagnostic> {
         let mut d = Diagnostics::new();
-        d.push(DiagnosticKind::Other, self.counts.degenerate, || {
+        d.push(DiagnosticKind::DegenerateEdge, self.counts.degenerate, || {
             format!("{} edges border a degenerate face and are never drawn", self.counts.degenerate)
         });
-        d.push(DiagnosticKind::Other, self.counts.inconsistent_orientation, || {
+        d.push(DiagnosticKind::InconsistentWinding, self.counts.inconsistent_orientation, || {
             format!(
                 "{} manifold edges join faces of inconsistent winding; their dihedral angle uses the normals as given",
                 self.counts.inconsistent_orientation

@@ -176,15 +176,12 @@ pub fn compute_normals(mesh: &Mesh, topology: &Topology, options: &NormalsOption
         tessellation: TessellationStats::measure(topology),
     };
     let mut diagnostics = Diagnostics::new();
-    diagnostics.push(DiagnosticKind::Other, report.degenerate_faces, || {
+    diagnostics.push(DiagnosticKind::DegenerateTriangle, report.degenerate_faces, || {
         let first = (0..faces.geometry.len()).find(|&f| faces.geometry.is_degenerate(f)).unwrap_or(0);
-        format!(
-            "mesh '{}': degenerate triangles (zero area) get no normal of their own; first: triangle {first}",
-            mesh.name
-        )
+        format!("mesh '{}' triangle {first} (zero area: no normal of its own)", mesh.name)
     });
-    diagnostics.push(DiagnosticKind::Other, report.fallback_normals, || {
-        format!("mesh '{}': vertices touched only by degenerate triangles got the normal +Z", mesh.name)
+    diagnostics.push(DiagnosticKind::FallbackNormal, report.fallback_normals, || {
+        format!("mesh '{}' (touched only by degenerate triangles: normal +Z)", mesh.name)
     });
     (MeshNormals { layout, normals, enhanced_normals, faces, report }, diagnostics.into_vec())
 }

@@ -238,7 +238,7 @@ impl Default for SegmentOptions {
 /// Cuts `scene` into parts. Builds the welded topology of every mesh it needs; see
 /// [`segment_with_topologies`] to reuse topologies built elsewhere.
 ///
-/// Diagnostics (kind [`DiagnosticKind::Other`]) report non-manifold edges whose faces could not
+/// Diagnostics (kind [`DiagnosticKind::UnpairedNonManifoldEdge`]) report non-manifold edges whose faces could not
 /// be paired, and how many small parts were merged.
 pub fn segment(scene: &Scene, options: &SegmentOptions) -> (Parts, Vec<Diagnostic>) {
     segment_with_topologies(scene, &[], options)
@@ -364,7 +364,7 @@ fn diagnostics<'a>(results: impl Iterator<Item = &'a MeshResult> + Clone) -> Vec
     let unpaired: usize = results.clone().map(|r| r.unpaired_edges).sum();
     if unpaired > 0 {
         out.push(Diagnostic {
-            kind: DiagnosticKind::Other,
+            kind: DiagnosticKind::UnpairedNonManifoldEdge,
             count: unpaired,
             first_example: format!(
                 "{unpaired} non-manifold edges could not be paired into solids (odd count or inconsistent orientation); parts are cut there"
@@ -377,7 +377,7 @@ fn diagnostics<'a>(results: impl Iterator<Item = &'a MeshResult> + Clone) -> Vec
         let untouched: usize = results.clone().map(|r| r.untouched).sum();
         let kept: usize = results.map(|r| r.kept).sum();
         out.push(Diagnostic {
-            kind: DiagnosticKind::Other,
+            kind: DiagnosticKind::MergedSliver,
             count: merged,
             first_example: format!(
                 "{merged} of {before} components were small and merged into a touching neighbour; \
