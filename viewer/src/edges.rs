@@ -256,12 +256,16 @@ fn load_silhouettes(
     position: &dyn Fn(usize, usize) -> Option<Vec3>,
     notices: &mut Vec<String>,
 ) -> Option<MeshSilhouetteLines> {
-    let mut segments = Vec::with_capacity(s.candidate_corners.len());
-    for &corner in &s.candidate_corners {
+    // The object-space segment of a corner `3·t + k` (edge v_k → v_(k+1) of mesh triangle t).
+    let segment = |corner: u32| {
         let (t, k) = ((corner / 3) as usize, (corner % 3) as usize);
-        match (position(t, k), position(t, k + 1)) {
-            (Some(a), Some(b)) => segments.push([a, b]),
-            _ => {
+        Some([position(t, k)?, position(t, k + 1)?])
+    };
+    let mut points = Vec::with_capacity(3 * s.candidate_corners.len());
+    for &corner in &s.candidate_corners {
+        match segment(corner) {
+            Some([a, _]) => points.extend(a.to_array()),
+            None => {
                 notices
                     .push(format!("mesh {m}: silhouette candidate corner {corner} is not a triangle edge: none drawn"));
                 return None;
@@ -284,7 +288,7 @@ fn load_silhouettes(
     let arrays = |gauss: bool, bvh: bool| SilhouetteArrays {
         candidate_edges: s.candidate_corners.clone(),
         candidate_normals: s.candidate_normals.clone(),
-        candidate_points: segments.iter().flat_map(|[a, _]| a.to_array()).collect(),
+        candidate_points: points.clone(),
         gauss_map: s.gauss_map.as_ref().filter(|_| gauss).map(|g| GaussMapArrays {
             base: g.base,
             max_depth: g.max_depth,
@@ -325,9 +329,15 @@ fn load_silhouettes(
             }
         }
     };
-    if index.len() != segments.len() {
-        notices.push(format!("mesh {m}: silhouette index and candidates disagree: none drawn"));
-        return None;
+    // The index answers in its own candidate order (the Gauss map's storage order): segments and
+    // corners follow it.
+    let corners = index.candidate_edges().to_vec();
+    let segments: Option<Vec<[Vec3; 2]>> = corners.iter().map(|&c| segment(c)).collect();
+    match segments {
+        Some(segments) if segments.len() == index.len() => Some(MeshSilhouetteLines { index, corners, segments }),
+        _ => {
+            notices.push(format!("mesh {m}: silhouette index and candidates disagree: none drawn"));
+            None
+        }
     }
-    Some(MeshSilhouetteLines { index, corners: s.candidate_corners.clone(), segments })
 }

@@ -183,6 +183,20 @@ pub fn run(args: Args) -> Result<()> {
             started.elapsed().as_secs_f64() * 1e3,
             r.stages.iter().map(|s| format!("{} {:.0} ms", s.name, s.ms)).collect::<Vec<_>>().join(", ")
         );
+        let b = &r.sections;
+        let share = |x: u64| 100.0 * x as f64 / b.total.max(1) as f64;
+        eprintln!(
+            "  bytes: geometry {:.1}%, normals {:.1}%, Khronos edges {:.1}%, hierarchies {:.1}%, labels {:.1}%, \
+             textures {:.1}%, JSON {:.1}%, other {:.1}%",
+            share(b.geometry),
+            share(b.normals),
+            share(b.khronos_edges),
+            share(b.hierarchies),
+            share(b.labels),
+            share(b.textures),
+            share(b.json),
+            share(b.other)
+        );
         if let Some(t) = &r.textures {
             let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
             eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);

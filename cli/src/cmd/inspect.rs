@@ -4,7 +4,7 @@ use crate::cmd::out;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use drafter_core::{Diagnostic, MeshId, Scene, Topology, Weld};
+use drafter_core::{Diagnostic, MeshId, Scene, Topology, Weld, thousands};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -68,6 +68,8 @@ pub struct BakedSummary {
     pub parts: Vec<drafter_format::PartRecord>,
     /// Primitives with per-triangle part labels.
     pub labelled_primitives: usize,
+    /// The file's bytes by what they hold.
+    pub sections: drafter_format::ByteSections,
 }
 
 /// Reads the extension if the file is a baked glTF; `None` for anything else.
@@ -86,6 +88,8 @@ fn read_baked(path: &std::path::Path, bytes: &[u8]) -> Result<Option<BakedSummar
         Ok(baked) => Ok(Some(BakedSummary {
             parts: baked.parts().into_iter().cloned().collect(),
             labelled_primitives: baked.primitive_labels.len(),
+            sections: drafter_format::byte_sections(bytes, &external)
+                .map_err(|e| BadInput(format!("{}: {e}", path.display())))?,
             root: baked.root,
         })),
         Err(drafter_format::FormatError::NotBaked(_)) => Ok(None),
@@ -349,10 +353,29 @@ fn print_text(r: &Report) -> anyhow::Result<()> {
             kinds.extend(t.metal.as_ref().map(|m| format!("metal ({} metal parts)", m.parts.len())));
             out!("  textures: {}", kinds.join(", "));
         }
+        let s = &b.sections;
+        let row = |name: &str, bytes: u64| {
+            format!("{name} {} ({:.1}%)", thousands(bytes as usize), 100.0 * bytes as f64 / s.total.max(1) as f64)
+        };
+        out!(
+            "  bytes: {} in all: {}",
+            thousands(s.total as usize),
+            [
+                row("geometry", s.geometry),
+                row("normals", s.normals),
+                row("Khronos edges", s.khronos_edges),
+                row("hierarchies", s.hierarchies),
+                row("labels", s.labels),
+                row("textures", s.textures),
+                row("JSON", s.json),
+                row("other", s.other),
+            ]
+            .join(", ")
+        );
     }
     if !r.diagnostics.is_empty() {
         out!("\n  input problems recovered from:");
-        for d in &r.diagnostics {
+        for d in drafter_core::summarize(&r.diagnostics) {
             out!("    {d}");
         }
     }

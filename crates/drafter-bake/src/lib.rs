@@ -74,6 +74,8 @@ pub struct BakeReport {
     pub stages: Vec<StageTiming>,
     /// Bytes of the written file(s).
     pub output_bytes: u64,
+    /// The same bytes by what they hold (geometry, normals, Khronos edges, hierarchies, ...).
+    pub sections: drafter_format::ByteSections,
     /// What the normal stage did, summed over unique meshes (absent when it was off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normals: Option<NormalsSummary>,
@@ -188,7 +190,8 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
 
     let start = begin("lines");
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
-        let (edges, silhouettes, summary, line_diagnostics) = compute_lines(scene, &topologies, &parts, &config.lines);
+        let (edges, silhouettes, summary, line_diagnostics) =
+            compute_lines(scene, &topologies, &parts, &vertex_data, &config.lines);
         diagnostics.extend(line_diagnostics);
         (edges, silhouettes, Some(summary))
     } else {
@@ -258,6 +261,8 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     timed("write", start);
 
     let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
+    let sections = drafter_format::byte_sections(&written.main, &|_| written.bin.clone())
+        .map_err(|e| BakeError::Internal { stage: "write", message: format!("the written file does not read: {e}") })?;
     diagnostics.sort_by_key(|d| d.kind);
     let report = BakeReport {
         input: config.input.clone(),
@@ -265,6 +270,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         parts: records.iter().map(part_report).collect(),
         stages,
         output_bytes,
+        sections,
         normals: normals_summary,
         lines: lines_summary,
         textures: textures_summary,
@@ -333,7 +339,13 @@ type LinesResult = (Vec<Vec<Option<PrimitiveEdges>>>, Vec<Option<MeshSilhouettes
 
 /// Edges of every mesh used by an instance: classes (with part borders from the segmentation),
 /// the per-primitive encoding and the silhouette index.
-fn compute_lines(scene: &Scene, topologies: &[Topology], parts: &Parts, stage: &LinesStage) -> LinesResult {
+fn compute_lines(
+    scene: &Scene,
+    topologies: &[Topology],
+    parts: &Parts,
+    vertex_data: &[Option<VertexData>],
+    stage: &LinesStage,
+) -> LinesResult {
     let used = used_meshes(scene);
     // Per-triangle part labels of each mesh (shared by its instances), if it was split.
     let mut labels: Vec<Option<&[u32]>> = vec![None; scene.meshes.len()];
@@ -392,8 +404,7 @@ fn compute_lines(scene: &Scene, topologies: &[Topology], parts: &Parts, stage: &
                     }
                 })
                 .collect();
-            let silhouettes =
-                (!feature.candidates.is_empty()).then(|| silhouettes_of(topology, &feature, stage.hierarchies));
+            let silhouettes = silhouettes_of(mesh, &edges, vertex_data[m].as_ref(), stage.hierarchies);
             Some((edges, silhouettes, feature.counts, diagnostics))
         })
         .collect();
@@ -442,41 +453,76 @@ fn hard_edge_code(class: EdgeClass) -> u8 {
     }
 }
 
-/// The candidates of a mesh with the hierarchies drafter-lines chose to store (none when brute
-/// force is as fast, or when `hierarchies` is off).
-fn silhouettes_of(topology: &Topology, feature: &drafter_lines::FeatureEdges, hierarchies: bool) -> MeshSilhouettes {
+/// The mesh's silhouette candidates as every reader of the file sees them (format 0.2): the edges
+/// its primitives' `EXT_mesh_primitive_edge_visibility` encodes as 1, primitive by primitive in
+/// encoding order, with the decoded `silhouetteNormals` and, as the perspective test's point, the
+/// written position of the edge's first vertex. The hierarchies are built on exactly these values,
+/// so that they answer as brute force over the file's data, bit for bit; nothing per candidate is
+/// stored twice. `None` when no primitive has a candidate.
+fn silhouettes_of(
+    mesh: &drafter_core::Mesh,
+    edges: &[Option<PrimitiveEdges>],
+    layout: Option<&VertexData>,
+    hierarchies: bool,
+) -> Option<MeshSilhouettes> {
+    let mut corners = Vec::new();
+    let mut normals = Vec::new();
+    let mut points = Vec::new();
+    for (group, primitive_edges) in mesh.groups.iter().zip(edges) {
+        let Some(e) = primitive_edges else { continue };
+        let range = group.start as usize..(group.start + group.count) as usize;
+        // The position the writer gives each corner: with a new vertex layout, an output vertex
+        // takes the mesh vertex of its first corner in this primitive (as `write_vertex_data` does).
+        let written: Option<std::collections::HashMap<u32, u32>> = layout.map(|vd| {
+            let mut first = std::collections::HashMap::new();
+            for (t, mesh_triangle) in vd.triangles[range.clone()].iter().zip(&mesh.triangles[range.clone()]) {
+                for (&o, &v) in t.iter().zip(mesh_triangle) {
+                    first.entry(o).or_insert(v);
+                }
+            }
+            first
+        });
+        for (i, slot) in e.silhouette_slots().enumerate() {
+            let t = group.start as usize + slot as usize / 3;
+            let k = slot as usize % 3;
+            let vertex = match (&written, layout) {
+                (Some(first), Some(vd)) => first[&vd.triangles[t][k]],
+                _ => mesh.triangles[t][k],
+            };
+            corners.push(3 * t as u32 + k as u32);
+            normals.push([
+                drafter_core::snorm8_decode(e.silhouette_normals[2 * i]),
+                drafter_core::snorm8_decode(e.silhouette_normals[2 * i + 1]),
+            ]);
+            points.push(mesh.positions[vertex as usize]);
+        }
+    }
+    if corners.is_empty() {
+        return None;
+    }
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
-    let corner_of = |e: u32| -> u32 {
-        let f = topology.faces_of_edge(e as usize)[0];
-        let k = topology.face_edges[f as usize].iter().position(|&x| x == e).unwrap_or(0) as u32;
-        3 * f + k
-    };
-    // The perspective test's point v is the first vertex of the corner the file stores (the spec's
-    // "v the edge's first vertex"), so that a reader rebuilds the same candidates from the file.
-    let points = feature
-        .candidates
-        .iter()
-        .map(|&e| {
-            let c = corner_of(e) as usize;
-            topology.welded_positions[topology.faces[c / 3][c % 3] as usize]
-        })
-        .collect();
-    let index = SilhouetteIndex::from_candidates(
-        feature.candidates.clone(),
-        feature.candidate_normals.clone(),
-        points,
-        &options,
-    );
+    let index = SilhouetteIndex::from_candidates(corners.clone(), normals.clone(), points, &options);
     let arrays = index.to_arrays();
+    // The index renumbers its candidates in the Gauss map's storage order; the file keeps the
+    // Khronos encoding order. So each stored order maps a storage position to a file candidate:
+    // the index's candidate k (corner c) is file candidate `file_of[k]`. Corners are unique.
+    let mut by_corner: Vec<(u32, u32)> = corners.iter().enumerate().map(|(i, &c)| (c, i as u32)).collect();
+    by_corner.sort_unstable();
+    let file_of: Vec<u32> = arrays
+        .candidate_edges
+        .iter()
+        .map(|c| by_corner.binary_search_by_key(c, |p| p.0).map_or(u32::MAX, |i| by_corner[i].1))
+        .collect();
+    let remap = |order: &[u32]| -> Vec<u32> { order.iter().map(|&k| file_of[k as usize]).collect() };
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",
         HierarchyChoice::ConeBvh { .. } => "coneBvh",
         HierarchyChoice::BruteForce(_) => "bruteForce",
     };
-    MeshSilhouettes {
-        candidate_corners: arrays.candidate_edges.iter().map(|&e| corner_of(e)).collect(),
-        candidate_normals: arrays.candidate_normals,
+    Some(MeshSilhouettes {
+        candidate_normals: normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect(),
+        candidate_corners: corners,
         orthographic: choice(arrays.orthographic).to_owned(),
         perspective: choice(arrays.perspective).to_owned(),
         gauss_map: arrays.gauss_map.map(|g| GaussMapData {
@@ -484,15 +530,15 @@ fn silhouettes_of(topology: &Topology, feature: &drafter_lines::FeatureEdges, hi
             max_depth: g.max_depth,
             node_caps: g.node_caps,
             nodes: g.nodes,
-            order: g.order,
+            order: remap(&g.order),
         }),
         cone_bvh: arrays.cone_bvh.map(|b| ConeBvhData {
             node_boxes: b.node_boxes,
             node_cones: b.node_cones,
             nodes: b.nodes,
-            order: b.order,
+            order: remap(&b.order),
         }),
-    }
+    })
 }
 
 fn used_meshes(scene: &Scene) -> Vec<bool> {

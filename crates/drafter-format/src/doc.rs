@@ -8,6 +8,7 @@ use crate::FormatError;
 pub(crate) const ARRAY_BUFFER: u32 = 34962;
 pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
+pub(crate) const BYTE: u32 = 5120;
 pub(crate) const UNSIGNED_BYTE: u32 = 5121;
 pub(crate) const UNSIGNED_SHORT: u32 = 5123;
 pub(crate) const UNSIGNED_INT: u32 = 5125;
@@ -35,17 +36,8 @@ pub(crate) const COMPACTION_SAFE_EXTENSIONS: &[&str] = &[
 ];
 
 /// Keys whose integer values are accessor indices, anywhere inside our extension's objects.
-const OWN_ACCESSOR_KEYS: &[&str] = &[
-    "partLabels",
-    "hardEdgeClasses",
-    "candidateCorners",
-    "candidateNormals",
-    "nodeCaps",
-    "nodes",
-    "order",
-    "nodeBoxes",
-    "nodeCones",
-];
+const OWN_ACCESSOR_KEYS: &[&str] =
+    &["partLabels", "hardEdgeClasses", "nodeCaps", "nodes", "order", "nodeBoxes", "nodeCones"];
 const EDGE_VISIBILITY: &str = "EXT_mesh_primitive_edge_visibility";
 /// Accessor-valued keys of EXT_mesh_primitive_edge_visibility (`indices` inside `lineStrings`).
 const EDGE_VISIBILITY_ACCESSOR_KEYS: &[&str] = &["visibility", "silhouetteNormals", "indices"];
@@ -191,6 +183,34 @@ impl Doc {
             accessor["max"] = json!(hi);
         }
         self.push_accessor(accessor)
+    }
+
+    /// VEC3 BYTE normalized (`drafter_core::snorm`): a vertex attribute (`attribute`: 4-byte stride,
+    /// one padding byte, ARRAY_BUFFER) or data read only by an extension (tightly packed).
+    pub fn push_snorm8_vec3(&mut self, values: &[[i8; 3]], attribute: bool) -> usize {
+        let width = if attribute { 4 } else { 3 };
+        let mut bytes = Vec::with_capacity(width * values.len());
+        for v in values {
+            bytes.extend(v.map(|c| c as u8));
+            if attribute {
+                bytes.push(0);
+            }
+        }
+        let view = if attribute {
+            self.push_view(&bytes, Some(ARRAY_BUFFER), Some(4))
+        } else {
+            self.push_view(&bytes, None, None)
+        };
+        self.push_accessor(json!({
+            "bufferView": view, "componentType": BYTE, "normalized": true, "count": values.len(), "type": "VEC3"
+        }))
+    }
+
+    /// Appends a material and returns its index.
+    pub fn push_material(&mut self, material: Value) -> usize {
+        let materials = self.array_mut("materials");
+        materials.push(material);
+        materials.len() - 1
     }
 
     pub fn push_vec2(&mut self, values: &[[f32; 2]]) -> usize {

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 pub const EXTENSION: &str = "DRAFTER_illustration";
 
 /// Version of the extension's layout written by this crate.
-pub const FORMAT_VERSION: &str = "0.1";
+pub const FORMAT_VERSION: &str = "0.2";
 
 /// Root-level object: scene-wide data.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -320,15 +320,12 @@ pub struct MeshExtension {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]
 pub struct SilhouettesRecord {
+    /// Number of candidates: the edges the mesh's primitives encode as 1 in
+    /// `EXT_mesh_primitive_edge_visibility`, primitive by primitive in encoding order. Candidate i
+    /// has that extension's normals `2i` and `2i + 1` (as decoded) and, for an eye e, the point v
+    /// of the edge's first vertex: a silhouette for view direction u iff (n1·u) and (n2·u) have
+    /// strictly opposite signs, for an eye iff n1·(e − v) and n2·(e − v) do.
     pub candidates: u32,
-    /// Accessor (SCALAR, UNSIGNED_INT): for candidate i, `3·t + k` — edge k (v_k → v_(k+1)) of
-    /// triangle t of the mesh, counting triangles through the primitives in order.
-    pub candidate_corners: u32,
-    /// Accessor (SCALAR, FLOAT): 6 per candidate, the two face normals (x, y, z each) in full
-    /// precision. A candidate is a silhouette for view direction u iff (n1·u) and (n2·u) have
-    /// strictly opposite signs (for an eye e: n·(e − v), v the position of the corner's first
-    /// vertex v_k).
-    pub candidate_normals: u32,
     /// `gaussMap` or `bruteForce`: what answers orthographic views.
     pub orthographic: String,
     /// `coneBvh` or `bruteForce`: what answers perspective views.

@@ -22,8 +22,8 @@ pub use ext::{
     PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef, TexturesRecord,
 };
 pub use reader::{
-    BakedFile, EmbeddedPng, PrimitiveNormals, read, read_floats, read_normal_sets, read_scalars, read_textures,
-    split_container,
+    BakedFile, ByteSections, EmbeddedPng, PrimitiveNormals, byte_sections, read, read_floats, read_normal_sets,
+    read_scalars, read_textures, split_container,
 };
 pub use writer::{
     BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,
@@ -48,4 +48,7 @@ pub enum FormatError {
     NotBaked(String),
     #[error("invalid baked file: {0}")]
     Invalid(String),
+    /// A `DRAFTER_illustration` layout this crate does not read.
+    #[error("{EXTENSION} version {0} is not supported (this drafter reads {FORMAT_VERSION}); bake the model again")]
+    Version(String),
 }

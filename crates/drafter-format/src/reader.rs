@@ -6,8 +6,8 @@ use serde_json::Value;
 
 use crate::FormatError;
 use crate::ext::{
-    EDGE_VISIBILITY_EXTENSION, EXTENSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension, RootExtension,
-    TexturesRecord,
+    EDGE_VISIBILITY_EXTENSION, EXTENSION, FORMAT_VERSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension,
+    RootExtension, TexturesRecord,
 };
 use crate::writer::{ConeBvhData, GaussMapData, MeshSilhouettes, PrimitiveEdges};
 
@@ -130,15 +130,24 @@ fn load_buffer(
     })
 }
 
-/// Reads a baked .glb, or a .gltf whose buffer `external` returns (given the buffer's URI).
-pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<BakedFile, FormatError> {
-    let (json, bin) = split_container(bytes)?;
-    let doc: Value = serde_json::from_slice(json)?;
+/// The root object of the extension, refused unless its `version` is the one this crate reads
+/// (layouts change between versions; an older file is baked again, not guessed at).
+fn root_extension(doc: &Value) -> Result<RootExtension, FormatError> {
     let root_value = doc
         .get("extensions")
         .and_then(|e| e.get(EXTENSION))
         .ok_or_else(|| FormatError::NotBaked(format!("no {EXTENSION} extension on the root")))?;
-    let root: RootExtension = serde_json::from_value(root_value.clone())?;
+    match root_value.get("version").and_then(Value::as_str) {
+        Some(FORMAT_VERSION) => Ok(serde_json::from_value(root_value.clone())?),
+        found => Err(FormatError::Version(found.unwrap_or("(none)").to_owned())),
+    }
+}
+
+/// Reads a baked .glb, or a .gltf whose buffer `external` returns (given the buffer's URI).
+pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<BakedFile, FormatError> {
+    let (json, bin) = split_container(bytes)?;
+    let doc: Value = serde_json::from_slice(json)?;
+    let root = root_extension(&doc)?;
     let buffer = load_buffer(&doc, bin, external)?;
     let mut nodes = Vec::new();
     for (i, node) in doc.get("nodes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
@@ -151,9 +160,13 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
     let mut primitive_edges = Vec::new();
     let mut mesh_silhouettes = Vec::new();
     for (m, mesh) in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
+        // Mesh-wide number of each primitive's first triangle, and the edges of this mesh.
+        let mut first_triangle = 0u64;
+        let mut mesh_edges: Vec<(u64, usize)> = Vec::new();
         for (p, prim) in
             mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate()
         {
+            let triangles = triangle_count(&doc, prim);
             let extensions = prim.get("extensions");
             let ours = match extensions.and_then(|e| e.get(EXTENSION)) {
                 Some(ext) => Some(serde_json::from_value::<PrimitiveExtension>(ext.clone())?),
@@ -170,16 +183,14 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
                 };
                 let silhouette_normals = match accessor("silhouetteNormals") {
-                    Some(a) => read_scalars(&doc, a, data()?)?
-                        .into_iter()
-                        .map(|v| u16::try_from(v).map_err(|_| bad("silhouetteNormals above 16 bits")))
-                        .collect::<Result<_, _>>()?,
+                    Some(a) => read_snorm8_vec3s(&doc, a, data()?)?,
                     None => Vec::new(),
                 };
                 let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
                     Some(a) => narrow(read_scalars(&doc, a as usize, data()?)?, "hardEdgeClasses above 8 bits")?,
                     None => Vec::new(),
                 };
+                mesh_edges.push((first_triangle, primitive_edges.len()));
                 primitive_edges.push((
                     m as u32,
                     p as u32,
@@ -190,6 +201,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     },
                 ));
             }
+            first_triangle += triangles;
         }
         let Some(ext) = mesh.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
         let ext: MeshExtension = serde_json::from_value(ext.clone())?;
@@ -197,9 +209,11 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
             let data = data()?;
             let u32s = |a: u32| read_scalars(&doc, a as usize, data);
             let f32s = |a: u32| read_floats(&doc, a as usize, data);
+            let (candidate_corners, candidate_normals) = derived_candidates(&mesh_edges, &primitive_edges)
+                .map_err(|what| FormatError::Invalid(format!("/meshes/{m}: {what}")))?;
             let silhouettes = MeshSilhouettes {
-                candidate_corners: u32s(s.candidate_corners)?,
-                candidate_normals: f32s(s.candidate_normals)?,
+                candidate_corners,
+                candidate_normals,
                 orthographic: s.orthographic,
                 perspective: s.perspective,
                 gauss_map: match s.gauss_map {
@@ -222,14 +236,11 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     None => None,
                 },
             };
-            if silhouettes.candidate_corners.len() != s.candidates as usize
-                || silhouettes.candidate_normals.len() != 6 * s.candidates as usize
-            {
+            if silhouettes.candidate_corners.len() != s.candidates as usize {
                 return Err(FormatError::Invalid(format!(
-                    "/meshes/{m}: {} candidates, but {} corners and {} normal components",
+                    "/meshes/{m}: {} silhouette candidates, but the primitives encode {} edges as 1",
                     s.candidates,
-                    silhouettes.candidate_corners.len(),
-                    silhouettes.candidate_normals.len()
+                    silhouettes.candidate_corners.len()
                 )));
             }
             mesh_silhouettes.push((m as u32, silhouettes));
@@ -239,18 +250,14 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
 }
 
 /// The bytes of a tightly packed SCALAR accessor with components of `size` bytes.
+/// The bytes of a tightly packed accessor of `size`-byte elements (no `byteStride`, or one equal
+/// to `size`), checked against its buffer view and the buffer.
 fn accessor_bytes<'a>(doc: &Value, accessor: usize, buffer: &'a [u8], size: usize) -> Result<&'a [u8], FormatError> {
-    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
-    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
-    let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
-    let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))? as usize;
-    let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize
-        + a.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-    count
-        .checked_mul(size)
-        .and_then(|n| buffer.get(start..start.checked_add(n)?))
-        .ok_or_else(|| bad("data outside the buffer"))
+    let (start, stride, count) = accessor_layout(doc, accessor, buffer, size)?;
+    if stride != size {
+        return Err(FormatError::Invalid(format!("/accessors/{accessor}: interleaved (byteStride {stride})")));
+    }
+    Ok(&buffer[start..start + count * size])
 }
 
 /// Reads a FLOAT SCALAR accessor (tightly packed) from the single buffer.
@@ -307,11 +314,7 @@ pub fn read_normal_sets(
 ) -> Result<Vec<PrimitiveNormals>, FormatError> {
     let (json, bin) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
-    let root_value = doc
-        .get("extensions")
-        .and_then(|e| e.get(EXTENSION))
-        .ok_or_else(|| FormatError::NotBaked(format!("no {EXTENSION} extension on the root")))?;
-    let root: RootExtension = serde_json::from_value(root_value.clone())?;
+    let root = root_extension(&doc)?;
     let swapped = root.normals.as_ref().is_some_and(|n| n.enhanced_in_normal);
     let mut buffer = None;
     let mut sets = Vec::new();
@@ -349,22 +352,252 @@ pub fn read_normal_sets(
     Ok(sets)
 }
 
-/// Reads a FLOAT VEC3 accessor (tightly packed, or with a 12-byte stride) from the single buffer.
+/// `v` at unit length (+Z when it has none).
+fn unit(v: glam::Vec3) -> [f32; 3] {
+    v.try_normalize().unwrap_or(glam::Vec3::Z).to_array()
+}
+
+/// Triangles of a primitive as the importers count them: `n / 3` for mode 4 (triangles), `n − 2`
+/// for strips and fans, none for points and lines; `n` is the index count, or POSITION's count
+/// for a primitive without indices.
+fn triangle_count(doc: &Value, primitive: &Value) -> u64 {
+    let count_of = |accessor: Option<&Value>| {
+        accessor
+            .and_then(Value::as_u64)
+            .and_then(|a| doc.get("accessors")?.get(a as usize)?.get("count")?.as_u64())
+            .unwrap_or(0)
+    };
+    let n = match primitive.get("indices") {
+        Some(indices) => count_of(Some(indices)),
+        None => count_of(primitive.get("attributes").and_then(|a| a.get("POSITION"))),
+    };
+    match primitive.get("mode").and_then(Value::as_u64).unwrap_or(4) {
+        4 => n / 3,
+        5 | 6 => n.saturating_sub(2),
+        _ => 0,
+    }
+}
+
+/// A mesh's silhouette candidates as format 0.2 defines them: the edges its primitives encode as 1,
+/// primitive by primitive in encoding order, as corners `3·t + k` counted through the mesh's
+/// triangles, with the two decoded normals of each. `edges` lists each primitive with edges as (its
+/// first mesh triangle, its index in `all`).
+fn derived_candidates(
+    edges: &[(u64, usize)],
+    all: &[(u32, u32, PrimitiveEdges)],
+) -> Result<(Vec<u32>, Vec<f32>), String> {
+    let mut corners = Vec::new();
+    let mut normals = Vec::new();
+    for &(first, i) in edges {
+        let e = &all[i].2;
+        let slots: Vec<u32> = e.silhouette_slots().collect();
+        if e.silhouette_normals.len() != 2 * slots.len() {
+            return Err(format!(
+                "primitive {}: {} edges encoded 1 but {} silhouetteNormals",
+                all[i].1,
+                slots.len(),
+                e.silhouette_normals.len()
+            ));
+        }
+        for (k, slot) in slots.into_iter().enumerate() {
+            let corner = (3 * first + u64::from(slot))
+                .try_into()
+                .map_err(|_| format!("primitive {}: triangle numbers beyond 32 bits", all[i].1))?;
+            corners.push(corner);
+            for n in &e.silhouette_normals[2 * k..2 * k + 2] {
+                normals.extend(drafter_core::snorm8_decode(*n).to_array());
+            }
+        }
+    }
+    Ok((corners, normals))
+}
+
+/// Where an accessor's elements lie: (first byte in the buffer, byte stride, count), for elements
+/// of `size` bytes, honouring its buffer view's `byteStride`. Every offset is checked against the
+/// buffer view and the buffer with checked arithmetic (the numbers come from the file).
+fn accessor_layout(
+    doc: &Value,
+    accessor: usize,
+    buffer: &[u8],
+    size: usize,
+) -> Result<(usize, usize, usize), FormatError> {
+    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
+    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
+    let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
+    let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
+    let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))?;
+    let number = |v: &Value, key: &str| v.get(key).and_then(Value::as_u64).unwrap_or(0);
+    let stride = match number(view, "byteStride") {
+        0 => size as u64,
+        s if s >= size as u64 => s,
+        _ => return Err(bad("byteStride smaller than an element")),
+    };
+    let view_start = number(view, "byteOffset");
+    let view_length =
+        view.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad("bufferView has no byteLength"))?;
+    let offset = number(a, "byteOffset");
+    // The last element ends at offset + (count − 1)·stride + size: inside the view and the buffer.
+    let end = match count {
+        0 => Some(offset),
+        _ => (count - 1).checked_mul(stride).and_then(|x| x.checked_add(offset)?.checked_add(size as u64)),
+    };
+    let end = end.filter(|&e| e <= view_length).ok_or_else(|| bad("data outside its buffer view"))?;
+    if view_start.checked_add(end).is_none_or(|e| e > buffer.len() as u64) {
+        return Err(bad("data outside the buffer"));
+    }
+    Ok(((view_start + offset) as usize, stride as usize, count as usize))
+}
+
+/// The elements of an accessor, `size` bytes each (see [`accessor_layout`]).
+fn accessor_elements<'a>(
+    doc: &Value,
+    accessor: usize,
+    buffer: &'a [u8],
+    size: usize,
+) -> Result<impl Iterator<Item = &'a [u8]>, FormatError> {
+    let (start, stride, count) = accessor_layout(doc, accessor, buffer, size)?;
+    Ok((0..count).map(move |i| &buffer[start + i * stride..start + i * stride + size]))
+}
+
+/// Reads a VEC3 accessor of unit vectors as normalized bytes: BYTE normalized as stored, SHORT
+/// normalized and FLOAT re-encoded (`drafter_core::snorm`), the three component types the merged
+/// `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
+fn read_snorm8_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[i8; 3]>, FormatError> {
+    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
+    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
+    if a.get("type").and_then(Value::as_str) != Some("VEC3") {
+        return Err(bad("silhouetteNormals must be VEC3"));
+    }
+    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
+    match (a.get("componentType").and_then(Value::as_u64), normalized) {
+        (Some(5120), true) => {
+            Ok(accessor_elements(doc, accessor, buffer, 3)?.map(|c| [c[0] as i8, c[1] as i8, c[2] as i8]).collect())
+        }
+        (Some(5122), true) => Ok(accessor_elements(doc, accessor, buffer, 6)?
+            .map(|c| {
+                drafter_core::snorm16_to_snorm8(std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
+            })
+            .collect()),
+        (Some(5126), _) => Ok(read_vec3s(doc, accessor, buffer)?
+            .into_iter()
+            .map(|v| drafter_core::snorm8_encode(glam::Vec3::from(v)))
+            .collect()),
+        _ => Err(bad("silhouetteNormals must be FLOAT, or BYTE or SHORT normalized")),
+    }
+}
+
+/// Reads a VEC3 accessor of FLOAT, or of BYTE / SHORT normalized (decoded as glTF defines, then
+/// renormalised: these are shading normals), from the single buffer, tightly packed or strided.
 fn read_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[f32; 3]>, FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
     let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    if a.get("componentType").and_then(Value::as_u64) != Some(5126)
-        || a.get("type").and_then(Value::as_str) != Some("VEC3")
-    {
-        return Err(bad("not a FLOAT VEC3 accessor"));
+    if a.get("type").and_then(Value::as_str) != Some("VEC3") {
+        return Err(bad("not a VEC3 accessor"));
     }
-    let view = a.get("bufferView").and_then(Value::as_u64).and_then(|v| doc.get("bufferViews")?.get(v as usize));
-    if view.and_then(|v| v.get("byteStride")).and_then(Value::as_u64).is_some_and(|s| s != 12) {
-        return Err(bad("interleaved (byteStride other than 12)"));
+    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
+    match (a.get("componentType").and_then(Value::as_u64), normalized) {
+        (Some(5126), _) => Ok(accessor_elements(doc, accessor, buffer, 12)?
+            .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
+            .collect()),
+        (Some(5120), true) => Ok(accessor_elements(doc, accessor, buffer, 3)?
+            .map(|c| unit(drafter_core::snorm8_decode([c[0] as i8, c[1] as i8, c[2] as i8])))
+            .collect()),
+        (Some(5122), true) => Ok(accessor_elements(doc, accessor, buffer, 6)?
+            .map(|c| {
+                let v: [f32; 3] = std::array::from_fn(|k| {
+                    (f32::from(i16::from_le_bytes([c[2 * k], c[2 * k + 1]])) / 32767.0).max(-1.0)
+                });
+                unit(glam::Vec3::from(v))
+            })
+            .collect()),
+        _ => Err(bad("not a FLOAT, or BYTE or SHORT normalized, VEC3 accessor")),
     }
-    let bytes = accessor_bytes(doc, accessor, buffer, 12)?;
-    Ok(bytes
-        .chunks_exact(12)
-        .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
-        .collect())
+}
+
+/// Bytes of a baked file by what they hold. Each buffer view is counted once, under the first use
+/// found (mesh attributes and indices, then the edge extensions, then our hierarchies, then
+/// images); `json` is the JSON text, `other` everything else (padding, the GLB framing, buffer
+/// views of the input that nothing above names).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ByteSections {
+    /// Indices, POSITION and every vertex attribute but the normals.
+    pub geometry: u64,
+    /// `NORMAL` and the enhanced normals (`_ENHANCED_NORMAL`).
+    pub normals: u64,
+    /// `EXT_mesh_primitive_edge_visibility`: `visibility` and `silhouetteNormals`.
+    pub khronos_edges: u64,
+    /// `DRAFTER_illustration` per primitive: part labels and hard-edge classes.
+    pub labels: u64,
+    /// `DRAFTER_illustration` silhouette hierarchies (nodes, bounds, `order` permutations).
+    pub hierarchies: u64,
+    /// Images (the input's and the baked lookup textures).
+    pub textures: u64,
+    pub json: u64,
+    pub other: u64,
+    pub total: u64,
+}
+
+/// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns.
+pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<ByteSections, FormatError> {
+    let (json, _) = split_container(bytes)?;
+    let doc: Value = serde_json::from_slice(json)?;
+    let external_bytes = match doc.pointer("/buffers/0/uri") {
+        Some(_) => load_buffer(&doc, None, external)?.map_or(0, |b| b.len() as u64),
+        None => 0,
+    };
+    let views = doc.get("bufferViews").and_then(Value::as_array).map_or(&[][..], Vec::as_slice);
+    let mut counted = vec![false; views.len()];
+    let mut count_view = |view: Option<u64>, into: &mut u64| {
+        if let Some(v) = view.map(|v| v as usize).filter(|&v| v < views.len())
+            && !std::mem::replace(&mut counted[v], true)
+        {
+            *into += views[v].get("byteLength").and_then(Value::as_u64).unwrap_or(0);
+        }
+    };
+    let view_of = |accessor: &Value| {
+        accessor.as_u64().and_then(|a| doc.get("accessors")?.get(a as usize)?.get("bufferView")?.as_u64())
+    };
+    let mut s =
+        ByteSections { json: json.len() as u64, total: bytes.len() as u64 + external_bytes, ..Default::default() };
+    let enhanced = crate::ext::ENHANCED_NORMAL_ATTRIBUTE;
+    for mesh in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
+        for prim in mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
+            for (name, accessor) in prim.get("attributes").and_then(Value::as_object).into_iter().flatten() {
+                let into = if name == "NORMAL" || name == enhanced { &mut s.normals } else { &mut s.geometry };
+                count_view(view_of(accessor), into);
+            }
+            if let Some(indices) = prim.get("indices") {
+                count_view(view_of(indices), &mut s.geometry);
+            }
+            if let Some(e) = prim.pointer(&format!("/extensions/{EDGE_VISIBILITY_EXTENSION}")) {
+                for key in ["visibility", "silhouetteNormals"] {
+                    if let Some(a) = e.get(key) {
+                        count_view(view_of(a), &mut s.khronos_edges);
+                    }
+                }
+            }
+            if let Some(e) = prim.pointer(&format!("/extensions/{EXTENSION}")) {
+                for key in ["partLabels", "hardEdgeClasses"] {
+                    if let Some(a) = e.get(key) {
+                        count_view(view_of(a), &mut s.labels);
+                    }
+                }
+            }
+        }
+        if let Some(sil) = mesh.pointer(&format!("/extensions/{EXTENSION}/silhouettes")) {
+            for hierarchy in ["gaussMap", "coneBvh"] {
+                for (key, a) in sil.get(hierarchy).and_then(Value::as_object).into_iter().flatten() {
+                    if !matches!(key.as_str(), "base" | "maxDepth") {
+                        count_view(view_of(a), &mut s.hierarchies);
+                    }
+                }
+            }
+        }
+    }
+    for image in doc.get("images").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
+        count_view(image.get("bufferView").and_then(Value::as_u64), &mut s.textures);
+    }
+    let named = s.geometry + s.normals + s.khronos_edges + s.labels + s.hierarchies + s.textures + s.json;
+    s.other = s.total.saturating_sub(named);
+    Ok(s)
 }

@@ -10,7 +10,7 @@ use drafter_core::{Mesh, Scene, TriangleGroup};
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
-use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER, UNSIGNED_BYTE, UNSIGNED_INT, UNSIGNED_SHORT};
+use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER, UNSIGNED_BYTE};
 use crate::ext::{
     ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, GaussMapRecord, MeshExtension,
     NodeExtension, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord, TexturesRecord,
@@ -95,8 +95,9 @@ impl SamplerDesc {
 pub struct PrimitiveEdges {
     /// 2 bits per triangle edge (the draft's `visibility`).
     pub visibility: Vec<u8>,
-    /// Two oct16 normals per silhouette candidate encoded as 1, in encoding order.
-    pub silhouette_normals: Vec<u16>,
+    /// The draft's `silhouetteNormals`: two VEC3 normalized-byte normals per edge encoded as 1, in
+    /// encoding order (`drafter_core::snorm`).
+    pub silhouette_normals: Vec<[i8; 3]>,
     /// [`crate::ext::HardEdgeClass`] code of each edge encoded as 2, in encoding order.
     pub hard_edge_classes: Vec<u8>,
 }
@@ -117,7 +118,7 @@ impl PrimitiveEdges {
             .map(|(n, slot)| (slot as u32, self.hard_edge_classes.get(n).copied().unwrap_or(0)))
     }
 
-    /// The slots encoded 1 (silhouette candidates), in encoding order: candidate i has the oct16
+    /// The slots encoded 1 (silhouette candidates), in encoding order: candidate i has the
     /// normals `silhouette_normals[2i..2i + 2]`.
     pub fn silhouette_slots(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.visibility.len() * 4).filter(|&slot| self.value(slot) == 1).map(|slot| slot as u32)
@@ -125,11 +126,19 @@ impl PrimitiveEdges {
 }
 
 /// A mesh's silhouette candidates and hierarchies, as flat arrays.
+///
+/// Format 0.2 stores no per-candidate data of its own: the candidates are the edges the mesh's
+/// primitives encode as 1 in `EXT_mesh_primitive_edge_visibility`, primitive by primitive in
+/// encoding order. `candidate_corners` and `candidate_normals` are what a reader derives from
+/// those (and what the writer checks them against); the hierarchies' `order` arrays map storage
+/// positions to candidates in that order.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshSilhouettes {
-    /// `3·t + k` of each candidate (edge k of mesh triangle t).
+    /// `3·t + k` of each candidate (edge k of mesh triangle t, triangles counted through the
+    /// primitives in order). Derived, not stored.
     pub candidate_corners: Vec<u32>,
-    /// 6 floats per candidate: both face normals.
+    /// 6 floats per candidate: both face normals as decoded from `silhouetteNormals`. Derived, not
+    /// stored.
     pub candidate_normals: Vec<f32>,
     /// `gaussMap` or `bruteForce`.
     pub orthographic: String,
@@ -221,6 +230,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             .ok_or_else(|| FormatError::Inconsistent(format!("instance {i} has no node")))?;
         extension_slot(node).insert(EXTENSION.into(), ext);
     }
+    let mut edge_material: Option<usize> = None;
     for (m, mesh) in scene.meshes.iter().enumerate() {
         for (g, group) in mesh.groups.iter().enumerate() {
             let primitive = if from_source { group.primitive.map_or(g, |p| p as usize) } else { g };
@@ -259,11 +269,10 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             let mut hard_edge_classes = None;
             if let Some(edges) = edges {
                 let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
-                let mut ext = json!({"visibility": visibility});
+                let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
+                let mut ext = json!({"visibility": visibility, "material": material});
                 if !edges.silhouette_normals.is_empty() {
-                    let bytes: Vec<u8> = edges.silhouette_normals.iter().flat_map(|v| v.to_le_bytes()).collect();
-                    ext["silhouetteNormals"] =
-                        doc.push_typed_scalars(UNSIGNED_SHORT, &bytes, edges.silhouette_normals.len()).into();
+                    ext["silhouetteNormals"] = doc.push_snorm8_vec3(&edges.silhouette_normals, false).into();
                 }
                 if !edges.hard_edge_classes.is_empty() {
                     hard_edge_classes = Some(doc.push_typed_scalars(
@@ -284,6 +293,13 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             extension_slot(prim).insert(EXTENSION.into(), ext);
         }
         if let Some(sil) = &out.mesh_silhouettes[m] {
+            let encoded: usize = out.primitive_edges[m].iter().flatten().map(|e| e.silhouette_normals.len() / 2).sum();
+            if encoded != sil.candidate_corners.len() || 6 * encoded != sil.candidate_normals.len() {
+                return Err(FormatError::Inconsistent(format!(
+                    "mesh {m}: {} silhouette candidates, but its primitives encode {encoded} edges as 1",
+                    sil.candidate_corners.len()
+                )));
+            }
             let record = silhouettes_record(&mut doc, sil);
             let ext = serde_json::to_value(MeshExtension { silhouettes: Some(record) })?;
             let mesh_json =
@@ -411,7 +427,9 @@ fn write_vertex_data(
     let enhanced: Vec<[f32; 3]> = picks.iter().map(|&(o, _)| vd.enhanced[o as usize]).collect();
     attributes.insert("POSITION".into(), doc.push_vec3(&positions, true).into());
     attributes.insert("NORMAL".into(), doc.push_vec3(&normals, false).into());
-    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_vec3(&enhanced, false).into());
+    // Normalized bytes (stride 4): a quarter of FLOAT, within 0.4° (what gltfpack gives NORMAL).
+    let enhanced: Vec<[i8; 3]> = enhanced.iter().map(|&n| drafter_core::snorm8_encode(n.into())).collect();
+    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_vec3(&enhanced, true).into());
     let indices = doc.push_scalars(&triangles, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
     prim["attributes"] = Value::Object(attributes);
@@ -454,28 +472,36 @@ fn write_mesh_vertices(
     Ok(())
 }
 
+/// The material `EXT_mesh_primitive_edge_visibility.material` names on every primitive: black and
+/// matte, so that engines that draw the edges (CesiumJS colours them with it) set them apart from
+/// their faces. Appended once after the input's materials, whose indices do not change.
+pub const EDGE_MATERIAL_NAME: &str = "drafter edges";
+
+fn edge_material_json() -> Value {
+    json!({
+        "name": EDGE_MATERIAL_NAME,
+        "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
+    })
+}
+
+/// The mesh's hierarchies: integer arrays in the smallest unsigned type that holds them (the
+/// `order` permutations are u16 below 65,536 candidates), float arrays as FLOAT.
 fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord {
-    let u32_bytes = |v: &[u32]| -> Vec<u8> { v.iter().flat_map(|x| x.to_le_bytes()).collect() };
-    let candidate_corners =
-        doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&sil.candidate_corners), sil.candidate_corners.len()) as u32;
-    let candidate_normals = doc.push_f32_scalars(&sil.candidate_normals) as u32;
     let gauss_map = sil.gauss_map.as_ref().map(|g| GaussMapRecord {
         base: g.base,
         max_depth: g.max_depth,
         node_caps: doc.push_f32_scalars(&g.node_caps) as u32,
-        nodes: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&g.nodes), g.nodes.len()) as u32,
-        order: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&g.order), g.order.len()) as u32,
+        nodes: doc.push_scalars(&g.nodes, None) as u32,
+        order: doc.push_scalars(&g.order, None) as u32,
     });
     let cone_bvh = sil.cone_bvh.as_ref().map(|b| ConeBvhRecord {
         node_boxes: doc.push_f32_scalars(&b.node_boxes) as u32,
         node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
-        nodes: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&b.nodes), b.nodes.len()) as u32,
-        order: doc.push_typed_scalars(UNSIGNED_INT, &u32_bytes(&b.order), b.order.len()) as u32,
+        nodes: doc.push_scalars(&b.nodes, None) as u32,
+        order: doc.push_scalars(&b.order, None) as u32,
     });
     SilhouettesRecord {
         candidates: sil.candidate_corners.len() as u32,
-        candidate_corners,
-        candidate_normals,
         orthographic: sil.orthographic.clone(),
         perspective: sil.perspective.clone(),
         gauss_map,

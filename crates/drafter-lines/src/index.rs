@@ -263,7 +263,22 @@ impl SilhouetteIndex {
     }
 
     /// Loads an index from its arrays, validating every hierarchy against the candidates.
+    ///
+    /// A file keeps its candidates in the Khronos encoding order, so a stored Gauss map's `order`
+    /// is a permutation. The candidates are then renumbered in its storage order (and the cone
+    /// BVH's order with them), as [`SilhouetteIndex::from_candidates`] does after a build: queries
+    /// run on the same memory layout either way, and answer in the renumbered order
+    /// ([`SilhouetteIndex::candidate_edges`] gives each answer's edge or corner).
     pub fn from_arrays(arrays: &SilhouetteArrays) -> Result<Self, ArraysError> {
+        match &arrays.gauss_map {
+            Some(g) if g.order.iter().enumerate().any(|(i, &k)| k as usize != i) => {
+                Self::from_arrays_in_order(&renumbered(arrays, &g.order)?)
+            }
+            _ => Self::from_arrays_in_order(arrays),
+        }
+    }
+
+    fn from_arrays_in_order(arrays: &SilhouetteArrays) -> Result<Self, ArraysError> {
         let n = arrays.candidate_edges.len();
         if arrays.candidate_normals.len() != 6 * n {
             return Err(ArraysError::Length {
@@ -301,6 +316,36 @@ impl SilhouetteIndex {
             perspective: arrays.perspective,
         })
     }
+}
+
+/// `arrays` with its candidates in the storage order `order` of its Gauss map (whose order becomes
+/// the identity) and its cone BVH's order mapped along.
+fn renumbered(arrays: &SilhouetteArrays, order: &[u32]) -> Result<SilhouetteArrays, ArraysError> {
+    let n = arrays.candidate_edges.len();
+    crate::tree::check_permutation(order, n)?;
+    let pick = |values: &[f32], width: usize| -> Vec<f32> {
+        if values.len() != width * n {
+            return values.to_vec();
+        }
+        order.iter().flat_map(|&k| values[width * k as usize..width * (k as usize + 1)].iter().copied()).collect()
+    };
+    let mut inverse = vec![0u32; n];
+    for (i, &k) in order.iter().enumerate() {
+        inverse[k as usize] = i as u32;
+    }
+    Ok(SilhouetteArrays {
+        candidate_edges: order.iter().map(|&k| arrays.candidate_edges[k as usize]).collect(),
+        candidate_normals: pick(&arrays.candidate_normals, 6),
+        candidate_points: pick(&arrays.candidate_points, 3),
+        gauss_map: arrays.gauss_map.clone().map(|g| GaussMapArrays { order: (0..n as u32).collect(), ..g }),
+        // An out-of-range entry stays out of range, so that the cone BVH's own check refuses it.
+        cone_bvh: arrays.cone_bvh.clone().map(|b| ConeBvhArrays {
+            order: b.order.iter().map(|&k| inverse.get(k as usize).copied().unwrap_or(u32::MAX)).collect(),
+            ..b
+        }),
+        orthographic: arrays.orthographic,
+        perspective: arrays.perspective,
+    })
 }
 
 fn speedup(brute_ns: f64, hierarchy_ns: f64) -> f32 {

@@ -14,7 +14,7 @@
 //!    degenerate face. Normals are computed in `f64` from the welded positions; classification uses
 //!    the welded topology, so unwelded CAD corners do not make every triangle edge a boundary.
 //! 2. [`encode_edge_visibility`] writes a primitive's triangles as the draft extension's 2-bit
-//!    `visibility` values plus oct16 `silhouetteNormals` (Cigolle et al. 2014);
+//!    `visibility` values plus `silhouetteNormals` as VEC3 normalized bytes (the merged draft);
 //!    [`decode_edge_visibility`] reads them back and recounts every edge against the encode-once
 //!    rules.
 //! 3. [`BruteForce`] tests every candidate: the reference and the fallback. Structure of arrays,
@@ -77,8 +77,6 @@
 //! * Johnson, Cohen 2001, "Spatialized Normal Cone Hierarchies", I3D.
 //! * Hertzmann, Zorin 2000, "Illustrating Smooth Surfaces", SIGGRAPH: silhouettes as the
 //!   intersection of the dual surface of face planes with the eye's plane.
-//! * Cigolle, Donow, Evangelakos, Mara, McGuire, Meyer 2014, "A Survey of Efficient
-//!   Representations for Independent Unit Vectors", JCGT 3(2): oct16.
 //! * Khronos draft `EXT_mesh_primitive_edge_visibility` (../shared/specs).
 
 mod brute;
@@ -118,5 +116,5 @@ pub use index::{
 pub use set::EdgeSet;
 pub use visibility::{
     DecodedEdgeVisibility, EdgeVisibility, HARD, HARD_REPEATED, HIDDEN, SILHOUETTE, VisibilityError,
-    decode_edge_visibility, encode_edge_visibility, oct16_decode, oct16_encode,
+    decode_edge_visibility, encode_edge_visibility,
 };
