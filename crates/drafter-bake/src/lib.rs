@@ -491,8 +491,8 @@ fn silhouettes_of(
             };
             corners.push(3 * t as u32 + k as u32);
             normals.push([
-                drafter_core::snorm8_decode(e.silhouette_normals[2 * i]),
-                drafter_core::snorm8_decode(e.silhouette_normals[2 * i + 1]),
+                drafter_core::snorm16_decode(e.silhouette_normals[2 * i]),
+                drafter_core::snorm16_decode(e.silhouette_normals[2 * i + 1]),
             ]);
             points.push(mesh.positions[vertex as usize]);
         }

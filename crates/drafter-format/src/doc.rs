@@ -9,6 +9,7 @@ pub(crate) const ARRAY_BUFFER: u32 = 34962;
 pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
 pub(crate) const BYTE: u32 = 5120;
+pub(crate) const SHORT: u32 = 5122;
 pub(crate) const UNSIGNED_BYTE: u32 = 5121;
 pub(crate) const UNSIGNED_SHORT: u32 = 5123;
 pub(crate) const UNSIGNED_INT: u32 = 5125;
@@ -185,24 +186,22 @@ impl Doc {
         self.push_accessor(accessor)
     }
 
-    /// VEC3 BYTE normalized (`drafter_core::snorm`): a vertex attribute (`attribute`: 4-byte stride,
-    /// one padding byte, ARRAY_BUFFER) or data read only by an extension (tightly packed).
-    pub fn push_snorm8_vec3(&mut self, values: &[[i8; 3]], attribute: bool) -> usize {
-        let width = if attribute { 4 } else { 3 };
-        let mut bytes = Vec::with_capacity(width * values.len());
-        for v in values {
-            bytes.extend(v.map(|c| c as u8));
-            if attribute {
-                bytes.push(0);
-            }
-        }
-        let view = if attribute {
-            self.push_view(&bytes, Some(ARRAY_BUFFER), Some(4))
-        } else {
-            self.push_view(&bytes, None, None)
-        };
+    /// VEC3 BYTE normalized vertex attribute (`drafter_core::snorm`): a 4-byte stride with one
+    /// padding byte, as the spec requires of vertex data.
+    pub fn push_snorm8_attribute(&mut self, values: &[[i8; 3]]) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| [v[0] as u8, v[1] as u8, v[2] as u8, 0]).collect();
+        let view = self.push_view(&bytes, Some(ARRAY_BUFFER), Some(4));
         self.push_accessor(json!({
             "bufferView": view, "componentType": BYTE, "normalized": true, "count": values.len(), "type": "VEC3"
+        }))
+    }
+
+    /// VEC3 SHORT normalized (`drafter_core::snorm`), tightly packed, read only by an extension.
+    pub fn push_snorm16_vec3(&mut self, values: &[[i16; 3]]) -> usize {
+        let bytes: Vec<u8> = values.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+        let view = self.push_view(&bytes, None, None);
+        self.push_accessor(json!({
+            "bufferView": view, "componentType": SHORT, "normalized": true, "count": values.len(), "type": "VEC3"
         }))
     }
 

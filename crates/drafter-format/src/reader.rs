@@ -183,7 +183,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
                 };
                 let silhouette_normals = match accessor("silhouetteNormals") {
-                    Some(a) => read_snorm8_vec3s(&doc, a, data()?)?,
+                    Some(a) => read_snorm16_vec3s(&doc, a, data()?)?,
                     None => Vec::new(),
                 };
                 let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
@@ -405,7 +405,7 @@ fn derived_candidates(
                 .map_err(|_| format!("primitive {}: triangle numbers beyond 32 bits", all[i].1))?;
             corners.push(corner);
             for n in &e.silhouette_normals[2 * k..2 * k + 2] {
-                normals.extend(drafter_core::snorm8_decode(*n).to_array());
+                normals.extend(drafter_core::snorm16_decode(*n).to_array());
             }
         }
     }
@@ -459,10 +459,10 @@ fn accessor_elements<'a>(
     Ok((0..count).map(move |i| &buffer[start + i * stride..start + i * stride + size]))
 }
 
-/// Reads a VEC3 accessor of unit vectors as normalized bytes: BYTE normalized as stored, SHORT
-/// normalized and FLOAT re-encoded (`drafter_core::snorm`), the three component types the merged
-/// `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
-fn read_snorm8_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[i8; 3]>, FormatError> {
+/// Reads a VEC3 accessor of unit vectors as normalized shorts: SHORT normalized as stored, BYTE
+/// normalized and FLOAT decoded then re-encoded (`drafter_core::snorm`): the three component types
+/// the merged `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
+fn read_snorm16_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[i16; 3]>, FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
     let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
     if a.get("type").and_then(Value::as_str) != Some("VEC3") {
@@ -470,17 +470,15 @@ fn read_snorm8_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<
     }
     let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
     match (a.get("componentType").and_then(Value::as_u64), normalized) {
-        (Some(5120), true) => {
-            Ok(accessor_elements(doc, accessor, buffer, 3)?.map(|c| [c[0] as i8, c[1] as i8, c[2] as i8]).collect())
-        }
         (Some(5122), true) => Ok(accessor_elements(doc, accessor, buffer, 6)?
-            .map(|c| {
-                drafter_core::snorm16_to_snorm8(std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
-            })
+            .map(|c| std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
+            .collect()),
+        (Some(5120), true) => Ok(accessor_elements(doc, accessor, buffer, 3)?
+            .map(|c| drafter_core::snorm16_encode(drafter_core::snorm8_decode([c[0] as i8, c[1] as i8, c[2] as i8])))
             .collect()),
         (Some(5126), _) => Ok(read_vec3s(doc, accessor, buffer)?
             .into_iter()
-            .map(|v| drafter_core::snorm8_encode(glam::Vec3::from(v)))
+            .map(|v| drafter_core::snorm16_encode(glam::Vec3::from(v)))
             .collect()),
         _ => Err(bad("silhouetteNormals must be FLOAT, or BYTE or SHORT normalized")),
     }

@@ -95,9 +95,9 @@ impl SamplerDesc {
 pub struct PrimitiveEdges {
     /// 2 bits per triangle edge (the draft's `visibility`).
     pub visibility: Vec<u8>,
-    /// The draft's `silhouetteNormals`: two VEC3 normalized-byte normals per edge encoded as 1, in
+    /// The draft's `silhouetteNormals`: two VEC3 normalized-short normals per edge encoded as 1, in
     /// encoding order (`drafter_core::snorm`).
-    pub silhouette_normals: Vec<[i8; 3]>,
+    pub silhouette_normals: Vec<[i16; 3]>,
     /// [`crate::ext::HardEdgeClass`] code of each edge encoded as 2, in encoding order.
     pub hard_edge_classes: Vec<u8>,
 }
@@ -272,7 +272,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
                 let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
                 let mut ext = json!({"visibility": visibility, "material": material});
                 if !edges.silhouette_normals.is_empty() {
-                    ext["silhouetteNormals"] = doc.push_snorm8_vec3(&edges.silhouette_normals, false).into();
+                    ext["silhouetteNormals"] = doc.push_snorm16_vec3(&edges.silhouette_normals).into();
                 }
                 if !edges.hard_edge_classes.is_empty() {
                     hard_edge_classes = Some(doc.push_typed_scalars(
@@ -429,7 +429,7 @@ fn write_vertex_data(
     attributes.insert("NORMAL".into(), doc.push_vec3(&normals, false).into());
     // Normalized bytes (stride 4): a quarter of FLOAT, within 0.4° (what gltfpack gives NORMAL).
     let enhanced: Vec<[i8; 3]> = enhanced.iter().map(|&n| drafter_core::snorm8_encode(n.into())).collect();
-    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_vec3(&enhanced, true).into());
+    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_attribute(&enhanced).into());
     let indices = doc.push_scalars(&triangles, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
     prim["attributes"] = Value::Object(attributes);
