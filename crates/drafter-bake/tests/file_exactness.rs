@@ -1,0 +1,127 @@
+//! The hierarchies a baked file stores answer exactly as brute force over what a reader decodes
+//! from the file (format 0.2: the candidates are the Khronos 1-edges, their normals the decoded
+//! `silhouetteNormals`, their points the written positions), bit for bit, over 10,000 views per
+//! model: half orthographic, a quarter eyes outside the bounding box, a quarter inside.
+//!
+//! The path is the viewer's: bake in memory, `drafter_format::read`, the mesh's positions through
+//! drafter-io's import of the baked bytes, `SilhouetteIndex::from_arrays` (which renumbers into
+//! the Gauss map's storage order), then queries mapped back to corners and compared as sets.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use drafter_lines::{
+    BruteForce, ConeBvhArrays, EdgeSet, GaussMapArrays, HierarchyChoice, SilhouetteArrays, SilhouetteIndex, View,
+};
+use glam::Vec3;
+
+const VIEWS: usize = 10_000;
+
+fn model(rel: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+    assert!(root.join("README.md").is_file(), "the shared model corpus is missing at {}", root.display());
+    root.join(rel)
+}
+
+/// xorshift64*, as the other exactness tests.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    fn direction(&mut self) -> Vec3 {
+        let z = 2.0 * self.unit() - 1.0;
+        let phi = std::f32::consts::TAU * self.unit();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
+
+fn check(path: &Path) -> usize {
+    let imported = drafter_io::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let baked = drafter_bake::bake(&imported.scene, &drafter_bake::BakeConfig::default()).expect("bakes");
+    let bytes = baked.written.main;
+    let file = drafter_format::read(&bytes, &|_| None).expect("reads");
+    let scene = drafter_io::import_bytes(Path::new("baked.glb"), &bytes).expect("imports").scene;
+    let mut hierarchies = 0;
+    for (m, s) in &file.mesh_silhouettes {
+        let mesh = &scene.meshes[*m as usize];
+        let position =
+            |corner: u32| mesh.positions[mesh.triangles[(corner / 3) as usize][(corner % 3) as usize] as usize];
+        let points: Vec<f32> = s.candidate_corners.iter().flat_map(|&c| position(c).to_array()).collect();
+        let choice = HierarchyChoice::GaussMap { max_depth: 0, nodes: 0, predicted_speedup: 0.0 };
+        let arrays = SilhouetteArrays {
+            candidate_edges: s.candidate_corners.clone(),
+            candidate_normals: s.candidate_normals.clone(),
+            candidate_points: points.clone(),
+            gauss_map: s.gauss_map.as_ref().map(|g| GaussMapArrays {
+                base: g.base,
+                max_depth: g.max_depth,
+                node_caps: g.node_caps.clone(),
+                nodes: g.nodes.clone(),
+                order: g.order.clone(),
+            }),
+            cone_bvh: s.cone_bvh.as_ref().map(|b| ConeBvhArrays {
+                node_boxes: b.node_boxes.clone(),
+                node_cones: b.node_cones.clone(),
+                nodes: b.nodes.clone(),
+                order: b.order.clone(),
+            }),
+            orthographic: choice,
+            perspective: HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 },
+        };
+        if arrays.gauss_map.is_none() && arrays.cone_bvh.is_none() {
+            continue;
+        }
+        hierarchies += 1;
+        let index = SilhouetteIndex::from_arrays(&arrays)
+            .unwrap_or_else(|e| panic!("{}: mesh {m}: stored hierarchies do not load: {e}", path.display()));
+        // The reference: brute force over the decoded candidates in file order.
+        let normals: Vec<[Vec3; 2]> = s
+            .candidate_normals
+            .chunks_exact(6)
+            .map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])])
+            .collect();
+        let points: Vec<Vec3> = points.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+        let brute = BruteForce::new(&normals, &points);
+        let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let (center, half) = ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6));
+        let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ u64::from(*m));
+        let (mut a, mut b) = (EdgeSet::new(normals.len()), EdgeSet::new(normals.len()));
+        for v in 0..VIEWS {
+            let view = match v % 4 {
+                0 | 1 => View::Orthographic { direction: rng.direction() },
+                2 => View::Perspective { eye: center + rng.direction() * half * (1.05 + 4.0 * rng.unit()) },
+                _ => View::Perspective { eye: lo + (hi - lo) * Vec3::new(rng.unit(), rng.unit(), rng.unit()) },
+            };
+            a.reset(normals.len());
+            b.reset(normals.len());
+            brute.query_serial(view, &mut a);
+            index.query_serial(view, &mut b);
+            let expected: BTreeSet<u32> = a.iter().map(|c| s.candidate_corners[c as usize]).collect();
+            let got: BTreeSet<u32> = b.iter().map(|c| index.candidate_edges()[c as usize]).collect();
+            assert_eq!(got, expected, "{}: mesh {m}, view {v} ({view:?})", path.display());
+        }
+    }
+    hierarchies
+}
+
+#[test]
+fn stored_hierarchies_answer_as_brute_force_over_the_decoded_file() {
+    let mut total = 0;
+    for rel in [
+        "obj/common-3d-test-models/fandisk.obj",
+        "obj/common-3d-test-models/stanford-bunny.obj",
+        "obj/v-hacd/crank.off",
+    ] {
+        let n = check(&model(rel));
+        assert!(n > 0, "{rel}: no stored hierarchy to check");
+        total += n;
+    }
+    assert!(total >= 3);
+}
