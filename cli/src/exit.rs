@@ -1,9 +1,11 @@
-//! Mapping errors to exit codes: the input's fault (2) versus ours (1).
+//! Mapping errors to exit codes: the input's fault (2), the system's (3: reading or writing failed
+//! for a reason other than the input's content, such as a full disk or a permission), or ours (1).
 
 use std::process::ExitCode;
 
 pub const INTERNAL: u8 = 1;
 pub const BAD_INPUT: u8 = 2;
+pub const IO_FAILURE: u8 = 3;
 
 /// An error caused by the user's input or options (exit code 2), as opposed to a bug.
 #[derive(Debug)]
@@ -17,12 +19,40 @@ impl std::fmt::Display for BadInput {
 
 impl std::error::Error for BadInput {}
 
+/// A file could not be read or written for a reason outside the input's content (exit code 3).
+#[derive(Debug)]
+pub struct IoFailure(pub String);
+
+impl std::fmt::Display for IoFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for IoFailure {}
+
+/// The exit code of `err`: 3 for I/O failures (an unreadable input counts, except one that does
+/// not exist, which is the user's to fix: 2), 2 for bad input, 1 otherwise.
+pub fn code_of(err: &anyhow::Error) -> u8 {
+    for e in err.chain() {
+        if e.is::<IoFailure>() {
+            return IO_FAILURE;
+        }
+        if let Some(drafter_io::ImportError::Io { source, .. }) = e.downcast_ref::<drafter_io::ImportError>() {
+            return if source.kind() == std::io::ErrorKind::NotFound { BAD_INPUT } else { IO_FAILURE };
+        }
+        if e.is::<drafter_io::ImportError>() || e.is::<BadInput>() {
+            return BAD_INPUT;
+        }
+    }
+    // drafter_bake::BakeError::Internal stays an internal error (exit 1).
+    INTERNAL
+}
+
 /// Prints `err` as one line and picks the exit code.
 pub fn report(err: &anyhow::Error) -> ExitCode {
-    let bad_input = err.chain().any(|e| e.is::<drafter_io::ImportError>() || e.is::<BadInput>());
-    // drafter_bake::BakeError::Internal stays an internal error (exit 1).
     // One line: the chain joined, newlines flattened.
     let message = err.chain().map(|e| e.to_string()).collect::<Vec<_>>().join(": ").replace('\n', " ");
     eprintln!("drafter: error: {message}");
-    ExitCode::from(if bad_input { BAD_INPUT } else { INTERNAL })
+    ExitCode::from(code_of(err))
 }

@@ -1,7 +1,8 @@
 //! `drafter`: bake technical 3D models into illustration-ready glTF, inspect them, render them.
 //!
-//! Exit codes: 0 success, 2 bad input (one line on stderr naming the file and the place), 1 internal
-//! error (a bug: please report it).
+//! Exit codes: 0 success, 2 bad input (one line on stderr naming the file and the place), 3 a file
+//! could not be read or written (disk full, permission denied, ...), 1 internal error (a bug: please
+//! report it); 130 / 143 after Ctrl-C / SIGTERM during a bake, which leaves no partial file.
 
 use std::process::ExitCode;
 
@@ -9,9 +10,17 @@ use clap::{Parser, Subcommand};
 
 mod cmd;
 mod exit;
+mod interrupt;
 
 #[derive(Debug, Parser)]
-#[command(name = "drafter", version, about = "Bake CAD assemblies and meshes into assets for technical illustration")]
+#[command(
+    name = "drafter",
+    version,
+    about = "Bake CAD assemblies and meshes into assets for technical illustration",
+    after_help = "Exit codes: 0 success; 2 bad input (one line naming the file and the place); 3 a file could not be \
+                  read or written (disk full, permission); 1 internal error (a bug). Ctrl-C or SIGTERM during a bake \
+                  exits with 130 or 143 and leaves no partial file."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
