@@ -69,6 +69,9 @@ fn under_pty(args: &[&str], env: &[(&str, &str)]) -> String {
     let quoted: Vec<String> = std::iter::once(exe).chain(args.iter().copied()).map(|a| format!("'{a}'")).collect();
     let mut cmd = Command::new("script");
     cmd.args(["-qec", &quoted.join(" "), "/dev/null"]);
+    // A terminal has a TERM; indicatif draws nothing without one (or with TERM=dumb), as on a bare
+    // CI machine's environment.
+    cmd.env("TERM", "xterm-256color");
     for (k, v) in env {
         cmd.env(k, v);
     }
