@@ -12,7 +12,7 @@
 
 use crate::cmd::out;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use drafter_viewer::{Enhancements, RenderOptions, Renderer, ShadowMode, Style};
@@ -101,6 +101,19 @@ pub struct Report {
     pub silhouettes: usize,
     /// Median CPU time of the per-frame silhouette query (all instances), milliseconds.
     pub silhouette_query_ms: f64,
+    /// Load to first frame, milliseconds: reading and decoding the file into the model (`load`),
+    /// the GPU device (`device`), uploading the model (`upload`), the first illustration frame
+    /// (`first_frame`, with its silhouette query) and their sum (`total`). One run: noisy.
+    pub startup_ms: Startup,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Startup {
+    pub load: f64,
+    pub device: f64,
+    pub upload: f64,
+    pub first_frame: f64,
+    pub total: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -122,9 +135,16 @@ fn render(args: RenderArgs) -> Result<()> {
     if args.frames < 30 {
         return Err(BadInput(format!("--frames {}: at least 30 frames are measured", args.frames)).into());
     }
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    let start = Instant::now();
     let model = crate::cmd::render::load(&args.file)?;
+    let load = ms(start);
+    let t = Instant::now();
     let mut renderer = Renderer::new()?;
+    let device = ms(t);
+    let t = Instant::now();
     renderer.set_model(&model)?;
+    let upload = ms(t);
 
     let base = RenderOptions { size: args.size, supersample: 1, use_part_styles: false, ..RenderOptions::default() };
     base.validate().map_err(BadInput)?;
@@ -148,6 +168,18 @@ fn render(args: RenderArgs) -> Result<()> {
         },
     ));
 
+    let t = Instant::now();
+    if let Some((_, illustration)) = cases.last() {
+        renderer.time_frame(illustration)?;
+    }
+    let first_frame = ms(t);
+    let startup_ms = Startup {
+        load: round3(load),
+        device: round3(device),
+        upload: round3(upload),
+        first_frame: round3(first_frame),
+        total: round3(load + device + upload + first_frame),
+    };
     for _ in 0..args.warmup.max(1) {
         for (_, options) in &cases {
             renderer.time_frame(options)?;
@@ -190,6 +222,7 @@ fn render(args: RenderArgs) -> Result<()> {
         silhouette_candidates: model.lines.candidate_count(),
         silhouettes,
         silhouette_query_ms: round3(silhouette_query_ms),
+        startup_ms,
     };
     if args.json {
         out!("{}", serde_json::to_string_pretty(&report)?);
@@ -213,6 +246,15 @@ fn render(args: RenderArgs) -> Result<()> {
             report.silhouettes,
             report.silhouette_candidates,
             report.silhouette_query_ms
+        );
+        let s = &report.startup_ms;
+        out!(
+            "  load to first frame {:.0} ms: load {:.0}, device {:.0}, upload {:.0}, first illustration frame {:.0} (one run)",
+            s.total,
+            s.load,
+            s.device,
+            s.upload,
+            s.first_frame
         );
     }
     Ok(())
