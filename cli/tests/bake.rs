@@ -239,10 +239,10 @@ fn overrides_reach_the_file() {
     bake(&repo().join("samples/assembly.glb"), &output, &["--config", config.to_str().expect("utf-8")]);
     let baked = drafter_format::read(&std::fs::read(&output).expect("read"), &|_| None).expect("reads");
     let parts = baked.parts();
-    assert_eq!(parts[0].style.as_deref(), Some("metal"));
+    assert_eq!(parts[0].style, Some(drafter_format::PartStyle::Metal));
     assert_eq!(parts[0].projector.direction, [0.0, 0.0, 1.0]);
     assert_eq!(parts[0].projector.scale, 3.0);
-    assert_eq!(parts[0].obb.method, "optimal");
+    assert_eq!(parts[0].obb.method, drafter_format::ObbMethod::Optimal);
     assert_eq!((parts[1].gradient.q, parts[1].gradient.p), (7.0, f64::from(1.4f32)));
     assert_eq!(parts[1].style, None);
 }
@@ -352,7 +352,7 @@ fn textures_are_embedded_only_as_the_scene_needs() {
             doc["materials"][material as usize]["pbrMetallicRoughness"]["metallicFactor"].as_f64().unwrap_or(1.0);
         assert_eq!(metal.parts.contains(&p.id), metallic >= 0.5, "part {} ({})", p.id, p.name);
     }
-    assert_eq!(record.gradient.as_ref().expect("gradient").curves, ["identity"]);
+    assert_eq!(record.gradient.as_ref().expect("gradient").curves, [drafter_format::TransferCurve::Identity]);
     assert_eq!(record.hatching.as_ref().expect("hatching").levels.len(), 4);
     // Record, report and files agree byte for byte.
     let listed = report["textures"]["images"].as_array().expect("report lists textures");

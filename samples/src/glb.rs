@@ -5,7 +5,8 @@
 //! Layout of the BIN chunk: per mesh, positions, normals, then indices, each in its own buffer view (targets
 //! ARRAY_BUFFER / ELEMENT_ARRAY_BUFFER) starting on a 4-byte boundary; accessors start at offset 0 of their view.
 //! Indices are u16 when every index fits below 65535 (the restart value a primitive must not use), else u32.
-//! The JSON chunk is padded with spaces, the BIN chunk with zeros, both to 4 bytes.
+//! The container is framed by `drafter_core::glb::write` (the workspace's one GLB writer): the JSON chunk padded
+//! with spaces, the BIN chunk with zeros, both to 4 bytes.
 //!
 //! Determinism: JSON objects are built with keys inserted in sorted order (see [`object`]), so the bytes are the
 //! same whether or not some other crate of the build turns on serde_json's `preserve_order`; floats are written
@@ -28,12 +29,6 @@ const UNSIGNED_INT: u32 = 5125;
 const ARRAY_BUFFER: u32 = 34962;
 /// glTF buffer view target for indices.
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-/// GLB magic "glTF".
-const GLB_MAGIC: u32 = 0x4654_6C67;
-/// GLB chunk type "JSON".
-const CHUNK_JSON: u32 = 0x4E4F_534A;
-/// GLB chunk type "BIN\0".
-const CHUNK_BIN: u32 = 0x004E_4942;
 /// Written to `asset.generator`.
 pub const GENERATOR: &str = "drafter-samples";
 
@@ -184,25 +179,9 @@ impl Document {
         }
         // glTF arrays must not be empty: leave out what the document does not have.
         top.retain(|(_, value)| value.as_array().is_none_or(|a| !a.is_empty()));
-        let mut json = object(top).to_string().into_bytes();
-        pad(&mut json, b' ');
-        let mut data = bin.data;
-        pad(&mut data, 0);
-
-        let chunks_len = 8 + json.len() + if data.is_empty() { 0 } else { 8 + data.len() };
-        let mut glb = Vec::with_capacity(12 + chunks_len);
-        glb.extend_from_slice(&GLB_MAGIC.to_le_bytes());
-        glb.extend_from_slice(&2u32.to_le_bytes());
-        glb.extend_from_slice(&((12 + chunks_len) as u32).to_le_bytes());
-        glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
-        glb.extend_from_slice(&CHUNK_JSON.to_le_bytes());
-        glb.extend_from_slice(&json);
-        if !data.is_empty() {
-            glb.extend_from_slice(&(data.len() as u32).to_le_bytes());
-            glb.extend_from_slice(&CHUNK_BIN.to_le_bytes());
-            glb.extend_from_slice(&data);
-        }
-        glb
+        let json = object(top).to_string().into_bytes();
+        // The samples are a few kilobytes, far below the container's 4 GiB limit.
+        drafter_core::glb::write(&json, &bin.data).expect("a sample fits in a GLB")
     }
 }
 

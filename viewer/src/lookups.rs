@@ -305,9 +305,7 @@ impl Decoder<'_> {
 
     fn gamma(&mut self, g: &GradientTexture) -> Option<GammaLookup> {
         let image = self.image(g.index, LookupFormat::R8)?;
-        let Some(curves) = g.curves.iter().map(|c| parse_curve(c)).collect::<Option<Vec<_>>>() else {
-            return self.reject(&image.name, "names an unknown transfer curve");
-        };
+        let curves = g.curves.clone();
         if curves.len() != image.height as usize {
             return self.reject(&image.name, format!("{} rows for {} curves", image.height, curves.len()));
         }
@@ -367,10 +365,6 @@ impl Decoder<'_> {
             None => self.reject("metal", format!("highlight mapping {:?} not understood", m.highlight_mapping)),
         }
     }
-}
-
-fn parse_curve(name: &str) -> Option<TransferCurve> {
-    serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()
 }
 
 /// The levels as one mip chain: level `m` must be `max(1, w >> m) × max(1, h >> m)`; the chain
@@ -510,10 +504,9 @@ mod tests {
         let row = png(128, 1, png::ColorType::Grayscale, &[7; 128]);
         let level = |w: u32| png(w, w, png::ColorType::Grayscale, &vec![0; (w * w) as usize]);
         let pngs = [embedded(0, row.clone()), embedded(1, level(8)), embedded(2, level(4)), embedded(3, level(3))];
-        let gradient =
-            |curves: &[&str]| GradientTexture { index: 0, curves: curves.iter().map(|c| (*c).into()).collect() };
+        let gradient = |curves: &[TransferCurve]| GradientTexture { index: 0, curves: curves.to_vec() };
         let record = TexturesRecord {
-            gradient: Some(gradient(&["smoothstep"])),
+            gradient: Some(gradient(&[TransferCurve::Smoothstep])),
             hatching: Some(HatchingTexture {
                 levels: [1, 2, 3, 9].into_iter().map(|index| TextureRef { index }).collect(),
                 contrast: 4.0,
@@ -535,11 +528,14 @@ mod tests {
                 "hatching: 2 of 4 mip levels usable: the coarser ones are left out"
             ]
         );
-        // Two curves for one row; an unknown curve; a texture the file lacks.
+        // Two curves for one row; a texture the file lacks.
         for (curves, index, notice) in [
-            (&["identity", "invert"][..], 0, "t0: 1 rows for 2 curves: procedural lookup used"),
-            (&["sigmoid"][..], 0, "t0: names an unknown transfer curve: procedural lookup used"),
-            (&["identity"][..], 5, "texture 5: not in the file: procedural lookup used"),
+            (
+                &[TransferCurve::Identity, TransferCurve::Invert][..],
+                0,
+                "t0: 1 rows for 2 curves: procedural lookup used",
+            ),
+            (&[TransferCurve::Identity][..], 5, "texture 5: not in the file: procedural lookup used"),
         ] {
             let record =
                 TexturesRecord { gradient: Some(GradientTexture { index, ..gradient(curves) }), ..Default::default() };

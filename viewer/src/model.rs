@@ -145,8 +145,7 @@ impl Model {
             .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
         model.diagnostics = imported.diagnostics;
         if let Some(record) = baked.as_ref().and_then(|b| b.root.textures.as_ref()) {
-            let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-            let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+            let external = drafter_format::external_buffers(path);
             let (lookups, notices) = BakedLookups::read(Some(record), bytes, &external);
             model.notices.extend(notices);
             model.set_lookups(lookups);
@@ -200,8 +199,6 @@ impl Model {
         let mut bad_ids = 0usize;
         let mut missing_node_parts = 0usize;
         let mut short_part_lists = 0usize;
-        let mut unknown_transfers = 0usize;
-        let mut unknown_styles = 0usize;
 
         for (mesh_index, mesh) in scene.meshes.iter().enumerate() {
             let labels = &triangle_labels[mesh_index];
@@ -225,10 +222,7 @@ impl Model {
                             label_to_part.push(record.id);
                             let slot = &mut parts[record.id as usize];
                             if slot.is_none() {
-                                let (part, transfer_known, style_known) = baked_part(record, origin);
-                                unknown_transfers += usize::from(!transfer_known);
-                                unknown_styles += usize::from(!style_known);
-                                *slot = Some(part);
+                                *slot = Some(baked_part(record, origin));
                             }
                         }
                     }
@@ -294,12 +288,6 @@ impl Model {
             notices.push(format!(
                 "{short_part_lists} instances have fewer parts than their mesh has labels: extra labels use part 0 of the node"
             ));
-        }
-        if unknown_transfers > 0 {
-            notices.push(format!("{unknown_transfers} parts name an unknown transfer curve: identity used"));
-        }
-        if unknown_styles > 0 {
-            notices.push(format!("{unknown_styles} parts name an unknown style: the scene style used"));
         }
 
         // Ids the file declares but no node uses get a neutral placeholder so indexing stays dense.
@@ -414,9 +402,8 @@ fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedFile>, LoadError>
     if !json.windows(marker.len()).any(|w| w == marker) {
         return Ok(None);
     }
-    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    // drafter-io has already imported this file, which confines and checks its buffer URIs.
-    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+    // drafter-format resolves the buffer URI, confined to the file's folder as the importer does.
+    let external = drafter_format::external_buffers(path);
     match drafter_format::read(bytes, &external) {
         Ok(baked) => Ok(Some(baked)),
         Err(FormatError::NotBaked(_)) => Ok(None),
@@ -426,9 +413,7 @@ fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedFile>, LoadError>
 
 /// Reads both normal sets of a baked glTF/GLB (see [`read_baked`] for the buffer resolution).
 fn read_normal_sets(path: &Path, bytes: &[u8]) -> Result<Vec<PrimitiveNormals>, LoadError> {
-    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
-    drafter_format::read_normal_sets(bytes, &external)
+    drafter_format::read_normal_sets(bytes, &drafter_format::external_buffers(path))
         .map_err(|source| LoadError::Baked { path: path.display().to_string(), source })
 }
 
@@ -587,37 +572,23 @@ fn render_row(world_row: DVec4, origin: DVec3) -> [f32; 4] {
     [world_row.x as f32, world_row.y as f32, world_row.z as f32, w as f32]
 }
 
-/// The viewer's record of a baked part; also whether its transfer and style names were known.
-fn baked_part(record: &PartRecord, origin: DVec3) -> (Part, bool, bool) {
+/// The viewer's record of a baked part (its transfer curve and style arrive typed: drafter-format
+/// refuses names outside the schema's enumerations when it reads the file).
+fn baked_part(record: &PartRecord, origin: DVec3) -> Part {
     let m = &record.projector.matrix;
     // Column-major: row 0 is elements 0, 4, 8, 12.
     let row = DVec4::new(m[0], m[4], m[8], m[12]);
-    let transfer = transfer_index(&record.gradient.transfer);
-    let style = record.style.as_deref().map(str::parse::<Style>);
+    let transfer = transfer_index(record.gradient.transfer);
+    let style = record.style.map(Style::from);
     let axes = record.obb.axes.map(|a| [a[0] as f32, a[1] as f32, a[2] as f32, 0.0]);
     let gpu = PartGpu {
         projector_row: render_row(row, origin),
         axes,
-        gradient: [
-            record.gradient.q as f32,
-            record.gradient.f as f32,
-            record.gradient.p as f32,
-            transfer.unwrap_or(0) as f32,
-        ],
-        style_hint: match &style {
-            Some(Ok(s)) => s.index(),
-            _ => NO_STYLE,
-        },
+        gradient: [record.gradient.q as f32, record.gradient.f as f32, record.gradient.p as f32, transfer as f32],
+        style_hint: style.map_or(NO_STYLE, Style::index),
         _pad: [0; 3],
     };
-    let part = Part {
-        id: record.id,
-        name: record.name.clone(),
-        style: style.as_ref().and_then(|s| s.as_ref().ok().copied()),
-        record: Some(record.clone()),
-        gpu,
-    };
-    (part, transfer.is_some(), !matches!(style, Some(Err(_))))
+    Part { id: record.id, name: record.name.clone(), style, record: Some(record.clone()), gpu }
 }
 
 /// A part for an instance without baked data: the projector runs along the longest side of its

@@ -7,6 +7,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use drafter_core::gradient::{IntensityTransfer, TransferCurve};
+use drafter_format::PartStyle;
 
 /// A shading style of the G-buffer pass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -72,6 +73,21 @@ impl fmt::Display for Style {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown style {0:?}: expected one of gradient, cel, gooch, goochel, phong, metal, hatch")]
 pub struct UnknownStyle(pub String);
+
+/// A part's style hint as the file carries it (the same seven styles).
+impl From<PartStyle> for Style {
+    fn from(style: PartStyle) -> Self {
+        match style {
+            PartStyle::Gradient => Style::Gradient,
+            PartStyle::Cel => Style::Cel,
+            PartStyle::Gooch => Style::Gooch,
+            PartStyle::Goochel => Style::Goochel,
+            PartStyle::Phong => Style::Phong,
+            PartStyle::Metal => Style::Metal,
+            PartStyle::Hatch => Style::Hatch,
+        }
+    }
+}
 
 impl FromStr for Style {
     type Err = UnknownStyle;
@@ -320,10 +336,9 @@ pub fn transfer_tables() -> Vec<f32> {
     TransferCurve::ALL.iter().flat_map(|&c| IntensityTransfer::from_curve(c).texels().to_vec()).collect()
 }
 
-/// The row of the named curve (the spec's `gradient.transfer` names) in [`transfer_tables`].
-pub fn transfer_index(name: &str) -> Option<usize> {
-    let curve: TransferCurve = serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()?;
-    TransferCurve::ALL.iter().position(|&c| c == curve)
+/// The row of `curve` in [`transfer_tables`].
+pub fn transfer_index(curve: TransferCurve) -> usize {
+    TransferCurve::ALL.iter().position(|&c| c == curve).unwrap_or(0)
 }
 
 /// Entries of the metal band table.
@@ -373,13 +388,12 @@ mod tests {
         let t = transfer_tables();
         assert_eq!(t.len(), TransferCurve::ALL.len() * INTENSITY_TABLE_LEN);
         assert!(t.iter().all(|v| (0.0..=1.0).contains(v)));
-        // The spec's names, in table order.
-        for (k, name) in ["identity", "smoothstep", "ease_in", "ease_out", "invert"].iter().enumerate() {
-            assert_eq!(transfer_index(name), Some(k));
+        // Rows in the order of the curves.
+        for (k, &curve) in TransferCurve::ALL.iter().enumerate() {
+            assert_eq!(transfer_index(curve), k);
             let row = &t[k * INTENSITY_TABLE_LEN..(k + 1) * INTENSITY_TABLE_LEN];
             assert!((f64::from(row[64]) - TransferCurve::ALL[k].eval(64.0 / 127.0)).abs() < 1e-6);
         }
-        assert_eq!(transfer_index("sigmoid"), None);
         let m = metal_table();
         assert_eq!(m.len(), METAL_TABLE_LEN);
         assert!(m.iter().all(|v| (0.0..=1.0).contains(v)));

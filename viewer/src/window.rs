@@ -200,7 +200,7 @@ pub fn describe_part(model: &Model, id: u32) -> String {
                 r.gradient.f,
                 r.gradient.p,
                 r.gradient.transfer,
-                r.style.as_deref().unwrap_or("(scene)")
+                r.style.map_or("(scene)", drafter_format::PartStyle::name)
             )
         }
         None => format!("part {id} {name:?}: not baked (bounding-box projector)"),

@@ -50,7 +50,7 @@ fn quad() -> Scene {
     scene
 }
 
-fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: &str) -> BakedFile {
+fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: TransferCurve) -> BakedFile {
     let part = PartRecord {
         id: 0,
         name: "quad".into(),
@@ -60,7 +60,7 @@ fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: &str) -> Baked
             axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             half_extents: [1.0, 0.5, 0.0],
             volume: 0.0,
-            method: "aabb".into(),
+            method: drafter_format::ObbMethod::Aabb,
         },
         projector: ProjectorRecord {
             anchor: projector.anchor.to_array(),
@@ -68,8 +68,8 @@ fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: &str) -> Baked
             scale: projector.scale,
             matrix: projector.matrix().to_cols_array(),
         },
-        gradient: GradientRecord { q: f64::from(q), f, p, transfer: transfer.into() },
-        style: Some("gradient".into()),
+        gradient: GradientRecord { q: f64::from(q), f, p, transfer },
+        style: Some(drafter_format::PartStyle::Gradient),
     };
     BakedFile {
         // From JSON, as a reader would see it: fields added to the extension later keep their defaults.
@@ -153,7 +153,7 @@ fn baked_parameters_match_omega() {
         (7, 1.0, 0.6, TransferCurve::Invert, "invert"),
         (255, 0.0, 1.0, TransferCurve::EaseIn, "ease_in"),
     ] {
-        let file = baked(&projector, q, f, p, name);
+        let file = baked(&projector, q, f, p, curve);
         let model = Model::from_scene(&quad(), Some(&file)).expect("model");
         // Only the line saying where the lookups come from (this file has no textures).
         assert_eq!(model.notices, ["textures: procedural (file has none)"]);

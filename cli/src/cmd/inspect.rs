@@ -81,9 +81,8 @@ fn read_baked(path: &std::path::Path, bytes: &[u8]) -> Result<Option<BakedSummar
     if !json.windows(drafter_format::EXTENSION.len()).any(|w| w == drafter_format::EXTENSION.as_bytes()) {
         return Ok(None);
     }
-    let folder = path.parent().map(std::path::Path::to_path_buf).unwrap_or_default();
-    // The importer has already confined and checked the buffer URIs.
-    let external = |uri: &str| std::fs::read(folder.join(uri)).ok();
+    // drafter-format resolves the buffer URI, confined to the file's folder as the importer does.
+    let external = drafter_format::external_buffers(path);
     match drafter_format::read(bytes, &external) {
         Ok(baked) => Ok(Some(BakedSummary {
             parts: baked.parts().into_iter().cloned().collect(),
@@ -338,7 +337,7 @@ fn print_text(r: &Report) -> anyhow::Result<()> {
                 format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2]),
                 p.projector.scale,
                 format!("{}/{}/{}", p.gradient.q, p.gradient.f, p.gradient.p),
-                p.style.as_deref().unwrap_or("-")
+                p.style.map_or("-", drafter_format::PartStyle::name)
             );
         }
         if b.parts.len() > TABLE_ROWS {

@@ -55,7 +55,7 @@
 //! Unknown keys and out-of-range values are errors that name the key.
 
 use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
-use drafter_format::{Container, InputInfo};
+use drafter_format::{Container, InputInfo, PartStyle};
 use drafter_normals::NormalsOptions;
 use drafter_segment::{SegmentMode, SegmentOptions};
 use drafter_textures::{CelOptions, CoolToWarmOptions, HatchingOptions, MetalOptions};
@@ -232,7 +232,8 @@ pub struct PartOverride {
     pub f: Option<f32>,
     pub p: Option<f32>,
     pub transfer: Option<TransferCurve>,
-    pub style: Option<String>,
+    /// Checked against the format's styles when the TOML is read (an unknown name is a config error).
+    pub style: Option<PartStyle>,
 }
 
 fn default_selector() -> PartSelector {
@@ -452,11 +453,6 @@ impl PartOverride {
             && !(s.is_finite() && s > 0.0)
         {
             return Err(format!("scale = {s} must be finite and > 0"));
-        }
-        if let Some(style) = &self.style
-            && !STYLES.contains(&style.as_str())
-        {
-            return Err(format!("style = {style:?} is not one of {}", STYLES.join(", ")));
         }
         Ok(())
     }

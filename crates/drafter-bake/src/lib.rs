@@ -26,8 +26,8 @@ use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
 use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
 use drafter_format::{
     BakeOutput, BoxRecord, ConeBvhData, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord, HardEdgeClass,
-    InputInfo, MeshSilhouettes, NormalsInfo, PartRecord, PrimitiveEdges, ProjectorRecord, RootExtension, TextureImage,
-    VertexData, Written,
+    InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges, ProjectorRecord,
+    RootExtension, TextureImage, VertexData, Written,
 };
 use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
@@ -118,7 +118,7 @@ pub struct PartReport {
     pub projector: ProjectorReport,
     pub gradient: GradientRecord,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub style: Option<String>,
+    pub style: Option<PartStyle>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -127,7 +127,7 @@ pub struct ObbReport {
     pub axes: [[f64; 3]; 3],
     pub half_extents: [f64; 3],
     pub volume: f64,
-    pub method: String,
+    pub method: ObbMethod,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -633,7 +633,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                 }
                 gradient = o.gradient(&gradient);
                 transfer = o.transfer.unwrap_or(transfer);
-                style = o.style.clone().or(style);
+                style = o.style.or(style);
             }
             Ok(PartRecord {
                 id: p as u32,
@@ -650,10 +650,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                     q: f64::from(gradient.q),
                     f: f64::from(gradient.f),
                     p: f64::from(gradient.p),
-                    transfer: serde_json::to_value(transfer)
-                        .ok()
-                        .and_then(|v| v.as_str().map(str::to_owned))
-                        .unwrap_or_else(|| "identity".into()),
+                    transfer,
                 },
                 style,
             })
@@ -684,7 +681,7 @@ fn box_record(obb: &Obb) -> BoxRecord {
         axes: obb.axes.map(|a| a.to_array()),
         half_extents: obb.half_extents.to_array(),
         volume: obb.volume,
-        method: obb.method.name().to_owned(),
+        method: obb.method,
     }
 }
 
@@ -698,7 +695,7 @@ fn part_report(r: &PartRecord) -> PartReport {
             axes: r.obb.axes,
             half_extents: r.obb.half_extents,
             volume: r.obb.volume,
-            method: r.obb.method.clone(),
+            method: r.obb.method,
         },
         projector: ProjectorReport {
             anchor: r.projector.anchor,
@@ -706,6 +703,6 @@ fn part_report(r: &PartRecord) -> PartReport {
             scale: r.projector.scale,
         },
         gradient: r.gradient.clone(),
-        style: r.style.clone(),
+        style: r.style,
     }
 }

@@ -26,7 +26,7 @@
 use drafter_core::{PartId, Scene};
 use drafter_format::{
     CelTableRecord, CelTexture, CoolToWarmTexture, EmbeddedTextures, GradientTexture, HatchingTexture, MetalTexture,
-    PartRecord, SamplerDesc, TextureImage, TextureRef, TexturesRecord,
+    PartRecord, PartStyle, SamplerDesc, TextureImage, TextureRef, TexturesRecord,
 };
 use drafter_segment::Parts;
 use drafter_textures::{Texture, TextureKind, TextureRequest, Wrap, bake_textures, encode_png_levels};
@@ -67,8 +67,8 @@ pub struct TextureReport {
 pub(crate) fn metal_parts(scene: &Scene, parts: &Parts, records: &[PartRecord], threshold: f32) -> Vec<u32> {
     records
         .iter()
-        .filter(|r| match r.style.as_deref() {
-            Some(style) => style == "metal",
+        .filter(|r| match r.style {
+            Some(style) => style == PartStyle::Metal,
             None => majority_metallic(scene, parts, PartId(r.id)) >= threshold,
         })
         .map(|r| r.id)
@@ -103,28 +103,25 @@ pub(crate) fn request(records: &[PartRecord], metal: &[u32], stage: &TexturesSta
     if !stage.enabled {
         return TextureRequest::default();
     }
-    let uses = |style: &str| {
-        stage.styles.iter().any(|s| s == style) || records.iter().any(|r| r.style.as_deref() == Some(style))
+    let uses = |style: PartStyle| {
+        stage.styles.iter().any(|s| s == style.name()) || records.iter().any(|r| r.style == Some(style))
     };
-    let gamma_curves = if uses("gradient") {
-        records.iter().map(|r| transfer_curve(&r.gradient.transfer)).collect()
-    } else {
-        Vec::new()
-    };
+    let gamma_curves =
+        if uses(PartStyle::Gradient) { records.iter().map(|r| r.gradient.transfer).collect() } else { Vec::new() };
     TextureRequest {
-        metal: (uses("metal") || !metal.is_empty()).then(|| stage.metal.clone()),
-        cool_to_warm: if uses("gooch") || uses("goochel") { vec![stage.cool_to_warm.clone()] } else { Vec::new() },
-        hatching: uses("hatch").then(|| stage.hatching.clone()),
+        metal: (uses(PartStyle::Metal) || !metal.is_empty()).then(|| stage.metal.clone()),
+        cool_to_warm: if uses(PartStyle::Gooch) || uses(PartStyle::Goochel) {
+            vec![stage.cool_to_warm.clone()]
+        } else {
+            Vec::new()
+        },
+        hatching: uses(PartStyle::Hatch).then(|| stage.hatching.clone()),
         gamma_curves,
-        cel_tables: if uses("cel") || uses("goochel") { vec![stage.cel] } else { Vec::new() },
+        cel_tables: if uses(PartStyle::Cel) || uses(PartStyle::Goochel) { vec![stage.cel] } else { Vec::new() },
     }
 }
 
 /// The curve a part record names (records are written from `TransferCurve`, so the name is known).
-fn transfer_curve(name: &str) -> drafter_core::gradient::TransferCurve {
-    serde_json::from_value(serde_json::Value::String(name.to_owned())).unwrap_or_default()
-}
-
 /// Bakes `request` and encodes every texture level as PNG, with the extension's record.
 pub(crate) fn bake(
     request: &TextureRequest,
@@ -183,8 +180,7 @@ pub(crate) fn bake(
                 });
             }
             TextureKind::GammaAtlas { curves } => {
-                record.gradient =
-                    Some(GradientTexture { index: first, curves: curves.iter().map(snake_name).collect() });
+                record.gradient = Some(GradientTexture { index: first, curves: curves.clone() });
             }
             TextureKind::CelAtlas { tables } => {
                 record.cel = Some(CelTexture {
@@ -245,7 +241,7 @@ mod tests {
     use drafter_format::{BoxRecord, GradientRecord, ProjectorRecord};
     use drafter_textures::HatchingOptions;
 
-    fn record(id: u32, transfer: &str, style: Option<&str>) -> PartRecord {
+    fn record(id: u32, transfer: TransferCurve, style: Option<PartStyle>) -> PartRecord {
         PartRecord {
             id,
             name: format!("p{id}"),
@@ -255,11 +251,11 @@ mod tests {
                 axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
                 half_extents: [1.0; 3],
                 volume: 8.0,
-                method: "aabb".into(),
+                method: drafter_core::ObbMethod::Aabb,
             },
             projector: ProjectorRecord { anchor: [0.0; 3], direction: [1.0, 0.0, 0.0], scale: 1.0, matrix: [0.0; 16] },
-            gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: transfer.into() },
-            style: style.map(str::to_owned),
+            gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer },
+            style,
         }
     }
 
@@ -269,8 +265,11 @@ mod tests {
 
     #[test]
     fn the_request_follows_styles_hints_and_metal_parts() {
-        let records =
-            [record(0, "smoothstep", None), record(1, "identity", Some("hatch")), record(2, "smoothstep", None)];
+        let records = [
+            record(0, TransferCurve::Smoothstep, None),
+            record(1, TransferCurve::Identity, Some(PartStyle::Hatch)),
+            record(2, TransferCurve::Smoothstep, None),
+        ];
         // Scene styles only phong; one part hinted hatch: the halftone only.
         let r = request(&records, &[], &stage(&["phong"]));
         assert_eq!(r.hatching, Some(HatchingOptions::default()));
@@ -290,7 +289,7 @@ mod tests {
 
     #[test]
     fn baked_record_points_at_each_image_once_in_order() {
-        let records = [record(0, "ease_in", Some("metal"))];
+        let records = [record(0, TransferCurve::EaseIn, Some(PartStyle::Metal))];
         let r = request(&records, &[0], &TexturesStage::default());
         let baked = bake(&r, vec![0], 0.5).expect("bakes");
         let record = &baked.embedded.record;
@@ -299,7 +298,7 @@ mod tests {
         assert_eq!(indices, (0..baked.embedded.images.len() as u32).collect::<Vec<_>>());
         let name = |i: u32| baked.embedded.images[i as usize].name.as_str();
         assert_eq!(name(record.gradient.as_ref().expect("gradient").index), "gamma_atlas");
-        assert_eq!(record.gradient.as_ref().expect("gradient").curves, ["ease_in"]);
+        assert_eq!(record.gradient.as_ref().expect("gradient").curves, [TransferCurve::EaseIn]);
         let hatching = record.hatching.as_ref().expect("hatching");
         let levels: Vec<&str> = hatching.levels.iter().map(|l| name(l.index)).collect();
         assert_eq!(levels, ["hatching", "hatching_mip1", "hatching_mip2", "hatching_mip3"]);

@@ -78,6 +78,7 @@
 //!   reduce by `(volume, index)`, so results do not depend on the thread count.
 
 use drafter_core::Aabb;
+pub use drafter_core::ObbMethod;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -94,57 +95,6 @@ pub const DEFAULT_FACE_NORMALS: usize = 48;
 pub const DEFAULT_EXHAUSTIVE_HULL_FACES: usize = 64;
 /// Default of [`ObbOptions::optimal_budget`].
 pub const DEFAULT_OPTIMAL_BUDGET: u64 = 100_000_000;
-
-/// How to orient a box.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum ObbMethod {
-    /// World axis-aligned box.
-    Aabb,
-    /// Covariance of all points.
-    Pca,
-    /// Area-weighted covariance of the convex-hull surface (Gottschalk 2000).
-    Hull,
-    /// Largest hull faces with exact rectangles, plus short refinement: fast and tight.
-    #[default]
-    Default,
-    /// Minimum volume: all hull faces, antipodal edge pairs and edge triples, plus refinement.
-    Optimal,
-}
-
-impl ObbMethod {
-    /// Every method, cheapest first.
-    pub const ALL: [ObbMethod; 5] =
-        [ObbMethod::Aabb, ObbMethod::Pca, ObbMethod::Hull, ObbMethod::Default, ObbMethod::Optimal];
-
-    /// The name used in configuration files, reports and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ObbMethod::Aabb => "aabb",
-            ObbMethod::Pca => "pca",
-            ObbMethod::Hull => "hull",
-            ObbMethod::Default => "default",
-            ObbMethod::Optimal => "optimal",
-        }
-    }
-}
-
-impl std::str::FromStr for ObbMethod {
-    type Err = crate::ParamError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        ObbMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| crate::ParamError {
-            name: "obb method",
-            value: s.to_owned(),
-            expected: "one of aabb, pca, hull, default, optimal",
-        })
-    }
-}
-
-impl std::fmt::Display for ObbMethod {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// Options of [`oriented_box`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -146,6 +146,17 @@ impl TransferCurve {
         TransferCurve::Invert,
     ];
 
+    /// The name written in baked files and configuration (its serde spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            TransferCurve::Identity => "identity",
+            TransferCurve::Smoothstep => "smoothstep",
+            TransferCurve::EaseIn => "ease_in",
+            TransferCurve::EaseOut => "ease_out",
+            TransferCurve::Invert => "invert",
+        }
+    }
+
     /// γ(x) for `x ∈ [0, 1]`.
     pub fn eval(self, x: f64) -> f64 {
         let x = x.clamp(0.0, 1.0);
@@ -156,6 +167,12 @@ impl TransferCurve {
             TransferCurve::EaseOut => 1.0 - (1.0 - x) * (1.0 - x),
             TransferCurve::Invert => 1.0 - x,
         }
+    }
+}
+
+impl std::fmt::Display for TransferCurve {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 

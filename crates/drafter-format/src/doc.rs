@@ -471,30 +471,8 @@ impl Doc {
     /// A .glb: header, JSON chunk (space padded), BIN chunk (zero padded).
     pub fn into_glb(mut self) -> Result<Vec<u8>, FormatError> {
         self.set_buffer(None);
-        let mut json = serde_json::to_vec(&Value::Object(std::mem::take(&mut self.json)))?;
-        while json.len() % 4 != 0 {
-            json.push(b' ');
-        }
-        let mut bin = std::mem::take(&mut self.bin);
-        while !bin.len().is_multiple_of(4) {
-            bin.push(0);
-        }
-        let bin_chunk = if bin.is_empty() { 0 } else { 8 + bin.len() };
-        let total = 12 + 8 + json.len() + bin_chunk;
-        let total = u32::try_from(total).map_err(|_| FormatError::TooLarge(total))?;
-        let mut out = Vec::with_capacity(total as usize);
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&total.to_le_bytes());
-        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&json);
-        if !bin.is_empty() {
-            out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-            out.extend_from_slice(b"BIN\0");
-            out.extend_from_slice(&bin);
-        }
-        Ok(out)
+        let json = serde_json::to_vec(&Value::Object(std::mem::take(&mut self.json)))?;
+        drafter_core::glb::write(&json, &self.bin).map_err(FormatError::from)
     }
 
     /// A .gltf (pretty JSON) and its .bin, the buffer referring to `bin_uri`.

@@ -1,6 +1,11 @@
 //! The `DRAFTER_illustration` extension's objects as serde types. The spec is `spec/README.md`
 //! beside this crate, the schema `spec/schema/`; keep the three in sync.
+//!
+//! The schema's enumerations are enums here ([`PartStyle`], [`ObbMethod`], [`TransferCurve`]), so a
+//! value outside them is refused when the file is read and no user parses a name again later.
 
+pub use drafter_core::ObbMethod;
+pub use drafter_core::gradient::TransferCurve;
 use serde::{Deserialize, Serialize};
 
 /// The extension's name, as listed in `extensionsUsed` (never in `extensionsRequired`).
@@ -101,8 +106,8 @@ impl TexturesRecord {
 pub struct GradientTexture {
     /// The glTF texture.
     pub index: u32,
-    /// The transfer curve of each row (the names of the parts' `gradient.transfer`).
-    pub curves: Vec<String>,
+    /// The transfer curve of each row (the parts' `gradient.transfer`).
+    pub curves: Vec<TransferCurve>,
 }
 
 /// The cel atlas: sample at `u = (0.5 + 127·x)/128`, `v = (row + 0.5)/rows`, `x = max(n·l, 0)`
@@ -226,9 +231,54 @@ pub struct PartRecord {
     pub obb: BoxRecord,
     pub projector: ProjectorRecord,
     pub gradient: GradientRecord,
-    /// Shading style hint (`metal`, `gooch`, ...); absent means "the scene's style".
+    /// Shading style hint; absent means "the scene's style".
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub style: Option<String>,
+    pub style: Option<PartStyle>,
+}
+
+/// A part's shading style hint: the viewer's styles, spelled as in the schema's `style` enum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PartStyle {
+    Gradient,
+    Cel,
+    Gooch,
+    Goochel,
+    Phong,
+    Metal,
+    Hatch,
+}
+
+impl PartStyle {
+    /// Every style, in the schema's order.
+    pub const ALL: [PartStyle; 7] = [
+        PartStyle::Gradient,
+        PartStyle::Cel,
+        PartStyle::Gooch,
+        PartStyle::Goochel,
+        PartStyle::Phong,
+        PartStyle::Metal,
+        PartStyle::Hatch,
+    ];
+
+    /// The name written in the file and accepted in configuration files.
+    pub fn name(self) -> &'static str {
+        match self {
+            PartStyle::Gradient => "gradient",
+            PartStyle::Cel => "cel",
+            PartStyle::Gooch => "gooch",
+            PartStyle::Goochel => "goochel",
+            PartStyle::Phong => "phong",
+            PartStyle::Metal => "metal",
+            PartStyle::Hatch => "hatch",
+        }
+    }
+}
+
+impl std::fmt::Display for PartStyle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// An oriented box: `center + Σ axes[i] · t_i · halfExtents[i]` for t in [-1, 1]³.
@@ -240,8 +290,8 @@ pub struct BoxRecord {
     pub axes: [[f64; 3]; 3],
     pub half_extents: [f64; 3],
     pub volume: f64,
-    /// The method that produced it (`aabb`, `pca`, `hull`, `default`, `optimal`).
-    pub method: String,
+    /// The method that produced it.
+    pub method: ObbMethod,
 }
 
 /// A part's projector (Lux et al. 2013, §3): the gradient runs along `direction` from `anchor`.
@@ -268,8 +318,8 @@ pub struct GradientRecord {
     pub f: f64,
     /// Power p.
     pub p: f64,
-    /// Name of the intensity transfer curve γ (`identity` by default).
-    pub transfer: String,
+    /// The intensity transfer curve γ (`identity` by default).
+    pub transfer: TransferCurve,
 }
 
 /// Primitive-level object: per-mesh data, bulk arrays as accessors.
@@ -363,4 +413,43 @@ pub struct ConeBvhRecord {
     pub nodes: u32,
     /// UNSIGNED_INT: candidate index of each stored candidate.
     pub order: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names the code prints are the JSON spellings, and both are the schema's enumerations.
+    #[test]
+    fn enum_names_are_their_json_spelling_and_the_schemas() {
+        let node_schema = include_str!("../spec/schema/DRAFTER_illustration.node.schema.json");
+        let schema: serde_json::Value = serde_json::from_str(node_schema).expect("schema");
+        let part = &schema["definitions"]["part"]["properties"];
+        let listed = |v: &serde_json::Value| -> Vec<String> {
+            v["enum"].as_array().expect("enum").iter().map(|s| s.as_str().expect("name").to_owned()).collect()
+        };
+        let spelled = |v: serde_json::Value| v.as_str().expect("a string").to_owned();
+        let styles: Vec<String> = PartStyle::ALL.iter().map(|s| spelled(serde_json::json!(s))).collect();
+        assert_eq!(styles, PartStyle::ALL.map(|s| s.name().to_owned()));
+        assert_eq!(styles, listed(&part["style"]));
+        let methods: Vec<String> = ObbMethod::ALL.iter().map(|m| spelled(serde_json::json!(m))).collect();
+        assert_eq!(methods, ObbMethod::ALL.map(|m| m.name().to_owned()));
+        assert_eq!(methods, listed(&part["obb"]["properties"]["method"]));
+        let curves: Vec<String> = TransferCurve::ALL.iter().map(|c| spelled(serde_json::json!(c))).collect();
+        assert_eq!(curves, TransferCurve::ALL.map(|c| c.name().to_owned()));
+        assert_eq!(curves, listed(&part["gradient"]["properties"]["transfer"]));
+    }
+
+    /// A name outside an enumeration is refused when the file is read, naming the value.
+    #[test]
+    fn unknown_names_are_refused_on_read() {
+        for (field, value) in [("style", "neon"), ("transfer", "sigmoid")] {
+            let error = match field {
+                "style" => serde_json::from_value::<PartStyle>(value.into()).expect_err(value).to_string(),
+                _ => serde_json::from_value::<TransferCurve>(value.into()).expect_err(value).to_string(),
+            };
+            assert!(error.contains(value), "{field}: {error}");
+        }
+        assert!(serde_json::from_value::<ObbMethod>("best".into()).is_err());
+    }
 }

@@ -4,7 +4,9 @@
 //!
 //! * [`write`] serialises a bake (a [`BakeOutput`]) as .glb or .gltf + .bin;
 //! * [`read`] loads a baked file back into the same types, [`read_textures`] its embedded textures,
-//!   [`read_normal_sets`] both sets of vertex normals (crease-aware and enhanced) for the viewer's toggle.
+//!   [`read_normal_sets`] both sets of vertex normals (crease-aware and enhanced) for the viewer's toggle;
+//! * [`external_buffers`] is the loader of a baked .gltf's buffer those readers take, confined to the
+//!   file's folder; [`split_container`] frames a .glb through `drafter_core::glb`.
 //!
 //! Invariant: this is the only crate that knows the file format. The extension is listed in
 //! `extensionsUsed` and never in `extensionsRequired`, so any glTF viewer opens the result as a plain
@@ -12,15 +14,18 @@
 
 mod doc;
 pub mod ext;
+mod external;
 mod reader;
 mod writer;
 
 pub use ext::{
     BoxRecord, CelTableRecord, CelTexture, ConeBvhRecord, CoolToWarmTexture, EDGE_VISIBILITY_EXTENSION,
     ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION, GaussMapRecord, GradientRecord, GradientTexture,
-    HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture, NodeExtension, NormalsInfo, PartRecord,
-    PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef, TexturesRecord,
+    HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture, NodeExtension, NormalsInfo, ObbMethod,
+    PartRecord, PartStyle, PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef,
+    TexturesRecord, TransferCurve,
 };
+pub use external::external_buffers;
 pub use reader::{
     BakedFile, ByteSections, EmbeddedPng, PrimitiveNormals, byte_sections, read, read_floats, read_normal_sets,
     read_scalars, read_textures, split_container,
@@ -51,4 +56,13 @@ pub enum FormatError {
     /// A `DRAFTER_illustration` layout this crate does not read.
     #[error("{EXTENSION} version {0} is not supported (this drafter reads {FORMAT_VERSION}); bake the model again")]
     Version(String),
+}
+
+impl From<drafter_core::glb::GlbError> for FormatError {
+    fn from(e: drafter_core::glb::GlbError) -> Self {
+        match e {
+            drafter_core::glb::GlbError::TooLarge(total) => Self::TooLarge(total),
+            malformed @ drafter_core::glb::GlbError::Malformed { .. } => Self::Invalid(malformed.to_string()),
+        }
+    }
 }

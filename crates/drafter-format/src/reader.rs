@@ -36,30 +36,14 @@ impl BakedFile {
     }
 }
 
-/// Splits a .glb into its JSON and BIN chunks, or returns a .gltf's JSON as is.
+/// Splits a .glb into its JSON and BIN chunks, or returns a .gltf's JSON as is. The container is
+/// framed by [`drafter_core::glb`], the workspace's one GLB reader.
 pub fn split_container(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), FormatError> {
-    if !bytes.starts_with(b"glTF") {
+    if !drafter_core::glb::is_glb(bytes) {
         return Ok((bytes, None));
     }
-    let u32_at = |at: usize| -> Result<usize, FormatError> {
-        let b = bytes.get(at..at + 4).ok_or_else(|| FormatError::Invalid(format!("GLB truncated at byte {at}")))?;
-        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
-    };
-    let json_length = u32_at(12)?;
-    let json =
-        bytes.get(20..20 + json_length).ok_or_else(|| FormatError::Invalid("GLB JSON chunk truncated".into()))?;
-    let bin_start = 20 + json_length;
-    let bin = if bytes.len() >= bin_start + 8 {
-        let length = u32_at(bin_start)?;
-        Some(
-            bytes
-                .get(bin_start + 8..bin_start + 8 + length)
-                .ok_or_else(|| FormatError::Invalid("GLB BIN chunk truncated".into()))?,
-        )
-    } else {
-        None
-    };
-    Ok((json, bin))
+    let chunks = drafter_core::glb::split(bytes)?;
+    Ok((chunks.json, chunks.bin))
 }
 
 /// The PNG bytes of one texture the extension refers to.

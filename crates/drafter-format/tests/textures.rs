@@ -49,7 +49,7 @@ fn part() -> PartRecord {
             axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             half_extents: [0.5, 0.5, 0.0],
             volume: 0.0,
-            method: "aabb".into(),
+            method: drafter_format::ObbMethod::Aabb,
         },
         projector: ProjectorRecord {
             anchor: [0.5, 0.5, 0.0],
@@ -57,7 +57,7 @@ fn part() -> PartRecord {
             scale: 1.0,
             matrix: [0.0; 16],
         },
-        gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: "identity".into() },
+        gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: drafter_format::TransferCurve::Identity },
         style: None,
     }
 }
@@ -74,7 +74,7 @@ fn textures() -> EmbeddedTextures {
     EmbeddedTextures {
         // Indices are positions in `images`, deliberately not in image order.
         record: TexturesRecord {
-            gradient: Some(GradientTexture { index: 2, curves: vec!["identity".into()] }),
+            gradient: Some(GradientTexture { index: 2, curves: vec![drafter_format::TransferCurve::Identity] }),
             cel: Some(CelTexture {
                 index: 0,
                 tables: vec![CelTableRecord {

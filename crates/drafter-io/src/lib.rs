@@ -21,6 +21,7 @@ use std::path::Path;
 use drafter_core::{Diagnostic, Diagnostics, Scene, SourceFormat};
 
 pub use error::{ImportError, ParseError, Place};
+pub use gltf_import::read_buffer_uri;
 pub use raw::RawMesh;
 
 /// A successfully imported file.
@@ -71,7 +72,7 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<SourceFormat, ImportEr
         return Err(ParseError::in_file("empty file").in_path(path));
     }
     let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    if bytes.starts_with(b"glTF") {
+    if drafter_core::glb::is_glb(bytes) {
         return Ok(SourceFormat::Glb);
     }
     if bytes.starts_with(b"ply") {

@@ -194,24 +194,7 @@ fn glb_and_external_buffers_load() {
 
     // The same as GLB: JSON chunk + BIN chunk, buffer without uri.
     doc["buffers"][0].as_object_mut().expect("obj").remove("uri");
-    let mut json_chunk = serde_json::to_vec(&doc).expect("json");
-    while !json_chunk.len().is_multiple_of(4) {
-        json_chunk.push(b' ');
-    }
-    let mut bin_chunk = bin;
-    while bin_chunk.len() % 4 != 0 {
-        bin_chunk.push(0);
-    }
-    let total = 12 + 8 + json_chunk.len() + 8 + bin_chunk.len();
-    let mut glb = b"glTF".to_vec();
-    glb.extend_from_slice(&2u32.to_le_bytes());
-    glb.extend_from_slice(&(total as u32).to_le_bytes());
-    glb.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
-    glb.extend_from_slice(b"JSON");
-    glb.extend_from_slice(&json_chunk);
-    glb.extend_from_slice(&(bin_chunk.len() as u32).to_le_bytes());
-    glb.extend_from_slice(b"BIN\0");
-    glb.extend_from_slice(&bin_chunk);
+    let glb = drafter_core::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
     let imported = drafter_io::import_bytes(Path::new("x.glb"), &glb).expect("glb");
     assert_eq!(imported.scene.format, SourceFormat::Glb);
     assert_eq!(imported.scene.meshes[0].positions, TRI.map(Vec3::from).to_vec());
