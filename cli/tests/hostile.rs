@@ -210,6 +210,12 @@ fn out_of_range_indices() {
     assert_rejected(&write(&dir, "index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"), "line");
     assert_rejected(&write(&dir, "index.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "line");
     assert_rejected(&write(&dir, "node.gltf", &gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())), "/nodes/0/mesh");
+    // gltf-json 1.4 indexes a POSITION accessor unchecked while validating: it must be refused
+    // before that (it was a panic in the dependency and exit 1).
+    let position = gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 5.into());
+    assert_rejected(&write(&dir, "position.gltf", &position), "/meshes/0/primitives/0/attributes/POSITION");
+    let huge = gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = u32::MAX.into());
+    assert_rejected(&write(&dir, "position-huge.gltf", &huge), "does not exist");
 }
 
 #[test]

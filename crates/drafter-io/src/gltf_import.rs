@@ -135,6 +135,22 @@ fn check_required_extensions(root: &gltf::json::Root) -> Result<(), ParseError> 
 }
 
 fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
+    // gltf-json 1.4's validation indexes `accessors` with a primitive's POSITION unchecked (its
+    // min/max rule in mesh.rs), so an out-of-range POSITION would panic inside the dependency:
+    // refuse it here first, as the validator would.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= root.accessors.len()
+            {
+                return Err(ParseError::at_json(
+                    format!("/meshes/{m}/primitives/{p}/attributes/POSITION"),
+                    format!("accessor {} does not exist (the file has {})", index.value(), root.accessors.len()),
+                ));
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path();
