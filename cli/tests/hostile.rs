@@ -273,3 +273,48 @@ fn malformed_json_names_the_line() {
         "/accessors/0",
     );
 }
+
+/// Inputs `inspect` accepts never end a bake with "internal error" (exit 1): a node whose mesh has
+/// only line primitives bakes (its part is the node's origin); JSON the writer cannot carry over (a
+/// number beyond f64 in `extras`, nesting deeper than serde_json's limit) is refused as bad input.
+#[test]
+fn accepted_inputs_bake_or_are_refused_as_input() {
+    let dir = common::scratch("hostile-accepted");
+    let bake = |name: &str, bytes: Vec<u8>| {
+        let input = write(&dir, name, &bytes);
+        let out = common::drafter()
+            .arg("bake")
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.join(format!("{name}.glb")))
+            .arg("--quiet")
+            .output()
+            .expect("runs");
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let lines_node = gltf_triangle(|j| {
+        j["meshes"].as_array_mut().expect("meshes").push(serde_json::json!({
+            "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 1}]
+        }));
+        j["nodes"].as_array_mut().expect("nodes").push(serde_json::json!({"mesh": 1}));
+        j["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    });
+    let (code, stderr) = bake("lines.gltf", lines_node);
+    assert_eq!(code, Some(0), "{stderr}");
+
+    let huge_number = String::from_utf8(gltf_triangle(|j| j["extras"] = serde_json::json!({"n": 1.0})))
+        .expect("utf-8")
+        .replace("\"n\": 1.0", "\"n\": 1e309");
+    let mut deep = serde_json::json!(0);
+    for _ in 0..200 {
+        deep = serde_json::json!({ "a": deep });
+    }
+    for (name, bytes) in
+        [("number.gltf", huge_number.into_bytes()), ("deep.gltf", gltf_triangle(|j| j["extras"] = deep.clone()))]
+    {
+        let (code, stderr) = bake(name, bytes);
+        assert_eq!(code, Some(2), "{name}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{name}: {stderr}");
+        assert!(stderr.contains(name), "{name}: {stderr}");
+    }
+}

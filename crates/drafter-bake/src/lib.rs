@@ -252,8 +252,14 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         mesh_silhouettes,
         textures: embedded,
     };
-    let written = drafter_format::write(&output, &config.container)
-        .map_err(|e| BakeError::Internal { stage: "write", message: e.to_string() })?;
+    let written = drafter_format::write(&output, &config.container).map_err(|e| match e {
+        // The input's own JSON that cannot be carried over (a number beyond f64, nesting deeper
+        // than the JSON parser's limit of 128): the input's fault, reported as such.
+        drafter_format::FormatError::Source(message) => {
+            BakeError::Input(format!("the glTF document cannot be passed through: {message}"))
+        }
+        e => BakeError::Internal { stage: "write", message: e.to_string() },
+    })?;
     let texture_images = output.textures.map(|t| t.images).unwrap_or_default();
     for note in &written.notes {
         diagnostics.push(Diagnostic { kind: DiagnosticKind::Output, count: 1, first_example: note.clone() });
@@ -671,6 +677,12 @@ pub fn part_points(scene: &Scene, parts: &Parts, part: PartId) -> Vec<DVec3> {
                 points.push(instance.world_from_object.transform_point3(mesh.positions[v as usize].as_dvec3()));
             }
         }
+    }
+    if points.is_empty() {
+        // A node whose mesh has no triangles (only line or point primitives, which the importer
+        // skips): its part is the node's origin, a box of size zero, so that the node still gets
+        // its record and the bake does not fail on valid glTF.
+        points.push(instance.world_from_object.transform_point3(DVec3::ZERO));
     }
     points
 }
