@@ -186,7 +186,16 @@ impl Model {
         let node_parts: HashMap<u32, &[PartRecord]> = baked
             .map(|b| b.nodes.iter().map(|(node, ext)| (*node, ext.parts.as_slice())).collect())
             .unwrap_or_default();
-        let baked_part_count = baked.map_or(0, |b| b.root.part_count);
+        // Ids are dense `0..partCount`, one per part record: a count beyond the records present is
+        // a broken (or hostile) file, and is never used to size an allocation.
+        let records = baked.map_or(0, |b| b.nodes.iter().map(|(_, ext)| ext.parts.len()).sum::<usize>());
+        let declared = baked.map_or(0, |b| b.root.part_count);
+        let baked_part_count = declared.min(u32::try_from(records).unwrap_or(u32::MAX));
+        if declared > baked_part_count {
+            notices.push(format!(
+                "partCount {declared} but {records} part records: ids from {baked_part_count} on are drawn as unbaked parts"
+            ));
+        }
 
         let mut parts: Vec<Option<Part>> = vec![None; baked_part_count as usize];
         let mut fallback_parts = Vec::new();
