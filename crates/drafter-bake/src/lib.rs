@@ -479,11 +479,14 @@ fn silhouettes_of(
         let range = group.start as usize..(group.start + group.count) as usize;
         // The position the writer gives each corner: with a new vertex layout, an output vertex
         // takes the mesh vertex of its first corner in this primitive (as `write_vertex_data` does).
-        let written: Option<std::collections::HashMap<u32, u32>> = layout.map(|vd| {
-            let mut first = std::collections::HashMap::new();
+        // Output vertex → the mesh vertex of its first corner here (u32::MAX: not in this primitive).
+        let written: Option<Vec<u32>> = layout.map(|vd| {
+            let mut first = vec![u32::MAX; vd.source_vertex.len()];
             for (t, mesh_triangle) in vd.triangles[range.clone()].iter().zip(&mesh.triangles[range.clone()]) {
                 for (&o, &v) in t.iter().zip(mesh_triangle) {
-                    first.entry(o).or_insert(v);
+                    if let Some(slot) = first.get_mut(o as usize).filter(|s| **s == u32::MAX) {
+                        *slot = v;
+                    }
                 }
             }
             first
@@ -492,7 +495,7 @@ fn silhouettes_of(
             let t = group.start as usize + slot as usize / 3;
             let k = slot as usize % 3;
             let vertex = match (&written, layout) {
-                (Some(first), Some(vd)) => first[&vd.triangles[t][k]],
+                (Some(first), Some(vd)) => first[vd.triangles[t][k] as usize],
                 _ => mesh.triangles[t][k],
             };
             corners.push(3 * t as u32 + k as u32);
@@ -513,13 +516,11 @@ fn silhouettes_of(
     // The index renumbers its candidates in the Gauss map's storage order; the file keeps the
     // Khronos encoding order. So each stored order maps a storage position to a file candidate:
     // the index's candidate k (corner c) is file candidate `file_of[k]`. Corners are unique.
-    let mut by_corner: Vec<(u32, u32)> = corners.iter().enumerate().map(|(i, &c)| (c, i as u32)).collect();
-    by_corner.sort_unstable();
-    let file_of: Vec<u32> = arrays
-        .candidate_edges
-        .iter()
-        .map(|c| by_corner.binary_search_by_key(c, |p| p.0).map_or(u32::MAX, |i| by_corner[i].1))
-        .collect();
+    let mut by_corner = vec![u32::MAX; 3 * mesh.triangles.len()];
+    for (i, &c) in corners.iter().enumerate() {
+        by_corner[c as usize] = i as u32;
+    }
+    let file_of: Vec<u32> = arrays.candidate_edges.iter().map(|&c| by_corner[c as usize]).collect();
     let remap = |order: &[u32]| -> Vec<u32> { order.iter().map(|&k| file_of[k as usize]).collect() };
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",

@@ -86,7 +86,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
-use crate::gauss::{BaseSolid, QueryCounts, arc_path, base_cells};
+use crate::gauss::{BaseSolid, QueryCounts, arc_paths, base_cells};
 use crate::tree::{
     breadth_first, check_breadth_first, check_permutation, for_each_in_subtrees, push_children, widest_level,
     with_levels,
@@ -295,6 +295,12 @@ const DUAL_BINS: usize = 32;
 /// which bounds the recursion.
 const DUAL_SAH_DEPTH: u32 = 48;
 
+/// A candidate's two normals in `f64`, normalised (zero for a degenerate face): what every bound
+/// of the build is computed from.
+fn unit_pair([a, b]: [Vec3; 2]) -> [DVec3; 2] {
+    [a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero()]
+}
+
 /// The plane-offset bound of a node: `[cos α, h_lo, h_hi, reach]`, where every face plane below
 /// the node (normal `n̂` normalised, through the candidate's point `v`) has the offset
 /// `h = n̂·(v − p₀)` in `[h_lo, h_hi]` from the anchor `p₀` (the centre of the node's box) and
@@ -305,11 +311,12 @@ struct PlaneBound([f32; 4]);
 impl PlaneBound {
     const NEVER: PlaneBound = PlaneBound([0.0, f32::NEG_INFINITY, f32::INFINITY, 0.0]);
 
-    /// The bound of the candidates `ids` (box `b`, cone `c` as stored).
-    fn of(ids: &[u32], b: &[f32; 6], c: &[f32; 4], normals: &[[Vec3; 2]], points: &[Vec3]) -> Self {
+    /// The bound of the candidates with unit normals `unit` (see [`unit_pair`]) and `points`
+    /// (box `b`, cone `c` as stored).
+    fn of(unit: &[[DVec3; 2]], points: &[Vec3], b: &[f32; 6], c: &[f32; 4]) -> Self {
         let mut acc = PlaneAcc::new(b);
-        for &i in ids {
-            acc.add(normals[i as usize], points[i as usize]);
+        for (&u, &p) in unit.iter().zip(points) {
+            acc.add(u, p);
         }
         acc.finish(c)
     }
@@ -330,11 +337,12 @@ impl PlaneAcc {
         Self { p0: anchor(b).as_dvec3(), lo: f64::INFINITY, hi: f64::NEG_INFINITY, reach: 0.0, count: 0 }
     }
 
-    fn add(&mut self, normals: [Vec3; 2], point: Vec3) {
+    /// Adds a candidate with unit normals `unit` (see [`unit_pair`]) and point `point`.
+    fn add(&mut self, unit: [DVec3; 2], point: Vec3) {
         let d = point.as_dvec3() - self.p0;
         self.reach = self.reach.max(d.length());
-        for n in normals {
-            let h = n.as_dvec3().normalize_or_zero().dot(d);
+        for n in unit {
+            let h = n.dot(d);
             self.lo = self.lo.min(h);
             self.hi = self.hi.max(h);
         }
@@ -408,7 +416,26 @@ impl Tree {
         self.nodes[at][2] = self.nodes.len() as u32;
         self.nodes[at][3] = u32::from(leaf);
     }
+
+    /// Appends `sub` (built on its own) as the next child of node `at`: its node indices, skip
+    /// pointers and ranges are shifted past this tree's.
+    fn append_child(&mut self, at: usize, sub: Tree) {
+        let (node_offset, arc_offset) = (self.nodes.len() as u32, self.order.len() as u32);
+        self.children[at].push(node_offset);
+        self.nodes.extend(
+            sub.nodes
+                .into_iter()
+                .map(|[start, end, skip, leaf]| [start + arc_offset, end + arc_offset, skip + node_offset, leaf]),
+        );
+        self.children
+            .extend(sub.children.into_iter().map(|c| c.into_iter().map(|k| k + node_offset).collect::<Vec<u32>>()));
+        self.order.extend(sub.order);
+    }
 }
+
+/// Subtrees over more candidates than this are built on the thread pool and appended to their
+/// parent; smaller ones in the calling thread. The tree is the same either way.
+const PARALLEL_CANDIDATES: usize = 32 * 1024;
 
 impl ConeBvh {
     /// Builds the hierarchy over candidates with `normals` and points `points` (one each).
@@ -416,24 +443,27 @@ impl ConeBvh {
         let n = normals.len().min(points.len());
         let (normals, points) = (&normals[..n], &points[..n]);
         let leaf_size = options.leaf_size.clamp(1, 4096);
-        let unit: Vec<[DVec3; 2]> = normals
-            .par_iter()
-            .map(|&[a, b]| [a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero()])
-            .collect();
+        let unit: Vec<[DVec3; 2]> = normals.par_iter().map(|&n| unit_pair(n)).collect();
         let normal_level = match options.normal_split {
             NormalSplit::Off => None,
             NormalSplit::Level(l) => Some(l.min(6)),
             NormalSplit::Auto => Some(normal_level_for_count(n)),
         };
         let tree = build_tree(points, &unit, leaf_size, normal_level);
+        // The candidates in tree order, so that every node's bounds read one contiguous range
+        // (gathering through `order` per node and level missed the cache on every candidate).
+        let (tree_points, tree_unit): (Vec<Vec3>, Vec<[DVec3; 2]>) =
+            tree.order.par_iter().map(|&i| (points[i as usize], unit[i as usize])).unzip();
+        drop(unit);
+        let range = |start: u32, end: u32| start as usize..end as usize;
         let (boxes, cones): (Vec<[f32; 6]>, Vec<[f32; 4]>) = tree
             .nodes
             .par_iter()
             .map(|&[start, end, _, _]| {
-                let range = &tree.order[start as usize..end as usize];
+                let r = range(start, end);
                 (
-                    bounding_box(range.iter().map(|&i| points[i as usize])),
-                    bounding_cone(range.iter().flat_map(|&i| unit[i as usize])),
+                    bounding_box(tree_points[r.clone()].iter().copied()),
+                    bounding_cone(tree_unit[r].iter().flatten().copied()),
                 )
             })
             .unzip();
@@ -442,9 +472,11 @@ impl ConeBvh {
             .par_iter()
             .enumerate()
             .map(|(i, &[start, end, _, _])| {
-                PlaneBound::of(&tree.order[start as usize..end as usize], &boxes[i], &cones[i], normals, points)
+                let r = range(start, end);
+                PlaneBound::of(&tree_unit[r.clone()], &tree_points[r], &boxes[i], &cones[i])
             })
             .collect();
+        drop((tree_points, tree_unit));
         let eyes = sample_eyes(points, options.sample_eyes);
         let mut leaf: Vec<bool> = tree.nodes.iter().map(|n| n[3] == 1).collect();
         if !eyes.is_empty() && options.prune {
@@ -688,7 +720,7 @@ impl ConeBvh {
         // The plane offsets are not stored: they follow from the boxes and the candidates.
         let mut acc: Vec<PlaneAcc> = boxes.iter().map(PlaneAcc::new).collect();
         for_each_in_subtrees(&flat, &parent, &arrays.order, |node, k| {
-            acc[node].add(normals[k as usize], points[k as usize]);
+            acc[node].add(unit_pair(normals[k as usize]), points[k as usize]);
             Ok(())
         })?;
         let planes: Vec<PlaneBound> = acc.iter().zip(&cones).map(|(a, c)| a.finish(c)).collect();
@@ -786,10 +818,7 @@ fn build_tree(points: &[Vec3], unit: &[[DVec3; 2]], leaf_size: u32, normal_level
         None => spatial(&mut tree, &ids, points, leaf_size),
         Some(level) => {
             let base = base_cells(BaseSolid::Icosahedron);
-            let paths: Vec<(u32, u8)> = unit
-                .par_iter()
-                .map(|&[a, b]| arc_path(a, b, &base, level, f64::from(crate::gauss::DEFAULT_OVERLAP)))
-                .collect();
+            let paths = arc_paths(unit, &base, level, f64::from(crate::gauss::DEFAULT_OVERLAP));
             let dual = dual_points(points, unit);
             let split = NormalSplitter { paths: &paths, level, dual: &dual, leaf_size };
             split.node(&mut tree, ids, 0);
@@ -798,7 +827,7 @@ fn build_tree(points: &[Vec3], unit: &[[DVec3; 2]], leaf_size: u32, normal_level
     tree
 }
 
-/// Splits candidates by the Gauss-map cell their arc is stored in (see [`arc_path`]).
+/// Splits candidates by the Gauss-map cell their arc is stored in (see [`arc_paths`]).
 struct NormalSplitter<'a> {
     paths: &'a [(u32, u8)],
     level: u8,
@@ -809,7 +838,8 @@ struct NormalSplitter<'a> {
 impl NormalSplitter<'_> {
     /// The dual-space tree over `ids`, whose normals are close (see [`dual_node`]).
     fn spatial(&self, tree: &mut Tree, ids: &[u32]) {
-        dual_node(tree, &mut ids.to_vec(), self.dual, self.leaf_size, 0);
+        let mut records: Vec<DualRecord> = ids.iter().map(|&id| DualRecord { b: self.dual[id as usize], id }).collect();
+        dual_node(tree, &mut records, self.leaf_size, 0);
     }
 
     /// Emits the subtree of `ids`, whose arcs all went down at least `depth` cells and share
@@ -845,6 +875,31 @@ impl NormalSplitter<'_> {
             return;
         }
         let at = tree.open();
+        let total = stay.len() + groups.iter().map(Vec::len).sum::<usize>();
+        if total > PARALLEL_CANDIDATES {
+            // The stay-here candidates first, then the groups by cell, as below.
+            let work: Vec<(Vec<u32>, bool)> = std::iter::once((stay, true))
+                .chain(groups.into_iter().map(|g| (g, false)))
+                .filter(|(ids, _)| !ids.is_empty())
+                .collect();
+            let subtrees: Vec<Tree> = work
+                .into_par_iter()
+                .map(|(ids, here)| {
+                    let mut sub = Tree::default();
+                    if here {
+                        self.spatial(&mut sub, &ids)
+                    } else {
+                        self.node(&mut sub, ids, depth + 1)
+                    }
+                    sub
+                })
+                .collect();
+            for sub in subtrees {
+                tree.append_child(at, sub);
+            }
+            tree.close(at, false);
+            return;
+        }
         if !stay.is_empty() {
             let child = tree.nodes.len() as u32;
             self.spatial(tree, &stay);
@@ -897,47 +952,82 @@ fn grow(a: &mut DualBox, b: &DualBox) {
     }
 }
 
-/// Emits the dual-space tree over `ids` (reordered in place), binary, top-down: on each of the
+/// A candidate as the dual-space build moves it: its box and its index. The build reorders
+/// these records in place, so that every pass reads memory in sequence (indices into a shared box
+/// array cost a cache miss per candidate and level on a million-candidate mesh).
+#[derive(Clone, Copy)]
+struct DualRecord {
+    b: DualBox,
+    id: u32,
+}
+
+impl DualRecord {
+    fn centre(&self) -> [f32; 4] {
+        std::array::from_fn(|a| (self.b[0][a] + self.b[1][a]) * 0.5)
+    }
+}
+
+/// Emits the dual-space tree over `records` (reordered in place), binary, top-down: on each of the
 /// 4 axes the candidates' box centres go into [`DUAL_BINS`] bins, and the split between bins
 /// that minimises `count_left · width_left + count_right · width_right` is taken (the binned
 /// surface-area heuristic of ray tracing, with the mean width that measures how often a random
-/// hyperplane crosses a box). Deterministic: sequential, in place, ties to the first axis and
-/// bin. Candidates whose centres coincide on every axis are split in halves.
-fn dual_node(tree: &mut Tree, ids: &mut [u32], boxes: &[DualBox], leaf_size: u32, depth: u32) {
+/// hyperplane crosses a box). Deterministic: in place, ties to the first axis and bin; subtrees
+/// of more than [`PARALLEL_CANDIDATES`] are built on the thread pool, which gives the same tree.
+/// Candidates whose centres coincide on every axis are split in halves.
+fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth: u32) {
     let at = tree.open();
-    if ids.len() <= leaf_size as usize || ids.len() < 2 {
-        tree.order.extend_from_slice(ids);
+    if records.len() <= leaf_size as usize || records.len() < 2 {
+        tree.order.extend(records.iter().map(|r| r.id));
         tree.close(at, true);
         return;
     }
-    let centre = |i: u32, a: usize| {
-        let b = &boxes[i as usize];
-        (b[0][a] + b[1][a]) * 0.5
-    };
     let mut bounds = EMPTY_BOX;
-    for &i in ids.iter() {
-        let c: [f32; 4] = std::array::from_fn(|a| centre(i, a));
+    for r in records.iter() {
+        let c = r.centre();
         grow(&mut bounds, &[c, c]);
     }
-    let bin_of = |i: u32, a: usize| {
+    let bin_of = |c: f32, a: usize| {
         let ext = bounds[1][a] - bounds[0][a];
         // `as` saturates (NaN to 0): no bin index leaves the range.
-        (((centre(i, a) - bounds[0][a]) / ext * DUAL_BINS as f32) as usize).min(DUAL_BINS - 1)
+        (((c - bounds[0][a]) / ext * DUAL_BINS as f32) as usize).min(DUAL_BINS - 1)
     };
+    // Axes whose centres all coincide (or are not finite) offer no split.
+    let splittable: [bool; 4] =
+        std::array::from_fn(|a| (bounds[1][a] - bounds[0][a]).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater));
     // (cost, axis, first bin of the right side)
     let mut best: Option<(f32, usize, usize)> = None;
-    if depth < DUAL_SAH_DEPTH {
-        // Axes whose centres all coincide (or are not finite) offer no split.
-        for a in
-            (0..4).filter(|&a| (bounds[1][a] - bounds[0][a]).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater))
-        {
-            let mut count = [0usize; DUAL_BINS];
-            let mut bin_box = [EMPTY_BOX; DUAL_BINS];
-            for &i in ids.iter() {
-                let k = bin_of(i, a);
-                count[k] += 1;
-                grow(&mut bin_box[k], &boxes[i as usize]);
+    if depth < DUAL_SAH_DEPTH && splittable.iter().any(|&s| s) {
+        // All four axes binned in one pass over the records; on the thread pool for large nodes
+        // (counts add and boxes take minima and maxima: the same bins in any split).
+        type Bins = ([[usize; DUAL_BINS]; 4], [[DualBox; DUAL_BINS]; 4]);
+        let empty = || -> Bins { ([[0usize; DUAL_BINS]; 4], [[EMPTY_BOX; DUAL_BINS]; 4]) };
+        let bin = |chunk: &[DualRecord]| {
+            let mut acc = empty();
+            for r in chunk {
+                let c = r.centre();
+                for a in (0..4).filter(|&a| splittable[a]) {
+                    let k = bin_of(c[a], a);
+                    acc.0[a][k] += 1;
+                    grow(&mut acc.1[a][k], &r.b);
+                }
             }
+            acc
+        };
+        let (count, bin_box) = if records.len() > PARALLEL_CANDIDATES {
+            records.par_chunks(16 * 1024).map(bin).reduce(empty, |mut x, y| {
+                for a in 0..4 {
+                    for k in 0..DUAL_BINS {
+                        x.0[a][k] += y.0[a][k];
+                        grow(&mut x.1[a][k], &y.1[a][k]);
+                    }
+                }
+                x
+            })
+        } else {
+            bin(records)
+        };
+        for a in (0..4).filter(|&a| splittable[a]) {
+            let (count, bin_box) = (&count[a], &bin_box[a]);
             let mut right_cost = [0f32; DUAL_BINS];
             let (mut acc, mut n) = (EMPTY_BOX, 0usize);
             for k in (1..DUAL_BINS).rev() {
@@ -949,7 +1039,7 @@ fn dual_node(tree: &mut Tree, ids: &mut [u32], boxes: &[DualBox], leaf_size: u32
             for k in 0..DUAL_BINS - 1 {
                 n += count[k];
                 grow(&mut acc, &bin_box[k]);
-                if n == 0 || n == ids.len() {
+                if n == 0 || n == records.len() {
                     continue;
                 }
                 let cost = n as f32 * dual_width(&acc) + right_cost[k + 1];
@@ -962,9 +1052,9 @@ fn dual_node(tree: &mut Tree, ids: &mut [u32], boxes: &[DualBox], leaf_size: u32
     let mid = match best {
         Some((_, a, split)) => {
             let mut left = 0;
-            for j in 0..ids.len() {
-                if bin_of(ids[j], a) < split {
-                    ids.swap(left, j);
+            for j in 0..records.len() {
+                if bin_of(records[j].centre()[a], a) < split {
+                    records.swap(left, j);
                     left += 1;
                 }
             }
@@ -975,18 +1065,31 @@ fn dual_node(tree: &mut Tree, ids: &mut [u32], boxes: &[DualBox], leaf_size: u32
             let a = (0..4).max_by(|&x, &y| {
                 (bounds[1][x] - bounds[0][x]).total_cmp(&(bounds[1][y] - bounds[0][y])).then(y.cmp(&x))
             });
-            let mid = ids.len() / 2;
+            let mid = records.len() / 2;
             if let Some(a) = a {
-                ids.select_nth_unstable_by(mid, |&x, &y| centre(x, a).total_cmp(&centre(y, a)).then(x.cmp(&y)));
+                records
+                    .select_nth_unstable_by(mid, |x, y| x.centre()[a].total_cmp(&y.centre()[a]).then(x.id.cmp(&y.id)));
             }
             mid
         }
     };
-    let (left, right) = ids.split_at_mut(mid);
-    for part in [left, right] {
-        let child = tree.nodes.len() as u32;
-        dual_node(tree, part, boxes, leaf_size, depth + 1);
-        tree.children[at].push(child);
+    let parallel = records.len() > PARALLEL_CANDIDATES;
+    let (left, right) = records.split_at_mut(mid);
+    if parallel {
+        let build = |part: &mut [DualRecord]| {
+            let mut sub = Tree::default();
+            dual_node(&mut sub, part, leaf_size, depth + 1);
+            sub
+        };
+        let (l, r) = rayon::join(|| build(left), || build(right));
+        tree.append_child(at, l);
+        tree.append_child(at, r);
+    } else {
+        for part in [left, right] {
+            let child = tree.nodes.len() as u32;
+            dual_node(tree, part, leaf_size, depth + 1);
+            tree.children[at].push(child);
+        }
     }
     tree.close(at, false);
 }
@@ -1184,11 +1287,11 @@ mod tests {
                 normals.push([tilt(&mut r), tilt(&mut r)]);
                 points.push(v);
             }
-            let ids: Vec<u32> = (0..n as u32).collect();
             let b = bounding_box(points.iter().copied());
             let unit: Vec<DVec3> = normals.iter().flatten().map(|v| v.as_dvec3().normalize()).collect();
             let c = bounding_cone(unit.iter().copied());
-            let p = PlaneBound::of(&ids, &b, &c, &normals, &points);
+            let pairs: Vec<[DVec3; 2]> = normals.iter().map(|&n| unit_pair(n)).collect();
+            let p = PlaneBound::of(&pairs, &points, &b, &c);
             for k in 0..200 {
                 let dir = Vec3::new(r(), r(), r()).normalize();
                 let dist = if k % 2 == 0 { size * (0.01 + 3.0 * r().abs()) } else { 50.0 * r().abs() };

@@ -392,32 +392,23 @@ pub(crate) fn base_cells(base: BaseSolid) -> Vec<Cell> {
 /// cell's bin (the cap of `factor` circumradii around its centre), at most `level` splits below
 /// the base. Returns `(digits, cells)`: `cells` is how many cells the arc went down (0: it fits
 /// no base cell), `digits` the path as `base · 4^level + child digits` with unused digits 0.
+/// The reference for [`arc_paths`], which computes it for many arcs at once.
+#[cfg(test)]
 pub(crate) fn arc_path(n1: DVec3, n2: DVec3, base: &[Cell], level: u8, factor: f64) -> (u32, u8) {
     let sum = n1 + n2;
     if n1 == DVec3::ZERO || n2 == DVec3::ZERO || sum.length() <= 1e-9 {
         return (0, 0);
     }
     let mid = sum.normalize();
-    let fits = |c: &Cell| {
-        let cos_bin = (c.cos_radius.clamp(-1.0, 1.0).acos() * factor.max(1.0)).min(std::f64::consts::PI).cos();
-        c.center.dot(n1) >= cos_bin && c.center.dot(n2) >= cos_bin
-    };
-    let most_inside = |cells: &[Cell]| {
-        cells
-            .iter()
-            .enumerate()
-            .map(|(k, c)| (k, c.score(mid)))
-            .fold((0, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
-            .0
-    };
-    let b = most_inside(base);
+    let fits = |c: &Cell| fits_bin(c, bin_cos(c, factor), [n1, n2]);
+    let b = most_inside(base, mid);
     if !fits(&base[b]) {
         return (0, 0);
     }
     let (mut key, mut cells, mut cell) = (b as u32, 1u8, base[b]);
     for _ in 0..level {
         let children = cell.children();
-        let k = most_inside(&children);
+        let k = most_inside(&children, mid);
         if !fits(&children[k]) {
             break;
         }
@@ -428,103 +419,307 @@ pub(crate) fn arc_path(n1: DVec3, n2: DVec3, base: &[Cell], level: u8, factor: f
     (key * 4u32.pow(u32::from(level + 1 - cells)), cells)
 }
 
-/// Unit endpoints and midpoint of an arc; `mid` is `None` for a zero or antipodal arc.
-#[derive(Clone, Copy, Debug)]
-struct ArcGeom {
-    n1: DVec3,
-    n2: DVec3,
-    mid: Option<DVec3>,
+/// Where the overlapping-bin rule stores each arc `unit[i]` (unit normals; zero for a degenerate
+/// face): the cells containing its midpoint, level after level, for as long as both endpoints lie
+/// in the cell's bin (the cap of `factor` circumradii around its centre), at most `level` splits
+/// below the base. Each path is `(digits, cells)`: `cells` is how many cells the arc went down
+/// (0: it fits no base cell), `digits` the path as `base · 4^level + child digits` with unused
+/// digits 0. Computed top-down over the cells instead of arc by arc:
+/// each visited cell's children (and their bins) are built once for all the arcs that reach it,
+/// rather than once per arc and level. Equal to `arc_path` on every arc (tested).
+pub(crate) fn arc_paths(unit: &[[DVec3; 2]], base: &[Cell], level: u8, factor: f64) -> Vec<(u32, u8)> {
+    let mids: Vec<Option<DVec3>> = unit
+        .par_iter()
+        .map(|&[n1, n2]| {
+            let sum = n1 + n2;
+            (n1 != DVec3::ZERO && n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
+        })
+        .collect();
+    let bins: Vec<f64> = base.iter().map(|c| bin_cos(c, factor)).collect();
+    let mut groups: Vec<Vec<u32>> = vec![Vec::new(); base.len()];
+    for (i, mid) in mids.iter().enumerate() {
+        if let Some(m) = mid {
+            let b = most_inside(base, *m);
+            if fits_bin(&base[b], bins[b], unit[i]) {
+                groups[b].push(i as u32);
+            }
+        }
+    }
+    let descend = PathDescent { unit, mids: &mids, level, factor };
+    let found: Vec<Vec<(u32, (u32, u8))>> = groups
+        .into_par_iter()
+        .enumerate()
+        .map(|(b, ids)| {
+            let mut out = Vec::with_capacity(ids.len());
+            descend.cell(base[b], b as u32, 1, ids, &mut out);
+            out
+        })
+        .collect();
+    let mut paths = vec![(0u32, 0u8); unit.len()];
+    for (i, path) in found.into_iter().flatten() {
+        paths[i as usize] = path;
+    }
+    paths
 }
 
-fn arc_geometry(normals: &[[Vec3; 2]]) -> Vec<ArcGeom> {
+/// Cosine of the overlapping bin radius of `c` (`factor` circumradii, at most π).
+fn bin_cos(c: &Cell, factor: f64) -> f64 {
+    (c.cos_radius.clamp(-1.0, 1.0).acos() * factor.max(1.0)).min(std::f64::consts::PI).cos()
+}
+
+fn fits_bin(c: &Cell, cos_bin: f64, [n1, n2]: [DVec3; 2]) -> bool {
+    c.center.dot(n1) >= cos_bin && c.center.dot(n2) >= cos_bin
+}
+
+/// The cell whose inside-ness score of `p` is the largest (the first of equals).
+fn most_inside(cells: &[Cell], p: DVec3) -> usize {
+    cells
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (k, c.score(p)))
+        .fold((0, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
+        .0
+}
+
+struct PathDescent<'a> {
+    unit: &'a [[DVec3; 2]],
+    mids: &'a [Option<DVec3>],
+    level: u8,
+    factor: f64,
+}
+
+impl PathDescent<'_> {
+    /// Paths of `ids`, all of which went down to `cell` (`cells` cells so far, digits `key`).
+    fn cell(&self, cell: Cell, key: u32, cells: u8, ids: Vec<u32>, out: &mut Vec<(u32, (u32, u8))>) {
+        let here = (key * 4u32.pow(u32::from(self.level + 1 - cells)), cells);
+        if cells > self.level {
+            out.extend(ids.into_iter().map(|i| (i, here)));
+            return;
+        }
+        let children = cell.children();
+        let bins = children.each_ref().map(|c| bin_cos(c, self.factor));
+        let mut groups: [Vec<u32>; 4] = Default::default();
+        for i in ids {
+            let Some(m) = self.mids[i as usize] else { continue };
+            let k = most_inside(&children, m);
+            if fits_bin(&children[k], bins[k], self.unit[i as usize]) {
+                groups[k].push(i);
+            } else {
+                out.push((i, here));
+            }
+        }
+        for (k, ids) in groups.into_iter().enumerate() {
+            if !ids.is_empty() {
+                self.cell(children[k], key * 4 + k as u32, cells + 1, ids, out);
+            }
+        }
+    }
+}
+
+/// An arc as the builder moves it: its candidate and its unit endpoints (zero for a degenerate
+/// face). The builder partitions these records in place, level after level, so that every pass
+/// reads and writes memory in sequence (carrying indices into a shared array instead cost a cache
+/// miss per arc and level on a million-arc mesh). The midpoint is recomputed where it is needed,
+/// which is cheaper than moving it along.
+#[derive(Clone, Copy, Debug, Default)]
+struct Arc {
+    n1: DVec3,
+    n2: DVec3,
+    id: u32,
+}
+
+impl Arc {
+    /// The arc's midpoint; `None` for a zero or antipodal arc.
+    fn mid(&self) -> Option<DVec3> {
+        let sum = self.n1 + self.n2;
+        (self.n1 != DVec3::ZERO && self.n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
+    }
+}
+
+fn arc_records(normals: &[[Vec3; 2]]) -> Vec<Arc> {
     normals
         .par_iter()
-        .map(|&[a, b]| {
-            let n1 = a.as_dvec3().normalize_or_zero();
-            let n2 = b.as_dvec3().normalize_or_zero();
-            let sum = n1 + n2;
-            let mid = (n1 != DVec3::ZERO && n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize());
-            ArcGeom { n1, n2, mid }
+        .enumerate()
+        .map(|(id, &[a, b])| Arc {
+            n1: a.as_dvec3().normalize_or_zero(),
+            n2: b.as_dvec3().normalize_or_zero(),
+            id: id as u32,
         })
         .collect()
 }
 
 struct BuildNode {
     depth: u8,
+    /// The node's own arcs, positions in the final arc order.
     own: (u32, u32),
-    /// End of the subtree's arcs in `order`.
+    /// End of the subtree's arcs in the final arc order.
     sub_end: u32,
     children: Vec<u32>,
     cell_center: Option<DVec3>,
 }
 
-struct Builder<'a> {
-    geo: &'a [ArcGeom],
+/// Subtrees holding more arcs than this are built on the thread pool (one task per child cell)
+/// and appended to their parent; smaller ones in the calling thread. The tree is the same either
+/// way.
+const PARALLEL_ARCS: usize = 32 * 1024;
+
+/// A cell and the cosine of its bin radius (see [`Bins`]), computed once per cell rather than
+/// once per arc tested against it.
+#[derive(Clone, Copy)]
+struct BinCell {
+    cell: Cell,
+    cos_bin: f64,
+}
+
+struct Builder {
     bins: Bins,
     max_depth: u8,
     base: Vec<Cell>,
-    nodes: Vec<BuildNode>,
-    order: Vec<u32>,
 }
 
-impl Builder<'_> {
-    fn fits(&self, cell: &Cell, arc: &ArcGeom) -> bool {
+/// Where an arc goes at a node: it stays there.
+const STAY: u8 = u8::MAX;
+
+impl Builder {
+    fn bin_cell(&self, cell: Cell) -> BinCell {
+        let cos_bin = match self.bins {
+            Bins::Strict => 0.0,
+            Bins::Overlapping { factor } => bin_cos(&cell, f64::from(factor)),
+        };
+        BinCell { cell, cos_bin }
+    }
+
+    fn fits(&self, bin: &BinCell, arc: &Arc) -> bool {
         match self.bins {
-            Bins::Strict => cell.score(arc.n1) >= 0.0 && cell.score(arc.n2) >= 0.0,
-            Bins::Overlapping { factor } => {
-                let bin =
-                    (cell.cos_radius.clamp(-1.0, 1.0).acos() * f64::from(factor.max(1.0))).min(std::f64::consts::PI);
-                let cos_bin = bin.cos();
-                cell.center.dot(arc.n1) >= cos_bin && cell.center.dot(arc.n2) >= cos_bin
-            }
+            Bins::Strict => bin.cell.score(arc.n1) >= 0.0 && bin.cell.score(arc.n2) >= 0.0,
+            Bins::Overlapping { .. } => fits_bin(&bin.cell, bin.cos_bin, [arc.n1, arc.n2]),
         }
     }
 
-    /// Builds the node for `cell` (`None`: the root) holding `arcs`; returns its index.
-    fn node(&mut self, cell: Option<Cell>, depth: u8, arcs: Vec<u32>) -> u32 {
-        let index = self.nodes.len() as u32;
-        self.nodes.push(BuildNode {
+    /// Appends to `out` the subtree, in preorder, for `cell` (`None`: the root) holding `arcs`,
+    /// which start at position `offset` of the final order. Reorders `arcs` into that order: the
+    /// node's own arcs, then each child's subtree (stable: input order within each). `scratch`
+    /// is as long as `arcs`.
+    fn node(
+        &self,
+        cell: Option<Cell>,
+        depth: u8,
+        arcs: &mut [Arc],
+        scratch: &mut [Arc],
+        offset: u32,
+        out: &mut Vec<BuildNode>,
+    ) {
+        let index = out.len();
+        out.push(BuildNode {
             depth,
-            own: (0, 0),
-            sub_end: 0,
+            own: (offset, offset),
+            sub_end: offset + arcs.len() as u32,
             children: Vec::new(),
             cell_center: cell.map(|c| c.center),
         });
-        let children: Vec<Cell> = match cell {
-            None => self.base.clone(),
+        let children: Vec<BinCell> = match cell {
+            None => self.base.iter().map(|&c| self.bin_cell(c)).collect(),
             // Depth 1 is level 0; a cell at level `depth - 1` splits while that is below max_depth.
-            Some(c) if depth <= self.max_depth => c.children().to_vec(),
+            Some(c) if depth <= self.max_depth => c.children().iter().map(|&c| self.bin_cell(c)).collect(),
             Some(_) => Vec::new(),
         };
-        let mut stay = Vec::new();
-        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); children.len()];
-        for a in arcs {
-            let g = &self.geo[a as usize];
-            let target = g.mid.and_then(|m| {
-                let (best, _) = children
-                    .iter()
-                    .enumerate()
-                    .map(|(k, c)| (k, c.score(m)))
-                    .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
-                (best < children.len() && self.fits(&children[best], g)).then_some(best)
-            });
-            match target {
-                Some(k) => lists[k].push(a),
-                None => stay.push(a),
+        if children.is_empty() {
+            out[index].own.1 = offset + arcs.len() as u32;
+            return;
+        }
+        // Where each arc goes, then a stable counting scatter: own arcs first, then by child.
+        let target = |g: &Arc| {
+            g.mid()
+                .and_then(|m| {
+                    let (best, _) = children
+                        .iter()
+                        .enumerate()
+                        .map(|(k, c)| (k, c.cell.score(m)))
+                        .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
+                    (best < children.len() && self.fits(&children[best], g)).then_some(best as u8)
+                })
+                .unwrap_or(STAY)
+        };
+        let targets: Vec<u8> = if arcs.len() > PARALLEL_ARCS {
+            arcs.par_iter().with_min_len(4096).map(target).collect()
+        } else {
+            arcs.iter().map(target).collect()
+        };
+        let bucket = |t: u8| if t == STAY { 0 } else { usize::from(t) + 1 };
+        let mut starts = vec![0usize; children.len() + 2];
+        for &t in &targets {
+            starts[bucket(t) + 1] += 1;
+        }
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        let mut next = starts.clone();
+        for (g, &t) in arcs.iter().zip(&targets) {
+            let b = bucket(t);
+            scratch[next[b]] = *g;
+            next[b] += 1;
+        }
+        arcs.copy_from_slice(scratch);
+        out[index].own.1 = offset + starts[1] as u32;
+
+        // The children's ranges, split off the two buffers in order.
+        let parallel = arcs.len() > PARALLEL_ARCS;
+        let mut work = Vec::new();
+        let (mut rest, mut rest_scratch) = (&mut arcs[starts[1]..], &mut scratch[starts[1]..]);
+        for k in 0..children.len() {
+            let len = starts[k + 2] - starts[k + 1];
+            let (these, tail) = rest.split_at_mut(len);
+            let (these_scratch, tail_scratch) = rest_scratch.split_at_mut(len);
+            (rest, rest_scratch) = (tail, tail_scratch);
+            if len > 0 {
+                work.push((children[k].cell, these, these_scratch, offset + starts[k + 1] as u32));
             }
         }
-        let start = self.order.len() as u32;
-        self.order.extend_from_slice(&stay);
-        self.nodes[index as usize].own = (start, self.order.len() as u32);
-        for (k, list) in lists.into_iter().enumerate() {
-            if !list.is_empty() {
-                let child = self.node(Some(children[k]), depth + 1, list);
-                self.nodes[index as usize].children.push(child);
+        if parallel {
+            let subtrees: Vec<Vec<BuildNode>> = work
+                .into_par_iter()
+                .map(|(cell, these, these_scratch, at)| {
+                    let mut sub = Vec::new();
+                    self.node(Some(cell), depth + 1, these, these_scratch, at, &mut sub);
+                    sub
+                })
+                .collect();
+            for sub in subtrees {
+                let node_offset = out.len() as u32;
+                out[index].children.push(node_offset);
+                out.extend(sub.into_iter().map(|mut n| {
+                    n.children.iter_mut().for_each(|c| *c += node_offset);
+                    n
+                }));
+            }
+        } else {
+            for (cell, these, these_scratch, at) in work {
+                let child = out.len() as u32;
+                self.node(Some(cell), depth + 1, these, these_scratch, at, out);
+                out[index].children.push(child);
             }
         }
-        self.nodes[index as usize].sub_end = self.order.len() as u32;
-        index
     }
+}
+
+/// The widest angle between the unit vector `c` and the unit vectors `points`. The exact angle
+/// (`atan2` of the cross and dot products, accurate at every size) is evaluated only for points
+/// whose dot product is within rounding of the smallest so far, so the result is the exact
+/// maximum over all points at a few `atan2` calls per node instead of one per point.
+pub(crate) fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
+    // A dot product of unit vectors is off by at most a few ulp of 1; two points whose true
+    // angles are in the opposite order of their rounded dot products differ by less than this.
+    const DOT_SLACK: f64 = 1e-15;
+    let mut cos_min = f64::INFINITY;
+    let mut widest = 0.0f64;
+    for p in points {
+        let d = c.dot(p);
+        if d <= cos_min + DOT_SLACK {
+            cos_min = cos_min.min(d);
+            widest = widest.max(c.cross(p).length().atan2(d));
+        }
+    }
+    widest
 }
 
 /// The cap of a set of unit endpoints: `[cx, cy, cz, threshold]` with the centre in `f32` and the
@@ -535,7 +730,7 @@ fn bounding_cap(points: impl Iterator<Item = DVec3> + Clone, cell_center: Option
     for center in [cell_center, (mean.length() > 1e-12).then(|| mean.normalize())].into_iter().flatten() {
         let c32 = center.as_vec3();
         let c = c32.as_dvec3().normalize();
-        let r = points.clone().map(|p| c.cross(p).length().atan2(c.dot(p))).fold(0.0f64, f64::max);
+        let r = widest_angle(c, points.clone());
         if best.is_none_or(|(_, b)| r < b) {
             best = Some((c32.to_array(), r));
         }
@@ -557,28 +752,24 @@ fn round_up(x: f64) -> f32 {
 impl GaussMapHierarchy {
     /// Builds the hierarchy over candidates with `normals` (see [`crate::FeatureEdges`]).
     pub fn build(normals: &[[Vec3; 2]], options: &GaussMapOptions, cost: &CostModel) -> Self {
-        let geo = arc_geometry(normals);
+        let mut arcs = arc_records(normals);
         let max_depth = options.max_depth.unwrap_or_else(|| depth_for_count(normals.len(), options.base)).min(12);
-        let mut builder = Builder {
-            geo: &geo,
-            bins: options.bins,
-            max_depth,
-            base: base_cells(options.base),
-            nodes: Vec::new(),
-            order: Vec::with_capacity(normals.len()),
-        };
-        builder.node(None, 0, (0..normals.len() as u32).collect());
-        let Builder { nodes, order, .. } = builder;
+        let builder = Builder { bins: options.bins, max_depth, base: base_cells(options.base) };
+        let mut nodes = Vec::new();
+        let mut scratch = vec![Arc::default(); arcs.len()];
+        builder.node(None, 0, &mut arcs, &mut scratch, 0, &mut nodes);
+        drop(scratch);
+        let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
 
-        // Caps over each subtree's endpoints (contiguous in the preorder `order`).
+        // Caps over each subtree's endpoints (contiguous in the preorder arc order).
         let caps: Vec<[f32; 4]> = nodes
             .par_iter()
             .map(|n| {
-                let range = &order[n.own.0 as usize..n.sub_end as usize];
-                let points = range.iter().flat_map(|&a| [geo[a as usize].n1, geo[a as usize].n2]);
-                bounding_cap(points, n.cell_center)
+                let range = &arcs[n.own.0 as usize..n.sub_end as usize];
+                bounding_cap(range.iter().flat_map(|a| [a.n1, a.n2]), n.cell_center)
             })
             .collect();
+        drop(arcs);
         let assigned =
             LevelHistogram::from_nodes(nodes.iter().map(|n| (u32::from(n.depth), (n.own.1 - n.own.0) as usize)));
 
@@ -834,7 +1025,7 @@ impl GaussMapHierarchy {
             }
             centers.push(c.normalize_or_zero());
         }
-        let geo = arc_geometry(normals);
+        let geo = arc_records(normals);
         for_each_in_subtrees(&flat, &parent, &arrays.order, |node, a| {
             let threshold = f64::from(caps[node][3]);
             if threshold >= 1.0 {
@@ -887,6 +1078,47 @@ fn visit_probabilities(nodes: &[BuildNode], caps: &[[f32; 4]]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn arc_paths_equal_arc_path_arc_by_arc() {
+        let mut rng = crate::measure::ViewRng::new(7);
+        let base = base_cells(BaseSolid::Icosahedron);
+        // Random arcs of every length (short ones go deep), plus zero and antipodal ones.
+        let mut unit: Vec<[DVec3; 2]> = (0..20_000)
+            .map(|k| {
+                let a = rng.direction().as_dvec3().normalize();
+                let spread = [1e-4, 1e-2, 0.1, 0.5, 2.0][k % 5];
+                let b = (a + rng.direction().as_dvec3() * spread).normalize_or_zero();
+                [a, b]
+            })
+            .collect();
+        unit.push([DVec3::ZERO, DVec3::Z]);
+        unit.push([DVec3::X, DVec3::NEG_X]);
+        for level in [0u8, 3, 6] {
+            let batch = arc_paths(&unit, &base, level, f64::from(DEFAULT_OVERLAP));
+            let deep = batch.iter().filter(|p| p.1 > level).count();
+            assert!(deep > 1000, "level {level}: only {deep} arcs reached the deepest level");
+            for (i, &[a, b]) in unit.iter().enumerate() {
+                assert_eq!(
+                    batch[i],
+                    arc_path(a, b, &base, level, f64::from(DEFAULT_OVERLAP)),
+                    "arc {i}, level {level}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn widest_angle_is_the_exact_maximum() {
+        let mut rng = crate::measure::ViewRng::new(11);
+        for round in 0..200 {
+            let c = rng.direction().as_dvec3().normalize();
+            let spread = [1e-7, 1e-3, 0.3, 1.5][round % 4];
+            let points: Vec<DVec3> = (0..500).map(|_| (c + rng.direction().as_dvec3() * spread).normalize()).collect();
+            let exact = points.iter().map(|p| c.cross(*p).length().atan2(c.dot(*p))).fold(0.0f64, f64::max);
+            assert_eq!(widest_angle(c, points.iter().copied()), exact, "round {round}");
+        }
+    }
 
     #[test]
     fn base_solids_tile_the_sphere() {

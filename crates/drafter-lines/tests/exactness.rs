@@ -309,3 +309,27 @@ fn standalone_hierarchies_answer_in_input_order() {
         assert_eq!(a, b);
     }
 }
+
+/// Above 32k candidates the builds split their work over the thread pool (the Gauss map's cell
+/// partitions, the cone BVH's dual-space subtrees and bins): the hierarchies must come out the
+/// same on one thread and on several, and still answer as brute force.
+#[test]
+fn parallel_builds_equal_single_thread_builds() {
+    let mesh = noisy_sphere(400, 200, 0.02, 5);
+    let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+    let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+    assert!(lines.candidates.len() > 2 * 32 * 1024, "{} candidates: too few to split", lines.candidates.len());
+    let options = forced(GaussMapOptions::default(), ConeBvhOptions::default());
+    let build_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| SilhouetteIndex::build(&lines, &options).to_arrays())
+    };
+    let one = build_on(1);
+    assert!(one.gauss_map.is_some() && one.cone_bvh.is_some());
+    assert!(one == build_on(2), "2 threads built other hierarchies than 1");
+    assert!(one == build_on(3), "3 threads built other hierarchies than 1");
+    let x = Indexed { index: SilhouetteIndex::build(&lines, &options), lines, mesh };
+    let mut rng = Rng::new(99);
+    let v = views(&x, &mut rng, 300, 300);
+    assert_eq!(check(&x, &v), 600, "every view checked against brute force");
+}
