@@ -67,6 +67,9 @@ pub struct Renderer {
     last_frame: Option<FrameInfo>,
     /// The shadow of the frame being recorded.
     shadow_plan: shadow::ShadowPlan,
+    /// What the display and lines pipelines write: [`OUTPUT_FORMAT`] headless, the surface's
+    /// format in a window (where screenshots render offscreen in the same format).
+    output_format: wgpu::TextureFormat,
 }
 
 impl Renderer {
@@ -106,6 +109,7 @@ impl Renderer {
             targets: None,
             last_frame: None,
             shadow_plan: shadow::ShadowPlan { layers: Vec::new(), resolve: None },
+            output_format,
         })
     }
 
@@ -158,7 +162,7 @@ impl Renderer {
         if self.targets.as_ref().is_none_or(|t| t.targets.size != size) {
             let device = &self.gpu.device;
             self.targets = Some(scoped(device, || {
-                let targets = Targets::new(device, size);
+                let targets = Targets::new(device, size, self.output_format);
                 let enhance = self.enhance.bindings(device, &targets);
                 let display = self.display.bind_group(device, &targets);
                 let lines = self.lines.targets_bind_group(device, &targets);
@@ -251,6 +255,12 @@ impl Renderer {
 
     /// Renders one frame offscreen and reads it back, down-sampled to `options.size`.
     pub fn render(&mut self, options: &RenderOptions) -> Result<Image, RenderError> {
+        use wgpu::TextureFormat as F;
+        let swap_red_blue = match self.output_format {
+            F::Rgba8Unorm | F::Rgba8UnormSrgb => false,
+            F::Bgra8Unorm | F::Bgra8UnormSrgb => true,
+            other => return Err(RenderError::Gpu(format!("cannot read back {other:?} pixels as RGBA8"))),
+        };
         let device = self.gpu.device.clone();
         let guard = ErrorScopes::push(&device);
         let mut encoder =
@@ -278,8 +288,11 @@ impl Renderer {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([encoder.finish()]);
-        let rgba = read_buffer(&device, &readback, bytes_per_row, w, h)?;
+        let mut rgba = read_buffer(&device, &readback, bytes_per_row, w, h)?;
         guard.pop()?;
+        if swap_red_blue {
+            rgba.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
         Ok(Image { width: w, height: h, rgba }.downsample(options.supersample))
     }
 

@@ -72,7 +72,9 @@ pub struct Targets {
 }
 
 impl Targets {
-    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Targets {
+    /// Targets of `size`; the offscreen output (headless renders and screenshots) in `output_format`,
+    /// the format the display and lines pipelines were built for.
+    pub fn new(device: &wgpu::Device, size: (u32, u32), output_format: wgpu::TextureFormat) -> Targets {
         use wgpu::TextureUsages as U;
         let sampled = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
         let reduced = |k: u32| (size.0.div_ceil(k), size.1.div_ceil(k));
@@ -94,7 +96,7 @@ impl Targets {
                 SHADOW_STENCIL_FORMAT,
                 U::RENDER_ATTACHMENT,
             ),
-            output: Target::new(device, "display output", size, OUTPUT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC),
+            output: Target::new(device, "display output", size, output_format, U::RENDER_ATTACHMENT | U::COPY_SRC),
         }
     }
 }

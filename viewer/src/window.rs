@@ -7,11 +7,12 @@
 //!   ([`crate::camera`]): dragging right turns the object's front to the right.
 //! * wheel: zoom about the frame's centre; right or middle drag: pan.
 //! * `1`–`7`: style (gradient, cel, gooch, goochel, phong, metal, hatch); `S`: next style.
-//! * `E` image-space edges, `L` baked lines, `H` drop shadow, `O` orthographic, `R` reset the view.
+//! * `E` image-space edges, `L` baked lines, `H` next drop shadow (none, hard, penumbra, soft),
+//!   `O` orthographic, `R` reset the view.
 //! * left click (no drag): pick the part under the cursor (the G-buffer's part-id target read
 //!   back); its name and parameters are printed and shown in the title, and it is highlighted.
-//! * `P`: save a screenshot PNG (`<file stem>-<n>.png` in the working directory, at the window's
-//!   size with 2× supersampling).
+//! * `P`: save a screenshot PNG (`<file stem>-<n>.png` beside the model, at the window's size with
+//!   2× supersampling; the path is printed).
 //! * `Esc` / `Q`: quit.
 //!
 //! Everything an event changes goes through pure functions ([`Orbit`], [`action_for_key`],
@@ -118,7 +119,7 @@ pub enum Action {
     NextStyle,
     ToggleEdges,
     ToggleLines,
-    ToggleShadow,
+    NextShadow,
     ToggleOrthographic,
     ResetView,
     Screenshot,
@@ -136,7 +137,7 @@ pub fn action_for_key(key: &Key) -> Option<Action> {
                 's' => Some(Action::NextStyle),
                 'e' => Some(Action::ToggleEdges),
                 'l' => Some(Action::ToggleLines),
-                'h' => Some(Action::ToggleShadow),
+                'h' => Some(Action::NextShadow),
                 'o' => Some(Action::ToggleOrthographic),
                 'r' => Some(Action::ResetView),
                 'p' => Some(Action::Screenshot),
@@ -147,9 +148,6 @@ pub fn action_for_key(key: &Key) -> Option<Action> {
         _ => None,
     }
 }
-
-/// The shadow `H` turns on.
-pub const TOGGLE_SHADOW: ShadowMode = ShadowMode::Soft;
 
 impl Action {
     /// Applies a view or style change to `options` and `orbit`; `false` for the actions the
@@ -166,8 +164,9 @@ impl Action {
                     if options.enhancements.any() { Enhancements::default() } else { Enhancements::ALL };
             }
             Action::ToggleLines => options.lines = !options.lines,
-            Action::ToggleShadow => {
-                options.shadow = if options.shadow == ShadowMode::None { TOGGLE_SHADOW } else { ShadowMode::None };
+            Action::NextShadow => {
+                let at = ShadowMode::ALL.iter().position(|&m| m == options.shadow).unwrap_or(0);
+                options.shadow = ShadowMode::ALL[(at + 1) % ShadowMode::ALL.len()];
             }
             Action::ToggleOrthographic => options.orthographic = !options.orthographic,
             Action::ResetView => *orbit = Orbit::default(),
@@ -307,12 +306,13 @@ impl App {
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, Some(&surface)))
             .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
         let capabilities = surface.get_capabilities(&adapter);
-        // Colours are display values end to end: prefer a non-sRGB surface.
-        let format = capabilities
-            .formats
-            .iter()
-            .copied()
-            .find(|f| !f.is_srgb())
+        // Colours are display values end to end: prefer a non-sRGB surface, and an 8-bit RGBA or
+        // BGRA one, which screenshots can read back.
+        let eight_bit = [wgpu::TextureFormat::Bgra8Unorm, wgpu::TextureFormat::Rgba8Unorm];
+        let format = eight_bit
+            .into_iter()
+            .find(|f| capabilities.formats.contains(f))
+            .or_else(|| capabilities.formats.iter().copied().find(|f| !f.is_srgb()))
             .or_else(|| capabilities.formats.first().copied())
             .ok_or_else(|| WindowError::Window("the surface supports no format".into()))?;
         let gpu = Gpu::with_adapter(instance, adapter)?;
@@ -366,10 +366,25 @@ impl App {
         let options = RenderOptions { supersample: 2, ..self.options.clone() };
         let image = state.renderer.render(&options)?;
         let stem = self.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "drafter".into());
-        let path = screenshot_path(Path::new("."), &stem);
         let png = image.to_png().map_err(|e| WindowError::Window(e.to_string()))?;
-        std::fs::write(&path, png).map_err(|e| WindowError::Window(format!("{}: {e}", path.display())))?;
-        println!("screenshot: {}", path.display());
+        // Beside the model; where that folder is read-only, in the working directory. A failed
+        // write is reported and the window goes on.
+        let beside = self.file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let mut failures = Vec::new();
+        for folder in [beside, Path::new(".")] {
+            let path = screenshot_path(folder, &stem);
+            match std::fs::write(&path, &png) {
+                Ok(()) => {
+                    println!("screenshot: {}", path.display());
+                    failures.clear();
+                    break;
+                }
+                Err(e) => failures.push(format!("{}: {e}", path.display())),
+            }
+        }
+        if !failures.is_empty() {
+            eprintln!("drafter: screenshot not saved ({})", failures.join("; "));
+        }
         // The screenshot drew at another size: the next frame resizes the targets back.
         state.window.request_redraw();
         Ok(())
@@ -543,7 +558,7 @@ mod tests {
         assert_eq!(action_for_key(&key("S")), Some(Action::NextStyle));
         assert_eq!(action_for_key(&key("e")), Some(Action::ToggleEdges));
         assert_eq!(action_for_key(&key("L")), Some(Action::ToggleLines));
-        assert_eq!(action_for_key(&key("h")), Some(Action::ToggleShadow));
+        assert_eq!(action_for_key(&key("h")), Some(Action::NextShadow));
         assert_eq!(action_for_key(&key("p")), Some(Action::Screenshot));
         assert_eq!(action_for_key(&Key::Named(NamedKey::Escape)), Some(Action::Quit));
         assert_eq!(action_for_key(&Key::Named(NamedKey::Enter)), None);
@@ -570,10 +585,13 @@ mod tests {
         assert_eq!(options.enhancements, Enhancements::ALL);
         Action::ToggleEdges.apply(&mut options, &mut orbit);
         assert!(!options.enhancements.any());
-        Action::ToggleShadow.apply(&mut options, &mut orbit);
-        assert_eq!(options.shadow, TOGGLE_SHADOW);
-        Action::ToggleShadow.apply(&mut options, &mut orbit);
-        assert_eq!(options.shadow, ShadowMode::None);
+        // `H` reaches every shadow mode, then none again.
+        let mut shadows = Vec::new();
+        for _ in 0..ShadowMode::ALL.len() {
+            Action::NextShadow.apply(&mut options, &mut orbit);
+            shadows.push(options.shadow);
+        }
+        assert_eq!(shadows, [ShadowMode::Hard, ShadowMode::Penumbra, ShadowMode::Soft, ShadowMode::None]);
         orbit.rotate(50.0, 20.0);
         Action::ResetView.apply(&mut options, &mut orbit);
         assert_eq!(orbit, Orbit::default());

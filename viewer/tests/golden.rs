@@ -144,3 +144,23 @@ fn lines_on_the_sample_and_a_corpus_part() {
         )],
     );
 }
+
+/// A window renders in its surface's format (BGRA on X11 and Windows); screenshots render the
+/// same frame offscreen in that format and read it back. The image must equal the headless RGBA
+/// render pixel for pixel (this failed with a validation error that closed the window).
+#[test]
+fn bgra_output_reads_back_as_the_rgba_render() {
+    let model = common::sample();
+    let options = options(Style::Gooch);
+    let mut rgba = common::renderer();
+    rgba.set_model(&model).expect("upload");
+    let expected = rgba.render(&options).expect("rgba render");
+    let gpu = drafter_viewer::context::Gpu::headless().expect("adapter");
+    let mut bgra =
+        drafter_viewer::renderer::Renderer::with_gpu(gpu, wgpu::TextureFormat::Bgra8Unorm).expect("bgra renderer");
+    bgra.set_model(&model).expect("upload");
+    let image = bgra.render(&options).expect("bgra render");
+    assert_eq!((image.width, image.height), (expected.width, expected.height));
+    let differing = image.rgba.iter().zip(&expected.rgba).filter(|(a, b)| a.abs_diff(**b) > 1).count();
+    assert_eq!(differing, 0, "{differing} channel values differ between the BGRA and RGBA renders");
+}
