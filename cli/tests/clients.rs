@@ -33,7 +33,19 @@ fn client(args: &[&str]) -> Value {
 }
 
 fn bake(input: &Path, output: &Path) {
-    let out = common::drafter().arg("bake").arg(input).arg("-o").arg(output).arg("--quiet").output().expect("runs");
+    bake_with(input, output, &[]);
+}
+
+fn bake_with(input: &Path, output: &Path, extra: &[&str]) {
+    let out = common::drafter()
+        .arg("bake")
+        .arg(input)
+        .arg("-o")
+        .arg(output)
+        .arg("--quiet")
+        .args(extra)
+        .output()
+        .expect("runs");
     assert!(out.status.success(), "{}: {}", input.display(), String::from_utf8_lossy(&out.stderr));
 }
 
@@ -72,13 +84,41 @@ fn three_js_sees_the_triangles_our_reader_sees() {
         models.join("gltf/RodAssembly/rod.glb"),
     ];
     for input in inputs {
-        let output = dir.join("baked.glb");
-        bake(&input, &output);
-        let bytes = std::fs::read(&output).expect("baked");
-        let ours = drafter_io::import_bytes(&output, &bytes).expect("imports").scene.instanced_triangle_count();
-        let json = client(&["three", output.to_str().expect("utf-8")]);
-        assert_eq!(json["triangles"].as_u64(), Some(ours as u64), "{}: {json}", input.display());
+        // Plain, and with EXT_meshopt_compression (three.js decodes it with its MeshoptDecoder).
+        for extra in [&[][..], &["--compress"][..]] {
+            let output = dir.join("baked.glb");
+            bake_with(&input, &output, extra);
+            let bytes = std::fs::read(&output).expect("baked");
+            let ours = drafter_io::import_bytes(&output, &bytes).expect("imports").scene.instanced_triangle_count();
+            let json = client(&["three", output.to_str().expect("utf-8")]);
+            assert_eq!(json["triangles"].as_u64(), Some(ours as u64), "{} {extra:?}: {json}", input.display());
+        }
     }
+}
+
+/// CesiumJS reads `--compress` files (EXT_meshopt_compression) and draws the same edges as from
+/// the plain file: the same cylinder, the same view, pixel for pixel.
+#[test]
+fn cesium_draws_the_same_edges_from_a_compressed_file() {
+    let dir = common::scratch("clients-cesium-compressed");
+    let obj = dir.join("cylinder.obj");
+    std::fs::write(&obj, cylinder_obj(64)).expect("writes");
+    let mut shots = Vec::new();
+    for (name, extra) in [("plain", &[][..]), ("compressed", &["--compress"][..])] {
+        let baked = dir.join(format!("{name}.glb"));
+        bake_with(&obj, &baked, extra);
+        let shot = dir.join(format!("{name}.png"));
+        let (file, image) = (baked.to_str().expect("utf-8"), shot.to_str().expect("utf-8"));
+        client(&["cesium", file, "--view", "0,15", "--edge-color", "255,0,0", "--screenshot", image]);
+        shots.push(shot);
+    }
+    let plain = std::fs::read(dir.join("plain.glb")).expect("plain");
+    let packed = std::fs::read(dir.join("compressed.glb")).expect("compressed");
+    assert!(packed.len() < plain.len(), "compressed {} B, plain {} B", packed.len(), plain.len());
+    let whole = "0,0,800,600";
+    let (a, b) = (pixels(&shots[0], whole), pixels(&shots[1], whole));
+    assert!(a > 500, "the plain file drew only {a} edge pixels");
+    assert_eq!(a, b, "edge pixels: plain {a}, compressed {b}");
 }
 
 /// The merged draft's `silhouetteNormals` (VEC3) as CesiumJS reads them: the curved side of a

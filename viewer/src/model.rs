@@ -135,6 +135,10 @@ impl Model {
     /// As [`Self::load`], for bytes already read from `path` (which names the file and resolves a
     /// glTF's external buffers).
     pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Model, LoadError> {
+        // A compressed GLB (EXT_meshopt_compression) is decoded once, and everything below reads
+        // the plain bytes; a stream that does not decode is reported by the import.
+        let plain = drafter_core::meshopt::decompress_glb(bytes).ok().flatten();
+        let bytes = plain.as_deref().unwrap_or(bytes);
         let imported = drafter_io::import_bytes(path, bytes)?;
         let baked = read_baked(path, bytes)?;
         let normal_sets = match &baked {

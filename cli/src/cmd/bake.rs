@@ -54,6 +54,11 @@ pub struct Args {
     #[arg(long, value_enum)]
     pub obb: Option<ObbArg>,
     /// Skip the normal stage (keep the input's normals and vertex layout).
+    /// Compress the file with EXT_meshopt_compression (lossless; .glb only; readers need the
+    /// extension: three.js with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress =
+    /// "meshopt"` in the config.
+    #[arg(long)]
+    pub compress: bool,
     #[arg(long)]
     pub no_normals: bool,
     /// Write the enhanced normals into NORMAL (and the crease-aware ones into _ENHANCED_NORMAL), so
@@ -136,6 +141,9 @@ pub fn run(args: Args) -> Result<()> {
             ObbArg::Optimal => ObbMethod::Optimal,
         };
     }
+    if args.compress {
+        config.compress = drafter_bake::Compression::Meshopt;
+    }
     if args.no_normals {
         config.normals.enabled = false;
     }
@@ -204,6 +212,18 @@ pub fn run(args: Args) -> Result<()> {
             share(b.json),
             share(b.other)
         );
+        if let Some(c) = &r.compression {
+            eprintln!(
+                "  compressed (EXT_meshopt_compression): {} of {} buffer views, {} → {} bytes; file {} → {} bytes ({:.2}×)",
+                c.encoded_views,
+                c.views,
+                drafter_core::thousands(c.encoded_bytes_before as usize),
+                drafter_core::thousands(c.encoded_bytes_after as usize),
+                drafter_core::thousands(c.file_bytes_before as usize),
+                drafter_core::thousands(c.file_bytes_after as usize),
+                c.file_bytes_before as f64 / c.file_bytes_after.max(1) as f64
+            );
+        }
         if let Some(t) = &r.textures {
             let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
             eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);

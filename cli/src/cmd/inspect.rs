@@ -59,6 +59,10 @@ pub struct Report {
     /// The `DRAFTER_illustration` data of a baked file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub baked: Option<BakedSummary>,
+    /// `EXT_meshopt_compression`: views encoded and their bytes (`file_bytes_before`: the file
+    /// decoded); absent for a plain file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compression: Option<drafter_core::meshopt::CompressionStats>,
 }
 
 /// What a baked file carries: the root extension and every part, by id.
@@ -154,7 +158,21 @@ pub fn run(args: Args) -> Result<()> {
         (None, WeldMode::Exact) => Weld::Exact,
     };
     let mut report = build_report(&args.file.display().to_string(), &imported.scene, imported.diagnostics, weld);
-    report.baked = read_baked(&args.file, &bytes)?;
+    // A compressed GLB: what is encoded, then the baked data from the decoded bytes.
+    let json = drafter_core::glb::split(&bytes).ok().map(|c| c.json);
+    report.compression = json.and_then(drafter_core::meshopt::describe).map(|mut stats| {
+        stats.file_bytes_after = bytes.len() as u64;
+        stats
+    });
+    let plain = match report.compression {
+        Some(_) => drafter_core::meshopt::decompress_glb(&bytes)
+            .map_err(|e| BadInput(format!("{}: {e}", args.file.display())))?,
+        None => None,
+    };
+    if let (Some(stats), Some(plain)) = (report.compression.as_mut(), &plain) {
+        stats.file_bytes_before = plain.len() as u64;
+    }
+    report.baked = read_baked(&args.file, plain.as_deref().unwrap_or(&bytes))?;
     if args.json {
         out!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -232,6 +250,7 @@ pub fn build_report(file: &str, scene: &Scene, diagnostics: Vec<Diagnostic>, wel
         mesh_topology,
         diagnostics,
         baked: None,
+        compression: None,
     }
 }
 
@@ -250,6 +269,20 @@ fn print_text(r: &Report) -> anyhow::Result<()> {
     );
     let f = |v: [f64; 3]| format!("({:.6}, {:.6}, {:.6})", v[0], v[1], v[2]);
     out!("  world bounds {} .. {}  size {}", f(r.bounds.min), f(r.bounds.max), f(r.bounds.size));
+    if let Some(c) = &r.compression {
+        let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { 0.0 };
+        out!(
+            "  compressed (EXT_meshopt_compression): {} of {} buffer views, {} → {} bytes ({:.2}×); file {} bytes, {} decoded ({:.2}×)",
+            c.encoded_views,
+            c.views,
+            drafter_core::thousands(c.encoded_bytes_before as usize),
+            drafter_core::thousands(c.encoded_bytes_after as usize),
+            ratio(c.encoded_bytes_before, c.encoded_bytes_after),
+            drafter_core::thousands(c.file_bytes_after as usize),
+            drafter_core::thousands(c.file_bytes_before as usize),
+            ratio(c.file_bytes_before, c.file_bytes_after),
+        );
+    }
     let t = &r.topology;
     out!(
         "  topology (welded, per unique mesh, summed): {} welded vertices, {} edges, {} boundary, {} non-manifold, {} components, {} degenerate triangles",

@@ -40,6 +40,9 @@
 //! steps = 3
 //! specular = true
 //!
+//! [output]
+//! compress = "meshopt"       # "none" (default) or "meshopt": EXT_meshopt_compression, lossless, .glb only
+//!
 //! [[part]]                   # any number; `name` or `id` selects the part(s)
 //! name = "gear"
 //! method = "optimal"
@@ -82,6 +85,21 @@ pub struct BakeConfig {
     /// Provenance written into the file.
     pub input: InputInfo,
     pub container: Container,
+    /// How the written file is compressed (`[output] compress`, `drafter bake --compress`).
+    pub compress: Compression,
+}
+
+/// Compression of the written file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Compression {
+    /// Plain buffers (the default): any glTF reader opens the file.
+    #[default]
+    None,
+    /// `EXT_meshopt_compression` on the buffer views where it pays, lossless (see
+    /// `drafter_core::meshopt`); readers need the extension (three.js with its MeshoptDecoder,
+    /// CesiumJS, gltfpack, our own). GLB output only.
+    Meshopt,
 }
 
 impl Default for BakeConfig {
@@ -97,6 +115,7 @@ impl Default for BakeConfig {
             overrides: Vec::new(),
             input: InputInfo { name: String::new(), format: String::new(), sha256: String::new() },
             container: Container::Glb,
+            compress: Compression::None,
         }
     }
 }
@@ -255,8 +274,16 @@ struct FileConfig {
     lines: LinesSection,
     #[serde(default)]
     textures: TexturesSection,
+    #[serde(default)]
+    output: OutputSection,
     #[serde(default, rename = "part")]
     parts: Vec<PartOverride>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OutputSection {
+    compress: Option<Compression>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -317,6 +344,9 @@ impl BakeConfig {
         let file: FileConfig = toml::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))?;
         if let Some(mode) = file.segment.mode {
             self.segment.mode = mode;
+        }
+        if let Some(c) = file.output.compress {
+            self.compress = c;
         }
         if let Some(angle) = file.segment.region_angle_deg {
             if !(0.0..=180.0).contains(&angle) {

@@ -25,9 +25,9 @@ use std::time::Instant;
 use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
 use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
 use drafter_format::{
-    BakeOutput, BoxRecord, ConeBvhData, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord, HardEdgeClass,
-    InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges, ProjectorRecord,
-    RootExtension, TextureImage, VertexData, Written,
+    BakeOutput, BoxRecord, ConeBvhData, Container, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord,
+    HardEdgeClass, InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges,
+    ProjectorRecord, RootExtension, TextureImage, VertexData, Written,
 };
 use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
@@ -36,8 +36,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use config::{
-    BakeConfig, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage, PartOverride,
-    PartSelector, STYLES, TexturesStage,
+    BakeConfig, Compression, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage,
+    PartOverride, PartSelector, STYLES, TexturesStage,
 };
 pub use textures::{TextureReport, TexturesSummary};
 
@@ -74,8 +74,12 @@ pub struct BakeReport {
     pub stages: Vec<StageTiming>,
     /// Bytes of the written file(s).
     pub output_bytes: u64,
-    /// The same bytes by what they hold (geometry, normals, Khronos edges, hierarchies, ...).
+    /// The same bytes by what they hold (geometry, normals, Khronos edges, hierarchies, ...),
+    /// before compression.
     pub sections: drafter_format::ByteSections,
+    /// What `--compress` did (absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compression: Option<drafter_core::meshopt::CompressionStats>,
     /// What the normal stage did, summed over unique meshes (absent when it was off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normals: Option<NormalsSummary>,
@@ -264,11 +268,24 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     for note in &written.notes {
         diagnostics.push(Diagnostic { kind: DiagnosticKind::Output, count: 1, first_example: note.clone() });
     }
-    timed("write", start);
 
-    let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
     let sections = drafter_format::byte_sections(&written.main, &|_| written.bin.clone())
         .map_err(|e| BakeError::Internal { stage: "write", message: format!("the written file does not read: {e}") })?;
+    let mut written = written;
+    let compression = match (config.compress, &config.container) {
+        (Compression::None, _) => None,
+        (Compression::Meshopt, Container::Glb) => {
+            let (main, stats) = drafter_core::meshopt::compress_glb(&written.main)
+                .map_err(|e| BakeError::Internal { stage: "write", message: format!("compression: {e}") })?;
+            written.main = main;
+            Some(stats)
+        }
+        (Compression::Meshopt, Container::Gltf { .. }) => {
+            return Err(BakeError::Config("compression (meshopt) writes .glb files only".into()));
+        }
+    };
+    timed("write", start);
+    let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
     diagnostics.sort_by_key(|d| d.kind);
     let report = BakeReport {
         input: config.input.clone(),
@@ -277,6 +294,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         stages,
         output_bytes,
         sections,
+        compression,
         normals: normals_summary,
         lines: lines_summary,
         textures: textures_summary,

@@ -42,9 +42,10 @@ impl Rng {
     }
 }
 
-fn check(path: &Path) -> usize {
+fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
     let imported = drafter_io::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let baked = drafter_bake::bake(&imported.scene, &drafter_bake::BakeConfig::default()).expect("bakes");
+    let config = drafter_bake::BakeConfig { compress, ..Default::default() };
+    let baked = drafter_bake::bake(&imported.scene, &config).expect("bakes");
     let bytes = baked.written.main;
     let file = drafter_format::read(&bytes, &|_| None).expect("reads");
     let scene = drafter_io::import_bytes(Path::new("baked.glb"), &bytes).expect("imports").scene;
@@ -119,9 +120,36 @@ fn stored_hierarchies_answer_as_brute_force_over_the_decoded_file() {
         "obj/common-3d-test-models/stanford-bunny.obj",
         "obj/v-hacd/crank.off",
     ] {
-        let n = check(&model(rel));
+        let n = check(&model(rel), drafter_bake::Compression::None);
         assert!(n > 0, "{rel}: no stored hierarchy to check");
         total += n;
     }
     assert!(total >= 3);
+}
+
+/// `--compress` is lossless: the compressed file reads back to the same illustration data and
+/// the same imported scene as the plain one, and its hierarchies answer as brute force over what
+/// a reader decodes from it.
+#[test]
+fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
+    let path = model("obj/common-3d-test-models/fandisk.obj");
+    let imported = drafter_io::import(&path).expect("imports");
+    let bake = |compress| {
+        let config = drafter_bake::BakeConfig { compress, ..Default::default() };
+        drafter_bake::bake(&imported.scene, &config).expect("bakes")
+    };
+    let (plain, packed) = (bake(drafter_bake::Compression::None), bake(drafter_bake::Compression::Meshopt));
+    let stats = packed.report.compression.clone().expect("compression stats");
+    assert!(stats.encoded_views > 0 && stats.encoded_bytes_after < stats.encoded_bytes_before, "{stats:?}");
+    assert!(packed.written.main.len() < plain.written.main.len());
+    assert_eq!(stats.file_bytes_after, packed.written.main.len() as u64);
+    let read = |bytes: &[u8]| drafter_format::read(bytes, &|_| None).expect("reads");
+    assert_eq!(read(&packed.written.main), read(&plain.written.main));
+    let scene = |bytes: &[u8]| drafter_io::import_bytes(Path::new("baked.glb"), bytes).expect("imports").scene;
+    let (a, b) = (scene(&packed.written.main), scene(&plain.written.main));
+    assert_eq!(a.meshes.len(), b.meshes.len());
+    for (x, y) in a.meshes.iter().zip(&b.meshes) {
+        assert_eq!((&x.positions, &x.triangles, &x.normals), (&y.positions, &y.triangles, &y.normals));
+    }
+    assert!(check(&path, drafter_bake::Compression::Meshopt) > 0);
 }

@@ -18,6 +18,7 @@ mod diagnostic;
 pub mod glb;
 pub mod gradient;
 mod ids;
+pub mod meshopt;
 mod obb_method;
 mod param;
 mod scene;

@@ -5,6 +5,18 @@
 use serde_json::Value;
 
 use crate::FormatError;
+
+/// `bytes`, or the plain GLB they decode to when they use `EXT_meshopt_compression` (see
+/// `drafter_core::meshopt`): every reader here takes compressed and plain files alike.
+fn plain(bytes: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, FormatError> {
+    if drafter_core::glb::is_glb(bytes)
+        && let Some(decoded) =
+            drafter_core::meshopt::decompress_glb(bytes).map_err(|e| FormatError::Invalid(e.to_string()))?
+    {
+        return Ok(std::borrow::Cow::Owned(decoded));
+    }
+    Ok(std::borrow::Cow::Borrowed(bytes))
+}
 use crate::ext::{
     EDGE_VISIBILITY_EXTENSION, EXTENSION, FORMAT_VERSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension,
     RootExtension, TexturesRecord,
@@ -64,6 +76,8 @@ pub fn read_textures(
     bytes: &[u8],
     external: &dyn Fn(&str) -> Option<Vec<u8>>,
 ) -> Result<Vec<EmbeddedPng>, FormatError> {
+    let decoded = plain(bytes)?;
+    let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
     let Some(record) = doc.pointer(&format!("/extensions/{EXTENSION}/textures")) else { return Ok(Vec::new()) };
@@ -129,6 +143,8 @@ fn root_extension(doc: &Value) -> Result<RootExtension, FormatError> {
 
 /// Reads a baked .glb, or a .gltf whose buffer `external` returns (given the buffer's URI).
 pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<BakedFile, FormatError> {
+    let decoded = plain(bytes)?;
+    let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
     let root = root_extension(&doc)?;
@@ -296,6 +312,8 @@ pub fn read_normal_sets(
     bytes: &[u8],
     external: &dyn Fn(&str) -> Option<Vec<u8>>,
 ) -> Result<Vec<PrimitiveNormals>, FormatError> {
+    let decoded = plain(bytes)?;
+    let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
     let root = root_extension(&doc)?;
@@ -521,6 +539,8 @@ pub struct ByteSections {
 
 /// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns.
 pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<ByteSections, FormatError> {
+    let decoded = plain(bytes)?;
+    let bytes = &*decoded;
     let (json, _) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
     let external_bytes = match doc.pointer("/buffers/0/uri") {

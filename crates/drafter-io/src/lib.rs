@@ -45,7 +45,13 @@ pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, ImportError> 
     let mut diagnostics = Diagnostics::new();
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let scene = match format {
-        SourceFormat::Gltf | SourceFormat::Glb => gltf_import::import(path, bytes, &mut diagnostics)?,
+        SourceFormat::Glb => match drafter_core::meshopt::decompress_glb(bytes) {
+            // EXT_meshopt_compression (drafter bake --compress, gltfpack -cc): the plain GLB.
+            Ok(Some(plain)) => gltf_import::import(path, &plain, &mut diagnostics)?,
+            Ok(None) => gltf_import::import(path, bytes, &mut diagnostics)?,
+            Err(e) => return Err(ParseError::in_file(e.to_string()).in_path(path)),
+        },
+        SourceFormat::Gltf => gltf_import::import(path, bytes, &mut diagnostics)?,
         SourceFormat::Obj => obj::import(path, bytes, &mut diagnostics)?,
         SourceFormat::Stl => raw_scene(path, stl::read(bytes), format, &name, &mut diagnostics)?,
         SourceFormat::Off => raw_scene(path, off::read(bytes), format, &name, &mut diagnostics)?,
