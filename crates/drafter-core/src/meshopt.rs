@@ -265,6 +265,16 @@ fn encode_view(bytes: &[u8], stride: usize, index: bool) -> Option<(Vec<u8>, Mod
     candidate.filter(|(e, _)| e.len() < bytes.len())
 }
 
+fn lcm(a: usize, b: usize) -> usize {
+    let gcd = |mut x: usize, mut y: usize| {
+        while y != 0 {
+            (x, y) = (y, x % y);
+        }
+        x
+    };
+    a / gcd(a, b) * b
+}
+
 fn pad4(bin: &mut Vec<u8>) {
     bin.resize(bin.len().next_multiple_of(4), 0);
 }
@@ -328,19 +338,30 @@ pub fn compress_glb(glb_bytes: &[u8]) -> Result<(Vec<u8>, CompressionStats), Mes
         let Some(bytes) = offset.checked_add(length).and_then(|end| bin.get(offset..end)) else {
             return Ok(unchanged(&stats));
         };
+        // The codec's stride: the view's, or for tightly packed elements the smallest multiple of
+        // both the element and 4 (two 6-byte SHORT VEC3 silhouette normals make one 12-byte
+        // vertex; four bytes of edge visibility one 4-byte vertex).
         let stride = match (uint(view, "byteStride"), element[v]) {
             (Some(s), _) => s as usize,
-            (None, Some(e)) if e.is_multiple_of(4) && e > 0 => e as usize,
-            (None, Some(_)) => 4,
-            (None, None) => 0,
+            (None, Some(e)) if e > 0 => lcm(e as usize, 4),
+            (None, _) => 0,
         };
         let index = index_view[v] && !other_use[v];
         let stride = if index { element[v].unwrap_or(0) as usize } else { stride };
         let encodable = stride > 0
             && length > 0
-            && length.is_multiple_of(stride)
-            && if index { stride == 2 || stride == 4 } else { stride.is_multiple_of(4) && stride <= 64 };
-        let encoded = if encodable { encode_view(bytes, stride, index) } else { None };
+            && if index { (stride == 2 || stride == 4) && length.is_multiple_of(stride) } else { stride <= 64 };
+        // A view whose length is not a whole number of strides is encoded zero-padded (its
+        // accessors read no further than before; the decoded view is longer by the padding).
+        let padded: std::borrow::Cow<'_, [u8]> = if encodable && !length.is_multiple_of(stride) {
+            let mut p = bytes.to_vec();
+            p.resize(length.next_multiple_of(stride), 0);
+            std::borrow::Cow::Owned(p)
+        } else {
+            std::borrow::Cow::Borrowed(bytes)
+        };
+        let encoded = if encodable { encode_view(&padded, stride, index) } else { None };
+        let length = padded.len();
         pad4(&mut new_bin);
         let mut out = view.clone();
         match encoded {
@@ -360,6 +381,7 @@ pub fn compress_glb(glb_bytes: &[u8]) -> Result<(Vec<u8>, CompressionStats), Mes
                 fallback_len = fallback_len.next_multiple_of(4);
                 out["buffer"] = json!(1);
                 out["byteOffset"] = json!(fallback_len);
+                out["byteLength"] = json!(length);
                 fallback_len += length;
                 out.as_object_mut()
                     .ok_or_else(|| invalid(format!("/bufferViews/{v} is not an object")))?
