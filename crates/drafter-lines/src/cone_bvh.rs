@@ -711,9 +711,10 @@ impl ConeBvh {
             let s = f64::from(cones[node][3]);
             let in_cone = s >= 1.0
                 || normals[k as usize].iter().all(|nrm| {
+                    // Angle below π/2 iff axis·n > 0, and then its sine is |axis × n| (unit vectors).
                     let nrm = nrm.as_dvec3().normalize_or_zero();
-                    let angle = axes[node].cross(nrm).length().atan2(axes[node].dot(nrm));
-                    nrm != DVec3::ZERO && angle < std::f64::consts::FRAC_PI_2 && angle.sin() + CONE_MARGIN * 0.5 <= s
+                    let a = axes[node];
+                    nrm != DVec3::ZERO && a.dot(nrm) > 0.0 && a.cross(nrm).length() + CONE_MARGIN * 0.5 <= s
                 });
             if inside && in_cone { Ok(()) } else { Err(ArraysError::NotConservative { node, candidate: k }) }
         })?;
