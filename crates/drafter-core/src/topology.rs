@@ -43,7 +43,8 @@ pub enum Weld {
     /// Merge vertices whose coordinates are bit-identical (after mapping -0.0 to 0.0).
     Exact,
     /// Merge vertices whose coordinates round to the same point of a grid with this spacing, as a
-    /// fraction of the bounding diagonal (default [`DEFAULT_SNAP_FRACTION`]). This is "identical
+    /// fraction of the bounding diagonal (default [`DEFAULT_SNAP_FRACTION`]; a few vertices far
+    /// outside the rest do not count, see `snap_scale`). This is "identical
     /// positions" up to float noise: CAD exporters write `2.4e-18` where a neighbouring facet has
     /// `0.0`, and trimesh's `merge_vertices` welds those by rounding too. At 1e-9 the grid is
     /// finer than f32 resolution for every coordinate above 1/60 of the diagonal, so distinct
@@ -244,11 +245,7 @@ fn weld_exact(positions: &[Vec3]) -> Welded {
 }
 
 fn weld_snap(positions: &[Vec3], fraction: f64) -> Welded {
-    let (lo, hi) =
-        positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
-            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-        });
-    let cell = if positions.is_empty() { 0.0 } else { (hi - lo).length() * fraction.abs() };
+    let cell = snap_scale(positions) * fraction.abs();
     if !(cell.is_finite() && cell > 0.0) {
         return weld_exact(positions);
     }
@@ -259,6 +256,44 @@ fn weld_snap(positions: &[Vec3], fraction: f64) -> Welded {
         |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64),
         |k| hash_words(k.map(|c| c as u64)),
     )
+}
+
+/// How far the core of a model may be outgrown by its outliers before they stop setting the weld
+/// grid (see [`snap_scale`]).
+const SNAP_CORE_FACTOR: f64 = 64.0;
+
+/// Vertices sampled (evenly, by index) for the core box of [`snap_scale`].
+const SNAP_SAMPLE: usize = 4096;
+
+/// The length the snap grid is a fraction of: the bounding diagonal, unless a few vertices lie far
+/// outside the rest. Then the diagonal of the *core* (the box from the 1st to the 99th percentile of
+/// each coordinate, at least one value trimmed at each end, over an even sample of at most 4,096
+/// vertices), times 64, is used instead. A finer grid never merges what a coarser one kept apart, so
+/// this can only leave float noise on the outliers themselves unwelded. One
+/// vertex moved to 1e19 would otherwise make the grid 1e10 wide and weld the whole model into a
+/// point, and every later stage would pay for that collapse (issue 21, class 3). For a model
+/// without such outliers the core spans more than 1/64 of the box and nothing changes.
+fn snap_scale(positions: &[Vec3]) -> f64 {
+    if positions.is_empty() {
+        return 0.0;
+    }
+    let (lo, hi) =
+        positions.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+        });
+    let diagonal = (hi - lo).length();
+    let step = positions.len().div_ceil(SNAP_SAMPLE).max(1);
+    let mut core = DVec3::ZERO;
+    for axis in 0..3 {
+        let mut values: Vec<f64> = positions.iter().step_by(step).map(|p| p[axis] as f64).collect();
+        values.sort_unstable_by(f64::total_cmp);
+        // At least one value is trimmed at each end, so that a small mesh has a core too.
+        let last = values.len() - 1;
+        let trim = (last / 100).max(1).min(last / 2);
+        core[axis] = values[last - trim] - values[trim];
+    }
+    let core = core.length();
+    if core.is_finite() && core > 0.0 { diagonal.min(core * SNAP_CORE_FACTOR) } else { diagonal }
 }
 
 /// Welds vertices with equal keys; ids in order of first occurrence.
@@ -707,6 +742,22 @@ mod tests {
         let p = vec![Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.5, 2.4e-18, 0.0), Vec3::new(0.5, 1e-4, 0.0), Vec3::ONE];
         let topo = Topology::from_triangles(&p, &[], Weld::default());
         assert_eq!(topo.welded_of_vertex, vec![0, 0, 1, 2]);
+    }
+
+    #[test]
+    fn a_far_away_vertex_does_not_coarsen_the_snap_grid() {
+        // An unwelded cube plus one triangle reaching 1e19 away: the grid follows the cube, so the
+        // cube still welds to its 8 corners and the corners stay apart (a grid of 1e-9 of the full
+        // diagonal, 1e10 wide, would merge all of them).
+        let (mut p, mut t) = unwelded_cube();
+        let n = p.len() as u32;
+        p.extend([Vec3::ZERO, Vec3::X, Vec3::new(0.0, 1e19, 0.0)]);
+        t.push([n, n + 1, n + 2]);
+        let topo = Topology::from_triangles(&p, &t, Weld::default());
+        assert_eq!(topo.welded_positions.len(), 9);
+        assert_eq!(topo.degenerate_triangle_count(), 0);
+        // Without outliers the scale is the bounding diagonal.
+        assert_eq!(snap_scale(&unwelded_cube().0), 3f64.sqrt());
     }
 
     #[test]

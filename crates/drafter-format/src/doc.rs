@@ -309,42 +309,47 @@ impl Doc {
     /// replaced) and rebuilds the binary buffer from the views that remain, renumbering every
     /// reference. References are looked for in every place the glTF 2.0 spec and the extensions in
     /// [`COMPACTION_SAFE_EXTENSIONS`] put them; a document that uses any other extension might refer
-    /// to accessors from places unknown here, so it is left as it is (returns false).
-    pub fn compact(&mut self, own_extension: &str) -> bool {
+    /// to accessors from places unknown here, so it is left as it is, and so is a document that refers
+    /// to an accessor or buffer view it does not have (nothing to renumber it to). `Err` says why.
+    pub fn compact(&mut self, own_extension: &str) -> Result<(), &'static str> {
         let used = self.array("extensionsUsed").iter().filter_map(Value::as_str).map(str::to_owned).collect::<Vec<_>>();
         if used.iter().any(|e| e != own_extension && !COMPACTION_SAFE_EXTENSIONS.contains(&e.as_str())) {
-            return false;
+            return Err("the input uses extensions drafter does not know");
         }
+        const DANGLING: &str = "the input refers to accessors or buffer views it does not have";
         let accessor_count = self.array("accessors").len();
         let view_count = self.array("bufferViews").len();
         // 1. Which accessors are referenced.
         let mut keep_accessor = vec![false; accessor_count];
-        self.visit_accessor_refs(own_extension, &mut |i| {
-            if let Some(k) = keep_accessor.get_mut(*i as usize) {
-                *k = true;
-            }
+        let mut dangling = false;
+        self.visit_accessor_refs(own_extension, &mut |i| match keep_accessor.get_mut(*i as usize) {
+            Some(k) => *k = true,
+            None => dangling = true,
         });
         let accessor_map = renumbering(&keep_accessor);
         // 2. Which buffer views: those of kept accessors (and their sparse parts) and of images.
         let mut keep_view = vec![false; view_count];
+        let mut keep = |v: u64| match keep_view.get_mut(v as usize) {
+            Some(k) => *k = true,
+            None => dangling = true,
+        };
         for (a, accessor) in self.array("accessors").iter().enumerate() {
             if !keep_accessor[a] {
                 continue;
             }
             for pointer in ["/bufferView", "/sparse/indices/bufferView", "/sparse/values/bufferView"] {
-                if let Some(v) = accessor.pointer(pointer).and_then(Value::as_u64)
-                    && let Some(k) = keep_view.get_mut(v as usize)
-                {
-                    *k = true;
+                if let Some(v) = accessor.pointer(pointer).and_then(Value::as_u64) {
+                    keep(v);
                 }
             }
         }
         for image in self.array("images") {
-            if let Some(v) = image.get("bufferView").and_then(Value::as_u64)
-                && let Some(k) = keep_view.get_mut(v as usize)
-            {
-                *k = true;
+            if let Some(v) = image.get("bufferView").and_then(Value::as_u64) {
+                keep(v);
             }
+        }
+        if dangling {
+            return Err(DANGLING);
         }
         let view_map = renumbering(&keep_view);
         // 3. New buffer from the kept views, 4-byte aligned.
@@ -359,7 +364,8 @@ impl Doc {
             self.align(4);
             let mut view = view;
             view["byteOffset"] = self.bin.len().into();
-            self.bin.extend_from_slice(old_bin.get(start..start + length).unwrap_or_default());
+            let bytes = start.checked_add(length).and_then(|end| old_bin.get(start..end));
+            self.bin.extend_from_slice(bytes.unwrap_or_default());
             views.push(view);
         }
         *self.array_mut("bufferViews") = views;
@@ -388,7 +394,7 @@ impl Doc {
             }
         }
         self.visit_accessor_refs(own_extension, &mut |i| *i = u64::from(accessor_map[*i as usize]));
-        true
+        Ok(())
     }
 
     /// Calls `f` on every accessor reference of the document (glTF 2.0 core, EXT_mesh_gpu_instancing

@@ -317,9 +317,8 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
         map.insert(EXTENSION.into(), root_ext);
     }
     doc.use_extension(EXTENSION);
-    if from_source && !doc.compact(EXTENSION) {
-        notes
-            .push("the input uses extensions drafter does not know; replaced vertex data is kept in the buffer".into());
+    if from_source && let Err(why) = doc.compact(EXTENSION) {
+        notes.push(format!("{why}; replaced vertex data is kept in the buffer"));
     }
     match container {
         Container::Glb => Ok(Written { main: doc.into_glb()?, bin: None, notes }),

@@ -263,15 +263,20 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
             values
         }
         None => {
-            // No buffer view: zeros (then sparse). Guard the size: a count with no data behind it
-            // must still be bounded by something real, so require sparse data to exist.
+            // No buffer view: zeros (then sparse). The count has no data behind it, so it is bounded
+            // by what the file holds: its elements, stored densely, must fit in the file's buffers
+            // (a real sparse accessor, a morph target's, has as many elements as a dense accessor
+            // beside it). Without that, 30 bytes of JSON would allocate gigabytes.
             if accessor.sparse().is_none() {
                 return Err(ParseError::at_json(pointer, "accessor has neither bufferView nor sparse data"));
             }
-            if count > 1 << 26 {
+            let held: usize = buffers.iter().map(Vec::len).sum();
+            if count.checked_mul(element).is_none_or(|bytes| bytes > held) {
                 return Err(ParseError::at_json(
                     pointer,
-                    format!("sparse accessor count {count} is implausibly large"),
+                    format!(
+                        "sparse accessor without bufferView has {count} elements of {element} bytes, more than the file's {held} buffer bytes"
+                    ),
                 ));
             }
             vec![[0.0f32; N]; count]

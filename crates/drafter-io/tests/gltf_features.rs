@@ -199,3 +199,36 @@ fn glb_and_external_buffers_load() {
     assert_eq!(imported.scene.format, SourceFormat::Glb);
     assert_eq!(imported.scene.meshes[0].positions, TRI.map(Vec3::from).to_vec());
 }
+
+/// A POSITION accessor without a bufferView, all zeros but for `count_sparse` substituted elements:
+/// the sparse indices 0.. and the values `TRI`.
+fn sparse_only_positions(count: u64) -> Vec<u8> {
+    let mut b = Builder::default();
+    let indices = b.indices(&[0, 1, 2]);
+    let values = b.positions(&TRI);
+    let (index_view, value_view) =
+        (b.accessors[indices]["bufferView"].clone(), b.accessors[values]["bufferView"].clone());
+    b.accessors.push(json!({
+        "componentType": 5126, "count": count, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0],
+        "sparse": {"count": 3, "indices": {"bufferView": index_view, "componentType": 5123}, "values": {"bufferView": value_view}}
+    }));
+    let pos = b.accessors.len() - 1;
+    b.document(json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}]
+    }))
+}
+
+#[test]
+fn sparse_accessor_without_buffer_view() {
+    // Three elements, all substituted: a triangle.
+    let s = import(&sparse_only_positions(3)).scene;
+    assert_eq!(s.meshes[0].positions, TRI.map(Vec3::from).to_vec());
+    // The count alone cannot size an allocation: 50 million VEC3s (600 MB) from a file of a few
+    // hundred bytes is refused before anything is allocated, naming the accessor.
+    let err = drafter_io::import_bytes(Path::new("mem.gltf"), &sparse_only_positions(50_000_000))
+        .expect_err("a count beyond the file's buffers is refused");
+    let message = err.to_string();
+    assert!(message.contains("/accessors/2") && message.contains("50000000 elements"), "{message}");
+}

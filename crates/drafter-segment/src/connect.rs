@@ -69,7 +69,22 @@ fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
                     1 => open.push(faces[0]),
                     2 => link(faces[0], faces[1]),
                     _ => {
-                        if !radial_pairs(topo, &orientation, e, faces, &mut fan, &link) {
+                        // A face repeated in the same orientation is the same surface twice: the copies
+                        // join the first and the fan is paired without them (2,000 copies of one face
+                        // would otherwise make 2,000 one-triangle parts, issue 21 class 3).
+                        let distinct = distinct_faces(topo, faces, &link);
+                        let paired = match distinct.len() {
+                            1 => {
+                                open.push(distinct[0]);
+                                true
+                            }
+                            2 => {
+                                link(distinct[0], distinct[1]);
+                                true
+                            }
+                            _ => radial_pairs(topo, &orientation, e, &distinct, &mut fan, &link),
+                        };
+                        if !paired {
                             unpaired.push(e as u32);
                             open.extend_from_slice(faces);
                         }
@@ -93,6 +108,42 @@ fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
         open_faces[f as usize] = true;
     }
     FreeEdges { unpaired, open_faces }
+}
+
+/// `faces` (of one edge) without their same-orientation copies: faces whose welded vertices are
+/// equal in the same cyclic order are linked to the lowest-numbered of them, which alone is kept.
+/// A copy in the opposite orientation is kept: that is two solids touching along a face.
+fn distinct_faces(topo: &Topology, faces: &[u32], link: &impl Fn(u32, u32)) -> Vec<u32> {
+    let key = |f: u32| {
+        let [a, b, c] = topo.faces[f as usize];
+        // The rotation that starts at the smallest vertex names the oriented face.
+        if a <= b && a <= c {
+            [a, b, c]
+        } else if b <= c {
+            [b, c, a]
+        } else {
+            [c, a, b]
+        }
+    };
+    let mut keyed: Vec<([u32; 3], u32)> = faces.iter().map(|&f| (key(f), f)).collect();
+    keyed.sort_unstable();
+    let mut distinct: Vec<u32> = Vec::with_capacity(keyed.len());
+    let mut first = 0;
+    for i in 0..keyed.len() {
+        if i > 0 && keyed[i].0 == keyed[first].0 {
+            link(keyed[first].1, keyed[i].1);
+        } else {
+            first = i;
+            distinct.push(keyed[i].1);
+        }
+    }
+    if distinct.len() == faces.len() {
+        // No copies: keep the edge's own face order.
+        distinct.copy_from_slice(faces);
+    } else {
+        distinct.sort_unstable();
+    }
+    distinct
 }
 
 /// Pairs the faces around non-manifold edge `e` into the wedges of the solids that meet there.

@@ -117,6 +117,22 @@ fn cubes_sharing_an_edge_are_paired_into_two_solids() {
 }
 
 #[test]
+fn a_face_repeated_in_the_same_orientation_joins_its_solid() {
+    // A face written 50 more times, same vertices in the same order: the same surface, not 50
+    // one-triangle parts (issue 21: 10,000 copies made the merge quadratic).
+    let mut mesh = Mesh::default();
+    add_box(&mut mesh, Vec3::ZERO, Vec3::ONE, 1);
+    let first = mesh.triangles[0];
+    mesh.triangles.extend(std::iter::repeat_n(first, 50));
+    let scene = single(mesh);
+    for mode in [SegmentMode::Components, SegmentMode::Auto] {
+        let (parts, diagnostics) = segment(&scene, &SegmentOptions { mode, ..Default::default() });
+        assert_eq!(sizes(&parts), vec![62], "{mode}");
+        assert!(diagnostics.is_empty(), "{mode}: {diagnostics:?}");
+    }
+}
+
+#[test]
 fn stacked_cubes_with_coincident_faces_are_two_solids() {
     // As in obj/occt/motor.stl: where two solids touch along a face, both write the same
     // triangles (opposite orientation), so every edge of the contact face is non-manifold.
