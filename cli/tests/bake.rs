@@ -37,20 +37,6 @@ fn corpus_models() -> Vec<PathBuf> {
     out
 }
 
-fn bake(input: &Path, output: &Path, extra: &[&str]) -> std::process::Output {
-    let out = common::drafter()
-        .arg("bake")
-        .arg(input)
-        .arg("-o")
-        .arg(output)
-        .arg("--quiet")
-        .args(extra)
-        .output()
-        .expect("drafter runs");
-    assert!(out.status.success(), "{}: {}", input.display(), String::from_utf8_lossy(&out.stderr));
-    out
-}
-
 fn schema(name: &str) -> jsonschema::Validator {
     let path = repo().join("crates/drafter-format/spec/schema").join(name);
     let schema: Value = serde_json::from_slice(&std::fs::read(&path).expect("schema")).expect("schema json");
@@ -123,7 +109,7 @@ fn every_model_bakes_validates_and_reads_back() {
     for (i, input) in inputs.iter().enumerate() {
         let output = dir.join(format!("{i:02}-{}.glb", input.file_stem().expect("stem").to_string_lossy()));
         let report = dir.join(format!("{i:02}.json"));
-        bake(input, &output, &["--report", report.to_str().expect("utf-8")]);
+        common::bake(input, &output, &["--report", report.to_str().expect("utf-8")]);
         check_schema(&output);
         // Read back: the same parts as the report, labels for every split mesh.
         let baked = drafter_format::read(&std::fs::read(&output).expect("read"), &|_| None).expect("reads back");
@@ -156,8 +142,8 @@ fn output_is_identical_at_any_thread_count() {
     ] {
         let one = dir.join("one.glb");
         let two = dir.join("two.glb");
-        bake(&input, &one, &["--threads", "1"]);
-        bake(&input, &two, &["--threads", "2"]);
+        common::bake(&input, &one, &["--threads", "1"]);
+        common::bake(&input, &two, &["--threads", "2"]);
         assert!(std::fs::read(&one).expect("one") == std::fs::read(&two).expect("two"), "{} differs", input.display());
     }
 }
@@ -177,7 +163,7 @@ fn no_arguments_bakes_the_embedded_sample() {
 fn gltf_output_writes_a_bin_beside_it() {
     let dir = common::scratch("bake-gltf");
     let output = dir.join("out.gltf");
-    bake(&repo().join("samples/gear.glb"), &output, &[]);
+    common::bake(&repo().join("samples/gear.glb"), &output, &[]);
     assert!(dir.join("out.bin").is_file());
     khronos_validate(&[output]);
 }
@@ -236,7 +222,7 @@ fn overrides_reach_the_file() {
     )
     .expect("config");
     let output = dir.join("o.glb");
-    bake(&repo().join("samples/assembly.glb"), &output, &["--config", config.to_str().expect("utf-8")]);
+    common::bake(&repo().join("samples/assembly.glb"), &output, &["--config", config.to_str().expect("utf-8")]);
     let baked = drafter_format::read(&std::fs::read(&output).expect("read"), &|_| None).expect("reads");
     let parts = baked.parts();
     assert_eq!(parts[0].style, Some(drafter_format::PartStyle::Metal));
@@ -260,7 +246,7 @@ fn edge_visibility_decodes_and_recounts() {
         models.join("gltf/RodAssembly/rod.glb"),
     ] {
         let output = dir.join("e.glb");
-        bake(&input, &output, &[]);
+        common::bake(&input, &output, &[]);
         let bytes = std::fs::read(&output).expect("baked");
         // The edges as drafter-format reads them (the one accessor decoder), the geometry as
         // drafter-io imports the file.
@@ -294,7 +280,7 @@ fn bake_with_textures(input: &Path, dir: &Path, name: &str, extra: &[&str]) -> (
     let mut args =
         vec!["--report", report.to_str().expect("utf-8"), "--textures-out", textures.to_str().expect("utf-8")];
     args.extend_from_slice(extra);
-    bake(input, &output, &args);
+    common::bake(input, &output, &args);
     let report: Value = serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("report json");
     (std::fs::read(&output).expect("baked"), report)
 }
@@ -428,7 +414,7 @@ fn textures_add_exactly_their_bytes_and_are_deterministic() {
     );
 
     // `--json` prints the same report, textures listed, on stdout.
-    let printed = bake(&input, &dir.join("json.glb"), &["--json"]);
+    let printed = common::bake(&input, &dir.join("json.glb"), &["--json"]);
     let printed: Value = serde_json::from_slice(&printed.stdout).expect("--json prints the report");
     let total: usize = pngs.iter().map(|p| p.png.len()).sum();
     assert_eq!(printed["textures"]["total_bytes"].as_u64(), Some(total as u64));

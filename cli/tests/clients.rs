@@ -32,23 +32,6 @@ fn client(args: &[&str]) -> Value {
     json
 }
 
-fn bake(input: &Path, output: &Path) {
-    bake_with(input, output, &[]);
-}
-
-fn bake_with(input: &Path, output: &Path, extra: &[&str]) {
-    let out = common::drafter()
-        .arg("bake")
-        .arg(input)
-        .arg("-o")
-        .arg(output)
-        .arg("--quiet")
-        .args(extra)
-        .output()
-        .expect("runs");
-    assert!(out.status.success(), "{}: {}", input.display(), String::from_utf8_lossy(&out.stderr));
-}
-
 /// A closed cylinder as an OBJ: `segments` around the +Y axis, radius 1, height 2, caps as fans.
 fn cylinder_obj(segments: u32) -> String {
     let mut obj = String::from("o cylinder\n");
@@ -87,7 +70,7 @@ fn three_js_sees_the_triangles_our_reader_sees() {
         // Plain, and with EXT_meshopt_compression (three.js decodes it with its MeshoptDecoder).
         for extra in [&[][..], &["--compress"][..]] {
             let output = dir.join("baked.glb");
-            bake_with(&input, &output, extra);
+            common::bake(&input, &output, extra);
             let bytes = std::fs::read(&output).expect("baked");
             let ours = drafter_io::import_bytes(&output, &bytes).expect("imports").scene.instanced_triangle_count();
             let json = client(&["three", output.to_str().expect("utf-8")]);
@@ -106,7 +89,7 @@ fn cesium_draws_the_same_edges_from_a_compressed_file() {
     let mut shots = Vec::new();
     for (name, extra) in [("plain", &[][..]), ("compressed", &["--compress"][..])] {
         let baked = dir.join(format!("{name}.glb"));
-        bake_with(&obj, &baked, extra);
+        common::bake(&obj, &baked, extra);
         let shot = dir.join(format!("{name}.png"));
         let (file, image) = (baked.to_str().expect("utf-8"), shot.to_str().expect("utf-8"));
         client(&["cesium", file, "--view", "0,15", "--edge-color", "255,0,0", "--screenshot", image]);
@@ -131,7 +114,7 @@ fn cesium_draws_a_cylinder_with_its_outline_and_caps_only() {
     let obj = dir.join("cylinder.obj");
     std::fs::write(&obj, cylinder_obj(64)).expect("writes");
     let baked = dir.join("cylinder.glb");
-    bake(&obj, &baked);
+    common::bake(&obj, &baked, &[]);
     let shot = dir.join("cylinder-cesium.png");
     let (file, image) = (baked.to_str().expect("utf-8"), shot.to_str().expect("utf-8"));
     client(&["cesium", file, "--view", "0,15", "--edge-color", "255,0,0", "--screenshot", image]);

@@ -213,16 +213,7 @@ pub fn run(args: Args) -> Result<()> {
             share(b.other)
         );
         if let Some(c) = &r.compression {
-            eprintln!(
-                "  compressed (EXT_meshopt_compression): {} of {} buffer views, {} → {} bytes; file {} → {} bytes ({:.2}×)",
-                c.encoded_views,
-                c.views,
-                drafter_core::thousands(c.encoded_bytes_before as usize),
-                drafter_core::thousands(c.encoded_bytes_after as usize),
-                drafter_core::thousands(c.file_bytes_before as usize),
-                drafter_core::thousands(c.file_bytes_after as usize),
-                c.file_bytes_before as f64 / c.file_bytes_after.max(1) as f64
-            );
+            eprintln!("  compressed with {c}");
         }
         if let Some(t) = &r.textures {
             let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();

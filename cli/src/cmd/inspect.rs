@@ -270,18 +270,7 @@ fn print_text(r: &Report) -> anyhow::Result<()> {
     let f = |v: [f64; 3]| format!("({:.6}, {:.6}, {:.6})", v[0], v[1], v[2]);
     out!("  world bounds {} .. {}  size {}", f(r.bounds.min), f(r.bounds.max), f(r.bounds.size));
     if let Some(c) = &r.compression {
-        let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { 0.0 };
-        out!(
-            "  compressed (EXT_meshopt_compression): {} of {} buffer views, {} → {} bytes ({:.2}×); file {} bytes, {} decoded ({:.2}×)",
-            c.encoded_views,
-            c.views,
-            drafter_core::thousands(c.encoded_bytes_before as usize),
-            drafter_core::thousands(c.encoded_bytes_after as usize),
-            ratio(c.encoded_bytes_before, c.encoded_bytes_after),
-            drafter_core::thousands(c.file_bytes_after as usize),
-            drafter_core::thousands(c.file_bytes_before as usize),
-            ratio(c.file_bytes_before, c.file_bytes_after),
-        );
+        out!("  compressed with {c}");
     }
     let t = &r.topology;
     out!(

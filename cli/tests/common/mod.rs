@@ -23,6 +23,14 @@ pub fn run(args: &[&str]) -> Output {
     drafter().args(args).output().expect("drafter runs")
 }
 
+/// `drafter bake INPUT -o OUTPUT --quiet EXTRA...`, asserted to succeed.
+pub fn bake(input: &Path, output: &Path, extra: &[&str]) -> Output {
+    let out = drafter().arg("bake").arg(input).arg("-o").arg(output).arg("--quiet").args(extra).output();
+    let out = out.expect("drafter runs");
+    assert!(out.status.success(), "{}: {}", input.display(), String::from_utf8_lossy(&out.stderr));
+    out
+}
+
 /// A fresh scratch folder under the target directory (no extra crate needed).
 pub fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);

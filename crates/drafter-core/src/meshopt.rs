@@ -90,6 +90,26 @@ pub struct CompressionStats {
     pub file_bytes_after: u64,
 }
 
+impl fmt::Display for CompressionStats {
+    /// One line: views encoded, their bytes, and the whole file (plain → compressed).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { 0.0 };
+        let n = |x: u64| crate::thousands(x as usize);
+        write!(
+            f,
+            "{EXTENSION}: {} of {} buffer views, {} → {} bytes ({:.2}×); file {} → {} bytes ({:.2}×)",
+            self.encoded_views,
+            self.views,
+            n(self.encoded_bytes_before),
+            n(self.encoded_bytes_after),
+            ratio(self.encoded_bytes_before, self.encoded_bytes_after),
+            n(self.file_bytes_before),
+            n(self.file_bytes_after),
+            ratio(self.file_bytes_before, self.file_bytes_after),
+        )
+    }
+}
+
 /// How a view is encoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Mode {
