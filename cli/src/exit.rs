@@ -49,10 +49,40 @@ pub fn code_of(err: &anyhow::Error) -> u8 {
     INTERNAL
 }
 
+/// The chain of `err` joined into one line, newlines flattened. A cause whose text its wrapper already
+/// ends with (`ImportError::Io` prints its `std::io::Error`) is not repeated.
+pub fn one_line(err: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for text in err.chain().map(|e| e.to_string()) {
+        if message.ends_with(&text) {
+            continue;
+        }
+        if !message.is_empty() {
+            message.push_str(": ");
+        }
+        message.push_str(&text);
+    }
+    message.replace('\n', " ")
+}
+
 /// Prints `err` as one line and picks the exit code.
 pub fn report(err: &anyhow::Error) -> ExitCode {
-    // One line: the chain joined, newlines flattened.
-    let message = err.chain().map(|e| e.to_string()).collect::<Vec<_>>().join(": ").replace('\n', " ");
-    eprintln!("drafter: error: {message}");
+    eprintln!("drafter: error: {}", one_line(err));
     ExitCode::from(code_of(err))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cause_the_message_already_names_is_not_repeated() {
+        let path = std::path::PathBuf::from("missing.obj");
+        let source = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory (os error 2)");
+        let err = anyhow::Error::new(drafter_io::ImportError::Io { path, source });
+        assert_eq!(one_line(&err), "missing.obj: cannot read: No such file or directory (os error 2)");
+        assert_eq!(code_of(&err), BAD_INPUT);
+        let err = anyhow::anyhow!("first line\nsecond").context("writing out.glb");
+        assert_eq!(one_line(&err), "writing out.glb: first line second");
+    }
 }

@@ -55,8 +55,19 @@ pub struct PartGpu {
     pub gradient: [f32; 4],
     /// Style hint ([`crate::Style::index`]) or [`NO_STYLE`].
     pub style_hint: u32,
-    pub _pad: [u32; 3],
+    /// [`PART_SELECTED`] and [`PART_REFERENCE`]: the editor's selection, tinted by the G-buffer pass.
+    pub flags: u32,
+    /// A flat grey in [0, 1] drawn instead of the shading, or [`NOT_FLAT`].
+    pub flat: f32,
+    pub _pad: u32,
 }
+
+/// `PartGpu::flags`: the part is selected.
+pub const PART_SELECTED: u32 = 1;
+/// `PartGpu::flags`: the part is the selection's reference (drawn in a lighter highlight).
+pub const PART_REFERENCE: u32 = 2;
+/// `PartGpu::flat` of a shaded part.
+pub const NOT_FLAT: f32 = -1.0;
 
 /// `PartGpu::style_hint` of a part without a hint: it takes the scene's style.
 pub const NO_STYLE: u32 = u32::MAX;

@@ -20,7 +20,10 @@
 //!    from the baked hierarchies, [`edges`]) as screen-space quads over the display output.
 //!
 //! [`window`] runs the same frame in a winit window (`drafter view`); its input handling is pure
-//! functions ([`window::Orbit`], [`window::action_for_key`]) tested without a display.
+//! functions ([`window::Orbit`], [`window::action_for_key`]) tested without a display. The
+//! illustrator's edits there (Lux et al. 2013 §4: selection, projector manipulators, gradient
+//! keys, undo, save and export) are the plain data and functions of [`edit`]; an edit rewrites the
+//! part table only ([`Renderer::update_parts`]).
 //!
 //! Frame times (`drafter bench render`, lavapipe, 1600×1200, ratio to Phong in the same run): every
 //! style 1.00–1.03×; edges 1.4×; soft shadow 1.1×; full illustration (gradient, edges, soft shadow)
@@ -44,6 +47,7 @@
 pub mod camera;
 pub mod context;
 pub mod edges;
+pub mod edit;
 pub mod gpu_types;
 pub mod image;
 pub mod lookups;

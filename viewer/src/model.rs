@@ -40,7 +40,7 @@ use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
-use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, PartGpu, Vertex};
+use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, NOT_FLAT, PartGpu, Vertex};
 use crate::lookups::BakedLookups;
 use crate::style::{Style, transfer_index};
 
@@ -386,6 +386,33 @@ impl Model {
         self.parts.get(id as usize)
     }
 
+    /// Replaces the baked record of part `record.id` (an edit) and its GPU record with it; the
+    /// selection flags stay. False when there is no such baked part.
+    pub fn set_part_record(&mut self, record: &PartRecord) -> bool {
+        let origin = self.origin;
+        let Some(part) = self.parts.get_mut(record.id as usize).filter(|p| p.record.is_some()) else { return false };
+        let flags = part.gpu.flags;
+        *part = baked_part(record, origin);
+        part.gpu.flags = flags;
+        true
+    }
+
+    /// Marks the selected parts and the reference part for the G-buffer's highlight (see
+    /// [`crate::gpu_types::PART_SELECTED`]).
+    pub fn set_selection(&mut self, selected: &[u32], reference: Option<u32>) {
+        for part in &mut self.parts {
+            part.gpu.flags = 0;
+        }
+        for &id in selected {
+            if let Some(part) = self.parts.get_mut(id as usize) {
+                part.gpu.flags |= crate::gpu_types::PART_SELECTED;
+            }
+        }
+        if let Some(part) = reference.and_then(|id| self.parts.get_mut(id as usize)) {
+            part.gpu.flags |= crate::gpu_types::PART_SELECTED | crate::gpu_types::PART_REFERENCE;
+        }
+    }
+
     /// Per-part GPU records, indexed by part id, each with the row of its transfer curve in the γ
     /// atlas the G-buffer binds (the file's when [`Self::lookups`] has one, else the procedural
     /// atlas, whose rows are [`TransferCurve::ALL`]).
@@ -599,7 +626,9 @@ fn baked_part(record: &PartRecord, origin: DVec3) -> Part {
         axes,
         gradient: [record.gradient.q as f32, record.gradient.f as f32, record.gradient.p as f32, transfer as f32],
         style_hint: style.map_or(NO_STYLE, Style::index),
-        _pad: [0; 3],
+        flags: 0,
+        flat: record.flat.map_or(NOT_FLAT, |g| g as f32),
+        _pad: 0,
     };
     Part { id: record.id, name: record.name.clone(), style, record: Some(record.clone()), gpu }
 }
@@ -641,7 +670,9 @@ fn fallback_part(id: u32, name: &str, world: &Aabb, origin: DVec3) -> Part {
             axes,
             gradient: [DEFAULT_QUANTIZATION as f32, DEFAULT_FADE_STEP, DEFAULT_POWER, 0.0],
             style_hint: NO_STYLE,
-            _pad: [0; 3],
+            flags: 0,
+            flat: NOT_FLAT,
+            _pad: 0,
         },
     }
 }

@@ -134,6 +134,25 @@ impl Renderer {
         Ok(())
     }
 
+    /// Uploads `model`'s part table again after an edit or a selection change: one write into the
+    /// parts storage buffer, nothing else (Lux et al. 2013 §4: no re-processing at edit time). The
+    /// model must be the one [`Self::set_model`] uploaded.
+    pub fn update_parts(&mut self, model: &Model) -> Result<(), RenderError> {
+        let scene = self.scene.as_ref().ok_or(RenderError::NoModel)?;
+        let parts = model.part_table();
+        let bytes: &[u8] = bytemuck::cast_slice(&parts);
+        if bytes.len() as u64 > scene.gpu.buffers.parts.size() {
+            return Err(RenderError::Options(format!(
+                "{} parts do not fit the uploaded part table; upload the model again",
+                parts.len()
+            )));
+        }
+        if !bytes.is_empty() {
+            self.gpu.queue.write_buffer(&scene.gpu.buffers.parts, 0, bytes);
+        }
+        Ok(())
+    }
+
     /// The camera and size of the last frame recorded.
     pub fn last_frame(&self) -> Option<FrameInfo> {
         self.last_frame

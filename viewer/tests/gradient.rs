@@ -70,6 +70,7 @@ fn baked(projector: &Projector, q: u32, f: f64, p: f64, transfer: TransferCurve)
         },
         gradient: GradientRecord { q: f64::from(q), f, p, transfer },
         style: Some(drafter_format::PartStyle::Gradient),
+        flat: None,
     };
     BakedFile {
         // From JSON, as a reader would see it: fields added to the extension later keep their defaults.

@@ -53,12 +53,12 @@ pub struct Args {
     /// Oriented-box method (overrides the config file).
     #[arg(long, value_enum)]
     pub obb: Option<ObbArg>,
-    /// Skip the normal stage (keep the input's normals and vertex layout).
     /// Compress the file with EXT_meshopt_compression (lossless; .glb only; readers need the
     /// extension: three.js with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress =
     /// "meshopt"` in the config.
     #[arg(long)]
     pub compress: bool,
+    /// Skip the normal stage (keep the input's normals and vertex layout).
     #[arg(long)]
     pub no_normals: bool,
     /// Write the enhanced normals into NORMAL (and the crease-aware ones into _ENHANCED_NORMAL), so

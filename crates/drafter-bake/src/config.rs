@@ -53,6 +53,8 @@
 //! f = 1.0
 //! p = 0.19
 //! style = "metal"            # gradient | cel | gooch | goochel | phong | metal | hatch
+//! transfer = "smoothstep"    # the part's transfer curve γ
+//! flat = 0.0                 # a flat grey in [0, 1] instead of shading (0 black, 1 white)
 //! ```
 //!
 //! Unknown keys and out-of-range values are errors that name the key.
@@ -253,6 +255,8 @@ pub struct PartOverride {
     pub transfer: Option<TransferCurve>,
     /// Checked against the format's styles when the TOML is read (an unknown name is a config error).
     pub style: Option<PartStyle>,
+    /// A flat grey in [0, 1] drawn instead of the part's shading (0 black, 1 white).
+    pub flat: Option<f32>,
 }
 
 fn default_selector() -> PartSelector {
@@ -458,6 +462,7 @@ impl PartOverride {
             p: None,
             transfer: None,
             style: None,
+            flat: None,
         }
     }
 
@@ -483,6 +488,11 @@ impl PartOverride {
             && !(s.is_finite() && s > 0.0)
         {
             return Err(format!("scale = {s} must be finite and > 0"));
+        }
+        if let Some(g) = self.flat
+            && !(0.0..=1.0).contains(&g)
+        {
+            return Err(format!("flat = {g} is out of range [0, 1]"));
         }
         Ok(())
     }

@@ -646,9 +646,14 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
             let mut gradient = config.gradient;
             let mut transfer = config.transfer;
             let mut style = None;
+            let mut flat = None;
             for o in overrides {
                 if let Some(d) = o.direction {
-                    projector.direction = DVec3::from(d).normalize();
+                    // A direction that is already unit is kept bit for bit, so the overrides that
+                    // `drafter view` exports re-bake to the records it saved.
+                    let d = DVec3::from(d);
+                    projector.direction =
+                        if (d.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON { d } else { d.normalize() };
                 }
                 if let Some(a) = o.anchor {
                     projector.anchor = DVec3::from(a);
@@ -659,6 +664,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                 gradient = o.gradient(&gradient);
                 transfer = o.transfer.unwrap_or(transfer);
                 style = o.style.or(style);
+                flat = o.flat.map(f64::from).or(flat);
             }
             Ok(PartRecord {
                 id: p as u32,
@@ -678,6 +684,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                     transfer,
                 },
                 style,
+                flat,
             })
         })
         .collect()

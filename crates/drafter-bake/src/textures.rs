@@ -256,6 +256,7 @@ mod tests {
             projector: ProjectorRecord { anchor: [0.0; 3], direction: [1.0, 0.0, 0.0], scale: 1.0, matrix: [0.0; 16] },
             gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer },
             style,
+            flat: None,
         }
     }
 

@@ -234,6 +234,10 @@ pub struct PartRecord {
     /// Shading style hint; absent means "the scene's style".
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub style: Option<PartStyle>,
+    /// A flat grey in [0, 1] (0 black, 1 white) that replaces the part's shading in every style
+    /// (Lux et al. 2013 §4: parts set to a constant tone); absent means shaded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flat: Option<f64>,
 }
 
 /// A part's shading style hint: the viewer's styles, spelled as in the schema's `style` enum.

@@ -5,6 +5,8 @@
 //! * [`write`] serialises a bake (a [`BakeOutput`]) as .glb or .gltf + .bin;
 //! * [`read`] loads a baked file back into the same types, [`read_textures`] its embedded textures,
 //!   [`read_normal_sets`] both sets of vertex normals (crease-aware and enhanced) for the viewer's toggle;
+//! * [`replace_part_records`] writes an illustrator's edited part records back into a baked file,
+//!   every other byte unchanged (`drafter view`'s save);
 //! * [`external_buffers`] is the loader of a baked .gltf's buffer those readers take, confined to the
 //!   file's folder; [`split_container`] frames a .glb through `drafter_core::glb`.
 //!
@@ -13,11 +15,13 @@
 //! model; everything of a glTF input that the scene model does not represent passes through.
 
 mod doc;
+mod edit;
 pub mod ext;
 mod external;
 mod reader;
 mod writer;
 
+pub use edit::{replace_part_records, validate as validate_part_record};
 pub use ext::{
     BoxRecord, CelTableRecord, CelTexture, ConeBvhRecord, CoolToWarmTexture, EDGE_VISIBILITY_EXTENSION,
     ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION, GaussMapRecord, GradientRecord, GradientTexture,

@@ -59,6 +59,7 @@ fn part() -> PartRecord {
         },
         gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: drafter_format::TransferCurve::Identity },
         style: None,
+        flat: None,
     }
 }
 

@@ -35,10 +35,16 @@ struct Part {
     axis2: vec4<f32>,
     gradient: vec4<f32>, // q, f, p, transfer curve index
     style_hint: u32,
+    flags: u32, // PART_SELECTED | PART_REFERENCE (gpu_types.rs)
+    flat: f32,  // a flat grey in [0, 1], or negative: shaded
     pad0: u32,
-    pad1: u32,
-    pad2: u32,
 }
+
+const PART_SELECTED: u32 = 1u;
+const PART_REFERENCE: u32 = 2u;
+// The editor's highlights: the selection in a saturated orange, its reference part lighter.
+const SELECTED_TINT: vec4<f32> = vec4<f32>(1.0, 0.55, 0.1, 0.45);
+const REFERENCE_TINT: vec4<f32> = vec4<f32>(1.0, 0.85, 0.55, 0.55);
 
 struct Lookups {
     flags: u32,
@@ -435,6 +441,14 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> GBufferO
         case STYLE_METAL: { color = shade_metal(s, part, normal); }
         case STYLE_HATCH: { color = shade_hatch(s); }
         default: { color = shade_phong(s); }
+    }
+    if part.flat >= 0.0 {
+        color = vec3<f32>(part.flat);
+    }
+    if (part.flags & PART_REFERENCE) != 0u {
+        color = mix(color, REFERENCE_TINT.rgb, REFERENCE_TINT.a);
+    } else if (part.flags & PART_SELECTED) != 0u {
+        color = mix(color, SELECTED_TINT.rgb, SELECTED_TINT.a);
     }
 
     var out: GBufferOut;
