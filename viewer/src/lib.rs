@@ -63,5 +63,5 @@ pub use camera::Camera;
 pub use context::{Gpu, RenderError};
 pub use image::{Image, ImageDiff, PngError};
 pub use model::{LoadError, Model, Part};
-pub use renderer::{FrameInfo, Renderer};
+pub use renderer::{FrameInfo, PartMap, Renderer};
 pub use style::{Enhancements, RenderOptions, ShadowMode, Style, UnknownStyle, View};

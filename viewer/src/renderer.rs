@@ -153,6 +153,14 @@ impl Renderer {
         Ok(())
     }
 
+    /// Submits what is queued (buffer writes included) and waits until the GPU has done it all: the
+    /// end of an edit's measured cost (`drafter bench parts`).
+    pub fn wait_idle(&self) -> Result<(), RenderError> {
+        self.gpu.queue.submit([]);
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
+        Ok(())
+    }
+
     /// The camera and size of the last frame recorded.
     pub fn last_frame(&self) -> Option<FrameInfo> {
         self.last_frame
@@ -323,12 +331,27 @@ impl Renderer {
         if x >= w || y >= h {
             return Ok(None);
         }
+        let ids = self.read_part_ids(x, y, 1, 1)?;
+        Ok(ids[0].checked_sub(1))
+    }
+
+    /// The part id of every pixel of the last frame: what tests compare two renders by.
+    pub fn part_map(&self) -> Result<Option<PartMap>, RenderError> {
+        let Some(frame) = self.targets.as_ref() else { return Ok(None) };
+        let (w, h) = frame.targets.size;
+        let ids = self.read_part_ids(0, 0, w, h)?;
+        Ok(Some(PartMap { size: (w, h), ids: ids.into_iter().map(|id| id.checked_sub(1)).collect() }))
+    }
+
+    /// The part-id target's texels (id + 1; 0 is the background) in a `w`×`h` region at (x, y).
+    fn read_part_ids(&self, x: u32, y: u32, w: u32, h: u32) -> Result<Vec<u32>, RenderError> {
+        let Some(frame) = self.targets.as_ref() else { return Ok(Vec::new()) };
         let device = &self.gpu.device;
         let guard = ErrorScopes::push(device);
-        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let bytes_per_row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pick readback"),
-            size: u64::from(align),
+            label: Some("part id readback"),
+            size: u64::from(bytes_per_row) * u64::from(h),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -342,15 +365,18 @@ impl Renderer {
             },
             wgpu::TexelCopyBufferInfo {
                 buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(align), rows_per_image: Some(1) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(bytes_per_row),
+                    rows_per_image: Some(h),
+                },
             },
-            wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(device, &readback, align, 1, 1)?;
+        let bytes = read_buffer(device, &readback, bytes_per_row, w, h)?;
         guard.pop()?;
-        let id = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-        Ok(id.checked_sub(1))
+        Ok(bytes.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
     }
 
     /// Records, submits and waits for one frame without reading it back; the wall time from
@@ -399,6 +425,15 @@ fn read_buffer(
     }
     buffer.unmap();
     Ok(rgba)
+}
+
+/// The part drawn at each pixel of a frame ([`Renderer::part_map`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PartMap {
+    /// Width and height of the target.
+    pub size: (u32, u32),
+    /// Row by row; `None` for the background.
+    pub ids: Vec<Option<u32>>,
 }
 
 /// Validation and out-of-memory error scopes, so GPU errors come back as [`RenderError::Gpu`]

@@ -15,6 +15,24 @@
 //!   2× supersampling; the path is printed).
 //! * `Esc` / `Q`: quit.
 //!
+//! # Editing (Lux et al. 2013 §4; the data and functions are [`crate::edit`])
+//! * left click: select the part under the cursor alone, or, on a selected part, make it the
+//!   *reference* (drawn lighter); `Shift`+click adds or removes a part; a click on the background
+//!   clears. `Ctrl`+drag draws a lasso (a part is selected when its box centre falls inside;
+//!   `Ctrl`+`Shift` adds). The selection is listed on stdout.
+//! * tools, for a left drag over a selection (the same key again: back to turning the object):
+//!   `A` anchor (drag the gradient across the part; a click centres it under the cursor), `X`
+//!   scale (drag away from or towards the anchor), `D` direction (turn about the anchor), `V`
+//!   projector line (draw anchor, direction and scale at once). Several parts follow the
+//!   reference: the same anchor offset, the same scale, the same turn about each part's axis.
+//! * gradient of the selection: `[`/`]` q, `,`/`.` f, `-`/`=` p, `T` next transfer curve γ,
+//!   `Y` next style hint (after the last: the scene's style), `G` flat grey (black, three greys,
+//!   white, shaded again).
+//! * `Ctrl`+`Z` undo, `Ctrl`+`Y` or `Ctrl`+`Shift`+`Z` redo; `Ctrl`+`S` saves the edited part
+//!   records into the file (atomically; every other byte stays), `Ctrl`+`E` writes
+//!   `<file stem>.edits.toml` beside it, the overrides that `drafter bake --config` applies to the
+//!   source model to re-create the edits.
+//!
 //! Everything an event changes goes through pure functions ([`Orbit`], [`action_for_key`],
 //! [`Action::apply`]) that are unit-tested without a display; the event loop only routes events
 //! to them and draws.
@@ -25,14 +43,16 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use glam::DVec2;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::keyboard::{Key, NamedKey};
+use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
 use crate::context::{Gpu, RenderError};
+use crate::edit::{Adjust, Editor, PartBox, ScreenView, Tool, parts_in_lasso};
 use crate::model::Model;
 use crate::renderer::Renderer;
 use crate::style::{Enhancements, RenderOptions, ShadowMode, Style, View, ZOOM_RANGE};
@@ -176,6 +196,60 @@ impl Action {
     }
 }
 
+/// What a key does to the edits (see the module docs); checked before [`action_for_key`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EditCommand {
+    /// Select this tool, or go back to turning the object when it is the current one.
+    Tool(Tool),
+    Adjust(Adjust),
+    Undo,
+    Redo,
+    Save,
+    Export,
+}
+
+/// The edit command of a pressed key with the modifiers held, if any.
+pub fn edit_command_for_key(key: &Key, ctrl: bool, shift: bool) -> Option<EditCommand> {
+    let Key::Character(c) = key else { return None };
+    let c = c.chars().next()?.to_ascii_lowercase();
+    if ctrl {
+        return match c {
+            'z' if shift => Some(EditCommand::Redo),
+            'z' => Some(EditCommand::Undo),
+            'y' => Some(EditCommand::Redo),
+            's' => Some(EditCommand::Save),
+            'e' => Some(EditCommand::Export),
+            _ => None,
+        };
+    }
+    Some(match c {
+        'a' => EditCommand::Tool(Tool::Anchor),
+        'x' => EditCommand::Tool(Tool::Scale),
+        'd' => EditCommand::Tool(Tool::Direction),
+        'v' => EditCommand::Tool(Tool::Line),
+        '[' => EditCommand::Adjust(Adjust::Q(-1)),
+        ']' => EditCommand::Adjust(Adjust::Q(1)),
+        ',' => EditCommand::Adjust(Adjust::F(-1)),
+        '.' => EditCommand::Adjust(Adjust::F(1)),
+        '-' => EditCommand::Adjust(Adjust::P(-1)),
+        '=' | '+' => EditCommand::Adjust(Adjust::P(1)),
+        't' => EditCommand::Adjust(Adjust::NextTransfer),
+        'y' => EditCommand::Adjust(Adjust::NextStyle),
+        'g' => EditCommand::Adjust(Adjust::NextFlat),
+        _ => return None,
+    })
+}
+
+/// The edits file written beside `file` by `Ctrl`+`E`: `<stem>.edits.toml`.
+pub fn edits_path(file: &Path) -> PathBuf {
+    let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "drafter".into());
+    file.with_file_name(format!("{stem}.edits.toml"))
+}
+
+/// Writes a file for the window (a save, an export): the CLI passes its atomic writer, so an
+/// interrupted save never leaves a partial file.
+pub type Writer = dyn Fn(&Path, &[u8]) -> Result<(), String>;
+
 /// One line about a part: its name and baked parameters (what a pick shows).
 pub fn describe_part(model: &Model, id: u32) -> String {
     let Some(part) = model.part(id) else { return format!("part {id}: unknown") };
@@ -184,13 +258,17 @@ pub fn describe_part(model: &Model, id: u32) -> String {
         Some(r) => {
             let d = r.projector.direction;
             let e = r.obb.half_extents;
+            let a = r.projector.anchor;
             format!(
-                "part {id} {name:?}: {} triangles, box {} half-extents {:.4} {:.4} {:.4}, projector ({:.3}, {:.3}, {:.3}) scale {:.4}, gradient q {} f {} p {} {}, style {}",
+                "part {id} {name:?}: {} triangles, box {} half-extents {:.4} {:.4} {:.4}, projector anchor ({:.4}, {:.4}, {:.4}) direction ({:.3}, {:.3}, {:.3}) scale {:.4}, gradient q {} f {} p {} {}, style {}",
                 r.triangles,
                 r.obb.method,
                 e[0],
                 e[1],
                 e[2],
+                a[0],
+                a[1],
+                a[2],
                 d[0],
                 d[1],
                 d[2],
@@ -200,7 +278,7 @@ pub fn describe_part(model: &Model, id: u32) -> String {
                 r.gradient.p,
                 r.gradient.transfer,
                 r.style.map_or("(scene)", drafter_format::PartStyle::name)
-            )
+            ) + &r.flat.map(|g| format!(", flat {g}")).unwrap_or_default()
         }
         None => format!("part {id} {name:?}: not baked (bounding-box projector)"),
     }
@@ -231,10 +309,11 @@ pub fn screenshot_path(folder: &Path, stem: &str) -> PathBuf {
 
 /// Opens a window on `model` (named `file` in the title) with `options` as the start state and
 /// runs until it is closed.
-pub fn run(model: Model, file: &Path, options: RenderOptions) -> Result<(), WindowError> {
+pub fn run(model: Model, file: &Path, options: RenderOptions, writer: &Writer) -> Result<(), WindowError> {
     let event_loop = EventLoop::new().map_err(|e| WindowError::NoDisplay(e.to_string()))?;
     let mut orbit = Orbit { view: options.view, ..Orbit::default() };
     orbit.zoom = options.zoom;
+    let editor = Editor::new(model.parts.iter().map(|p| p.record.clone()).collect());
     let mut app = App {
         model,
         file: file.to_path_buf(),
@@ -245,6 +324,11 @@ pub fn run(model: Model, file: &Path, options: RenderOptions) -> Result<(), Wind
         cursor: PhysicalPosition::new(0.0, 0.0),
         pressed: None,
         picked: None,
+        editor,
+        tool: None,
+        modifiers: ModifiersState::empty(),
+        lasso: None,
+        writer,
     };
     event_loop.run_app(&mut app).map_err(|e| WindowError::Window(e.to_string()))?;
     match app.error {
@@ -268,7 +352,7 @@ struct Press {
     dragged: bool,
 }
 
-struct App {
+struct App<'a> {
     model: Model,
     file: PathBuf,
     options: RenderOptions,
@@ -278,15 +362,22 @@ struct App {
     cursor: PhysicalPosition<f64>,
     pressed: Option<Press>,
     picked: Option<String>,
+    editor: Editor,
+    /// The manipulator a left drag over the selection applies; `None`: the drag turns the object.
+    tool: Option<Tool>,
+    modifiers: ModifiersState,
+    /// The lasso being drawn (`Ctrl`+drag), in window pixels.
+    lasso: Option<Vec<DVec2>>,
+    writer: &'a Writer,
 }
 
-impl std::fmt::Debug for App {
+impl std::fmt::Debug for App<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("App").field("file", &self.file).field("options", &self.options).finish_non_exhaustive()
     }
 }
 
-impl App {
+impl App<'_> {
     fn file_name(&self) -> String {
         self.file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
     }
@@ -390,24 +481,170 @@ impl App {
         Ok(())
     }
 
-    fn pick(&mut self, at: PhysicalPosition<f64>) -> Result<(), WindowError> {
-        let Some(state) = self.state.as_mut() else { return Ok(()) };
-        let (x, y) = (at.x.max(0.0) as u32, at.y.max(0.0) as u32);
-        let picked = state.renderer.pick(x, y)?;
-        self.options.selected_part = picked;
-        self.picked = picked.map(|id| describe_part(&self.model, id));
-        match &self.picked {
-            Some(line) => println!("{line}"),
-            None => println!("background"),
+    /// The part under `at` (the G-buffer's part-id target read back), or `None` for the background.
+    /// The last frame's targets may be larger (a supersampled screenshot) or smaller (an
+    /// interactive frame) than the window: the cursor is scaled to them.
+    fn part_at(&mut self, at: DVec2) -> Result<Option<u32>, WindowError> {
+        let Some(state) = self.state.as_mut() else { return Ok(None) };
+        let window = DVec2::new(f64::from(state.config.width.max(1)), f64::from(state.config.height.max(1)));
+        let target = state
+            .renderer
+            .last_frame()
+            .map_or(window, |f| DVec2::new(f64::from(f.target_size.0), f64::from(f.target_size.1)));
+        let p = (at.max(DVec2::ZERO) * target / window).floor();
+        Ok(state.renderer.pick(p.x as u32, p.y as u32)?)
+    }
+
+    /// A click that selects (see the module docs): alone, or with `Shift` added or removed.
+    fn click_select(&mut self, at: DVec2) -> Result<(), WindowError> {
+        let hit = self.part_at(at)?;
+        match hit {
+            Some(id) if self.modifiers.shift_key() => self.editor.selection.toggle(id),
+            _ => self.editor.selection.click(hit),
+        }
+        self.picked = hit.map(|id| describe_part(&self.model, id));
+        if hit.is_none() {
+            println!("background");
+        }
+        self.selection_changed()
+    }
+
+    /// The frame on screen as the edits see it: the last frame's camera at the window's size.
+    fn screen_view(&self) -> Option<ScreenView> {
+        let state = self.state.as_ref()?;
+        let frame = state.renderer.last_frame()?;
+        Some(ScreenView::new(
+            frame.camera.clip_from_render(),
+            self.model.origin,
+            (state.config.width, state.config.height),
+        ))
+    }
+
+    /// Uploads the selection's highlight and lists the selection on stdout.
+    fn selection_changed(&mut self) -> Result<(), WindowError> {
+        let selection = self.editor.selection.clone();
+        self.model.set_selection(&selection.parts, selection.reference);
+        self.options.selected_part = None;
+        if let Some(state) = self.state.as_mut() {
+            state.renderer.update_parts(&self.model)?;
+        }
+        if !selection.is_empty() {
+            println!("selected {} part(s):", selection.parts.len());
+            for &id in &selection.parts {
+                let mark = if selection.reference == Some(id) { " (reference)" } else { "" };
+                println!("  {}{mark}", describe_part(&self.model, id));
+            }
         }
         self.refresh_title();
         Ok(())
     }
 
+    /// Carries the editor's changed records over to the model and the GPU part table: one buffer
+    /// write, no re-bake.
+    fn parts_changed(&mut self, ids: &[u32]) -> Result<(), WindowError> {
+        if ids.is_empty() {
+            return Ok(());
+        }
+        for &id in ids {
+            if let Some(record) = self.editor.record(id) {
+                self.model.set_part_record(record);
+            }
+        }
+        if let Some(state) = self.state.as_mut() {
+            state.renderer.update_parts(&self.model)?;
+        }
+        self.refresh_title();
+        Ok(())
+    }
+
+    fn edit(&mut self, command: EditCommand) -> Result<(), WindowError> {
+        match command {
+            EditCommand::Tool(tool) => {
+                self.tool = if self.tool == Some(tool) { None } else { Some(tool) };
+                println!("tool: {}", self.tool.map_or("turn the object", Tool::name));
+                self.refresh_title();
+            }
+            EditCommand::Adjust(adjust) => {
+                let ids = self.editor.adjust(adjust);
+                self.parts_changed(&ids)?;
+                self.list_edited(&ids);
+            }
+            EditCommand::Undo => {
+                let ids = self.editor.undo();
+                self.parts_changed(&ids)?;
+                self.list_edited(&ids);
+            }
+            EditCommand::Redo => {
+                let ids = self.editor.redo();
+                self.parts_changed(&ids)?;
+                self.list_edited(&ids);
+            }
+            EditCommand::Save => self.save(),
+            EditCommand::Export => self.export(),
+        }
+        Ok(())
+    }
+
+    fn list_edited(&self, ids: &[u32]) {
+        for &id in ids {
+            println!("  {}", describe_part(&self.model, id));
+        }
+    }
+
+    /// Writes the edited part records into the file (`Ctrl`+`S`); failures are printed, the window
+    /// goes on.
+    fn save(&mut self) {
+        if !self.model.baked {
+            eprintln!("drafter: not saved: {} is not a baked file (bake it first)", self.file.display());
+            return;
+        }
+        let unsaved = self.editor.unsaved();
+        let records: Vec<drafter_format::PartRecord> = self.editor.records().cloned().collect();
+        let result = std::fs::read(&self.file)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| drafter_format::replace_part_records(&bytes, &records).map_err(|e| e.to_string()))
+            .and_then(|bytes| (self.writer)(&self.file, &bytes));
+        match result {
+            Ok(()) => {
+                self.editor.mark_saved();
+                println!("saved: {} ({} part record(s) changed)", self.file.display(), unsaved.len());
+                self.refresh_title();
+            }
+            Err(e) => eprintln!("drafter: not saved: {}: {e}", self.file.display()),
+        }
+    }
+
+    /// Writes `<stem>.edits.toml` beside the file (`Ctrl`+`E`).
+    fn export(&self) {
+        let path = edits_path(&self.file);
+        let toml = self.editor.overrides_toml(&self.file_name());
+        match (self.writer)(&path, toml.as_bytes()) {
+            Ok(()) => println!("edits: {}", path.display()),
+            Err(e) => eprintln!("drafter: edits not written: {}: {e}", path.display()),
+        }
+    }
+
     fn refresh_title(&self) {
         if let Some(state) = &self.state {
             let short = self.picked.as_deref().map(|p| p.split(':').next().unwrap_or(p));
-            state.window.set_title(&title(&self.file_name(), &self.options, short));
+            let mut title = title(&self.file_name(), &self.options, short);
+            let selection = &self.editor.selection;
+            if !selection.is_empty() {
+                title.push_str(&format!(" | {} selected", selection.parts.len()));
+            }
+            if let Some(tool) = self.tool {
+                title.push_str(&format!(" | tool: {}", tool.name()));
+            }
+            if !self.editor.unsaved().is_empty() {
+                title.push_str(" | unsaved");
+            }
+            state.window.set_title(&title);
+            state.window.request_redraw();
+        }
+    }
+
+    fn request_redraw(&self) {
+        if let Some(state) = &self.state {
             state.window.request_redraw();
         }
     }
@@ -424,34 +661,97 @@ impl App {
                 }
             }
             WindowEvent::RedrawRequested => self.redraw()?,
+            WindowEvent::ModifiersChanged(modifiers) => self.modifiers = modifiers.state(),
             WindowEvent::CursorMoved { position, .. } => {
                 let (dx, dy) = ((position.x - self.cursor.x) as f32, (position.y - self.cursor.y) as f32);
                 self.cursor = position;
+                let now = DVec2::new(position.x, position.y);
                 if let Some(press) = self.pressed.as_mut() {
                     let moved = (position.x - press.at.x).hypot(position.y - press.at.y);
                     press.dragged |= moved > CLICK_SLOP_PX;
                     if press.dragged {
-                        match press.button {
-                            MouseButton::Left => self.orbit.rotate(dx, dy),
-                            MouseButton::Right | MouseButton::Middle => {
-                                self.orbit.pan_by(dx, dy, self.options.size);
+                        let button = press.button;
+                        if let Some(path) = self.lasso.as_mut() {
+                            if path.last().is_none_or(|last| last.distance(now) >= 2.0) {
+                                path.push(now);
                             }
-                            _ => {}
+                        } else if self.editor.dragging() {
+                            if let Some(view) = self.screen_view() {
+                                let ids = self.editor.drag_to(&view, now);
+                                self.parts_changed(&ids)?;
+                            }
+                        } else {
+                            match button {
+                                MouseButton::Left => self.orbit.rotate(dx, dy),
+                                MouseButton::Right | MouseButton::Middle => {
+                                    self.orbit.pan_by(dx, dy, self.options.size);
+                                }
+                                _ => {}
+                            }
                         }
-                        if let Some(state) = &self.state {
-                            state.window.request_redraw();
-                        }
+                        self.request_redraw();
                     }
                 }
             }
             WindowEvent::MouseInput { state: button_state, button, .. } => match button_state {
-                ElementState::Pressed => self.pressed = Some(Press { button, at: self.cursor, dragged: false }),
+                ElementState::Pressed => {
+                    self.pressed = Some(Press { button, at: self.cursor, dragged: false });
+                    let at = DVec2::new(self.cursor.x, self.cursor.y);
+                    if button == MouseButton::Left {
+                        if self.modifiers.control_key() {
+                            self.lasso = Some(vec![at]);
+                        } else if let Some(tool) = self.tool
+                            && !self.modifiers.shift_key()
+                        {
+                            self.editor.begin(tool, at);
+                        }
+                    }
+                }
                 ElementState::Released => {
-                    if let Some(press) = self.pressed.take()
-                        && press.button == MouseButton::Left
-                        && !press.dragged
-                    {
-                        self.pick(press.at)?;
+                    let Some(press) = self.pressed.take() else { return Ok(()) };
+                    if press.button != MouseButton::Left {
+                        return Ok(());
+                    }
+                    let at = DVec2::new(press.at.x, press.at.y);
+                    if let Some(path) = self.lasso.take() {
+                        if press.dragged {
+                            if let Some(view) = self.screen_view() {
+                                let boxes: Vec<(u32, PartBox)> = self
+                                    .model
+                                    .parts
+                                    .iter()
+                                    .filter_map(|p| Some((p.id, PartBox::from_record(&p.record.as_ref()?.obb))))
+                                    .collect();
+                                let inside = parts_in_lasso(&path, &view, &boxes);
+                                self.editor.selection.lasso(&inside, self.modifiers.shift_key());
+                                self.selection_changed()?;
+                            }
+                        } else {
+                            self.click_select(at)?;
+                        }
+                    } else if self.editor.dragging() {
+                        if self.editor.end() {
+                            let ids = self.editor.selection.parts.clone();
+                            self.list_edited(&ids);
+                            self.refresh_title();
+                        } else if !press.dragged {
+                            // A click with a tool: the anchor tool centres the anchor under the
+                            // cursor when the click lands on a selected part; any other click
+                            // selects.
+                            let hit = self.part_at(at)?;
+                            let on_selection = hit.is_some_and(|id| self.editor.selection.contains(id));
+                            if self.tool == Some(Tool::Anchor) && on_selection {
+                                if let Some(view) = self.screen_view() {
+                                    let ids = self.editor.centre_anchor(&view, at);
+                                    self.parts_changed(&ids)?;
+                                    self.list_edited(&ids);
+                                }
+                            } else {
+                                self.click_select(at)?;
+                            }
+                        }
+                    } else if !press.dragged {
+                        self.click_select(at)?;
                     }
                 }
             },
@@ -466,6 +766,13 @@ impl App {
                 }
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                let (ctrl, shift) = (self.modifiers.control_key(), self.modifiers.shift_key());
+                if let Some(command) = edit_command_for_key(&event.logical_key, ctrl, shift) {
+                    return self.edit(command);
+                }
+                if ctrl {
+                    return Ok(());
+                }
                 match action_for_key(&event.logical_key) {
                     Some(Action::Quit) => event_loop.exit(),
                     Some(Action::Screenshot) => self.screenshot()?,
@@ -482,7 +789,7 @@ impl App {
     }
 }
 
-impl ApplicationHandler for App {
+impl ApplicationHandler for App<'_> {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.state.is_some() {
             return;
@@ -596,6 +903,33 @@ mod tests {
         Action::ResetView.apply(&mut options, &mut orbit);
         assert_eq!(orbit, Orbit::default());
         assert!(!Action::Screenshot.apply(&mut options, &mut orbit));
+    }
+
+    #[test]
+    fn edit_keys_map_to_commands_and_leave_the_view_keys_alone() {
+        let key = |s: &str| Key::Character(s.into());
+        assert_eq!(edit_command_for_key(&key("a"), false, false), Some(EditCommand::Tool(Tool::Anchor)));
+        assert_eq!(edit_command_for_key(&key("X"), false, true), Some(EditCommand::Tool(Tool::Scale)));
+        assert_eq!(edit_command_for_key(&key("d"), false, false), Some(EditCommand::Tool(Tool::Direction)));
+        assert_eq!(edit_command_for_key(&key("v"), false, false), Some(EditCommand::Tool(Tool::Line)));
+        assert_eq!(edit_command_for_key(&key("]"), false, false), Some(EditCommand::Adjust(Adjust::Q(1))));
+        assert_eq!(edit_command_for_key(&key(","), false, false), Some(EditCommand::Adjust(Adjust::F(-1))));
+        assert_eq!(edit_command_for_key(&key("="), false, false), Some(EditCommand::Adjust(Adjust::P(1))));
+        assert_eq!(edit_command_for_key(&key("g"), false, false), Some(EditCommand::Adjust(Adjust::NextFlat)));
+        assert_eq!(edit_command_for_key(&key("z"), true, false), Some(EditCommand::Undo));
+        assert_eq!(edit_command_for_key(&key("Z"), true, true), Some(EditCommand::Redo));
+        assert_eq!(edit_command_for_key(&key("y"), true, false), Some(EditCommand::Redo));
+        assert_eq!(edit_command_for_key(&key("s"), true, false), Some(EditCommand::Save));
+        assert_eq!(edit_command_for_key(&key("e"), true, false), Some(EditCommand::Export));
+        // Without Ctrl, S and E stay the view's keys (next style, edges); no edit key takes a view key.
+        for c in ["s", "e", "l", "h", "o", "r", "p", "q", "1", "7"] {
+            assert_eq!(edit_command_for_key(&key(c), false, false), None, "{c}");
+            assert!(action_for_key(&key(c)).is_some(), "{c}");
+        }
+        for c in ["a", "x", "d", "v", "[", "]", ",", ".", "-", "=", "t", "y", "g"] {
+            assert_eq!(action_for_key(&key(c)), None, "{c} is an edit key only");
+        }
+        assert_eq!(edits_path(Path::new("out/gear.baked.glb")), Path::new("out/gear.baked.edits.toml"));
     }
 
     #[test]

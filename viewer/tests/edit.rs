@@ -107,3 +107,44 @@ fn exported_overrides_rebake_to_the_saved_records() {
     let edited: Vec<PartRecord> = editor.records().cloned().collect();
     assert_eq!(records(&rebaked), edited, "{toml}");
 }
+
+/// An edit reaches the next frame through the part table alone: the frame drawn after
+/// `update_parts` equals a frame of the edited model uploaded from scratch, and differs from the
+/// frame before only on the edited parts' pixels.
+#[test]
+fn an_edit_reaches_the_next_frame_through_the_part_table_alone() {
+    let original = bake(&drafter_bake::BakeConfig::default());
+    let options = drafter_viewer::RenderOptions { size: (320, 240), ..Default::default() };
+    let mut model = Model::load_bytes(Path::new("sample.baked.glb"), &original).unwrap();
+    // The base plate's gradient (q) and the right bracket's tone: both large in the default view.
+    let mut editor = Editor::new(model.parts.iter().map(|p| p.record.clone()).collect());
+    editor.selection.click(Some(0));
+    editor.adjust(Adjust::Q(3));
+    editor.selection.click(Some(1));
+    editor.adjust(Adjust::NextFlat);
+    assert_eq!(editor.unsaved(), vec![0, 1]);
+
+    let mut renderer = common::renderer();
+    renderer.set_model(&model).unwrap();
+    let before = renderer.render(&options).unwrap();
+    let ids = renderer.part_map().unwrap().unwrap().ids;
+    for id in editor.unsaved() {
+        assert!(model.set_part_record(editor.record(id).unwrap()));
+    }
+    renderer.update_parts(&model).unwrap();
+    let after = renderer.render(&options).unwrap();
+
+    let mut fresh = common::renderer();
+    fresh.set_model(&model).unwrap();
+    assert_eq!(fresh.render(&options).unwrap().rgba, after.rgba, "update_parts draws what a full upload draws");
+
+    let edited = editor.unsaved();
+    let mut changed = 0;
+    for (k, (a, b)) in before.rgba.chunks_exact(4).zip(after.rgba.chunks_exact(4)).enumerate() {
+        if a != b {
+            changed += 1;
+            assert!(ids[k].is_some_and(|id| edited.contains(&id)), "pixel {k} of part {:?} changed", ids[k]);
+        }
+    }
+    assert!(changed > 20, "{changed} pixels changed");
+}

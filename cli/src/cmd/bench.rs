@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use drafter_viewer::{Enhancements, RenderOptions, Renderer, ShadowMode, Style};
+use drafter_viewer::{Enhancements, Model, RenderOptions, Renderer, ShadowMode, Style};
 use serde::Serialize;
 
 use crate::exit::BadInput;
@@ -275,6 +275,106 @@ pub struct PartsReport {
     pub cases: serde_json::Map<String, serde_json::Value>,
     /// Frame time with 1000 parts over the time with 10, per layout and style.
     pub ratios: serde_json::Map<String, serde_json::Value>,
+    /// What an illustrator's edit of all 1000 parts at once costs (issue 15's budget: 1 ms).
+    pub edit: EditCost,
+}
+
+/// Median milliseconds, CPU and upload until the GPU is idle, of one edit of every part of the
+/// 1000-part model: a keyboard edit (q) and a step of an anchor drag (the manipulator over 1000
+/// targets), each followed by the part-table upload ([`Renderer::update_parts`]).
+#[derive(Debug, Serialize)]
+pub struct EditCost {
+    pub parts: usize,
+    pub edits: usize,
+    pub key_ms: f64,
+    pub drag_ms: f64,
+}
+
+/// Times [`EditCost`] on the 1000-part labelled model, its parts given baked records (a box and a
+/// projector each) so that the editor can change them.
+fn edit_cost(renderer: &mut Renderer, base: &RenderOptions, triangles: usize) -> Result<EditCost> {
+    use drafter_viewer::edit::{Adjust, Editor, ScreenView, Tool};
+    const EDITS: usize = 101;
+    let mut model = spheres::model(1000, triangles, true)?;
+    let origin = model.origin;
+    let records: Vec<Option<drafter_format::PartRecord>> = model
+        .parts
+        .iter()
+        .map(|p| {
+            // The fallback projector row is p = d·x + w in render space: the anchor is where p = 1/2.
+            let row = glam::DVec4::from(p.gpu.projector_row.map(f64::from));
+            let gradient = glam::DVec3::new(row.x, row.y, row.z);
+            let scale = 1.0 / gradient.length().max(1e-12);
+            let direction = gradient * scale;
+            let anchor = origin + direction * (0.5 - row.w) * scale;
+            let projector = drafter_bounds::Projector { anchor, direction, scale };
+            Some(drafter_format::PartRecord {
+                id: p.id,
+                name: p.name.clone(),
+                triangles: 0,
+                obb: drafter_format::BoxRecord {
+                    center: anchor.to_array(),
+                    axes: p.gpu.axes.map(|a| [f64::from(a[0]), f64::from(a[1]), f64::from(a[2])]),
+                    half_extents: [scale * 0.5; 3],
+                    volume: scale.powi(3),
+                    method: drafter_format::ObbMethod::Aabb,
+                },
+                projector: drafter_format::ProjectorRecord {
+                    anchor: anchor.to_array(),
+                    direction: direction.to_array(),
+                    scale,
+                    matrix: projector.matrix().to_cols_array(),
+                },
+                gradient: drafter_format::GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: Default::default() },
+                style: None,
+                flat: None,
+            })
+        })
+        .collect();
+    for (part, record) in model.parts.iter_mut().zip(&records) {
+        part.record = record.clone();
+    }
+    renderer.set_model(&model)?;
+    renderer.time_frame(base)?;
+    let frame = renderer.last_frame().ok_or_else(|| anyhow::anyhow!("no frame drawn"))?;
+    let view = ScreenView::new(frame.camera.clip_from_render(), origin, frame.target_size);
+    let mut editor = Editor::new(records);
+    let all: Vec<u32> = model.parts.iter().map(|p| p.id).collect();
+    editor.selection.lasso(&all, false);
+    let mut apply = |editor: &Editor, ids: &[u32], model: &mut Model| -> Result<()> {
+        for &id in ids {
+            if let Some(record) = editor.record(id) {
+                model.set_part_record(record);
+            }
+        }
+        renderer.update_parts(model)?;
+        renderer.wait_idle()?;
+        Ok(())
+    };
+    let median = |mut t: Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        round3(t[t.len() / 2])
+    };
+    let mut key = Vec::new();
+    for k in 0..EDITS {
+        let start = Instant::now();
+        let ids = editor.adjust(Adjust::Q(if k % 2 == 0 { 1 } else { -1 }));
+        apply(&editor, &ids, &mut model)?;
+        key.push(start.elapsed().as_secs_f64() * 1e3);
+        anyhow::ensure!(ids.len() == all.len(), "the edit changed {} of {} parts", ids.len(), all.len());
+    }
+    let mut drag = Vec::new();
+    let (w, h) = (f64::from(frame.target_size.0), f64::from(frame.target_size.1));
+    editor.begin(Tool::Anchor, glam::DVec2::new(w * 0.5, h * 0.5));
+    for k in 0..EDITS {
+        let now = glam::DVec2::new(w * 0.5 + (k % 20) as f64, h * 0.5 + 1.0);
+        let start = Instant::now();
+        let ids = editor.drag_to(&view, now);
+        apply(&editor, &ids, &mut model)?;
+        drag.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    editor.end();
+    Ok(EditCost { parts: all.len(), edits: EDITS, key_ms: median(key), drag_ms: median(drag) })
 }
 
 fn parts(args: PartsArgs) -> Result<()> {
@@ -319,6 +419,7 @@ fn parts(args: PartsArgs) -> Result<()> {
         }
         cases.insert(name.clone(), serde_json::Value::Object(row));
     }
+    let edit = edit_cost(&mut renderer, &base, args.triangles)?;
     let mut ratios = serde_json::Map::new();
     for (layout, _) in layouts {
         for style in styles {
@@ -334,6 +435,7 @@ fn parts(args: PartsArgs) -> Result<()> {
         triangles: models.first().map_or(0, |(_, m)| m.triangle_count()),
         cases,
         ratios,
+        edit,
     };
     if args.json {
         out!("{}", serde_json::to_string_pretty(&report)?);
@@ -353,6 +455,14 @@ fn parts(args: PartsArgs) -> Result<()> {
         for (name, ratio) in &report.ratios {
             out!("  1000 / 10 parts, {name:<16} {ratio}×");
         }
+        let e = &report.edit;
+        out!(
+            "  edit of all {} parts, CPU + part-table upload until the GPU is idle (median of {}): key {:.3} ms, anchor-drag step {:.3} ms",
+            e.parts,
+            e.edits,
+            e.key_ms,
+            e.drag_ms
+        );
     }
     Ok(())
 }

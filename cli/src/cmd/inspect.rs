@@ -359,7 +359,8 @@ fn print_text(r: &Report) -> anyhow::Result<()> {
                 format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2]),
                 p.projector.scale,
                 format!("{}/{}/{}", p.gradient.q, p.gradient.f, p.gradient.p),
-                p.style.map_or("-", drafter_format::PartStyle::name)
+                p.style.map_or("-", drafter_format::PartStyle::name).to_owned()
+                    + &p.flat.map(|g| format!(", flat {g}")).unwrap_or_default()
             );
         }
         if b.parts.len() > TABLE_ROWS {

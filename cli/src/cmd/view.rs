@@ -1,7 +1,9 @@
 //! `drafter view FILE [--style S] [--size WxH] [--view AZ,EL] [--edges] [--lines] [--shadow S]
 //! [--ortho]`: the interactive window (winit). Drag turns the object, the wheel zooms, right or
 //! middle drag pans, `1`–`7`/`S` switch the style, `E`/`L`/`H` toggle edges, lines and the shadow,
-//! a click picks a part (printed and shown in the title), `P` saves a screenshot; see
+//! a click selects a part (printed and shown in the title), `P` saves a screenshot; parts are
+//! edited in place (Lux et al. 2013 §4: anchor, scale, direction and projector-line tools, gradient
+//! keys, undo, `Ctrl`+`S` saves into the file, `Ctrl`+`E` exports the edits as bake overrides); see
 //! `drafter_viewer::window`. Without a display it fails with one line (exit code 2).
 
 use std::path::PathBuf;
@@ -56,7 +58,13 @@ pub fn run(args: Args) -> Result<()> {
     for notice in &model.notices {
         eprintln!("  note: {notice}");
     }
-    drafter_viewer::window::run(model, &args.file, options).map_err(|e| match e {
+    // Saves and exports from the window go through the bake's atomic writer: a signal during a
+    // save leaves the previous file intact and no temporary file.
+    crate::interrupt::install();
+    let writer = |path: &std::path::Path, bytes: &[u8]| {
+        crate::cmd::bake::write_atomically(path, bytes).map_err(|e| crate::exit::one_line(&e))
+    };
+    drafter_viewer::window::run(model, &args.file, options, &writer).map_err(|e| match e {
         WindowError::NoDisplay(_) => anyhow::Error::from(BadInput(e.to_string())),
         other => anyhow::Error::from(other),
     })
