@@ -11,6 +11,9 @@ pub fn all(report: &SweepReport) -> Vec<(&'static str, Figure)> {
         out.push(("silhouettes", f));
     }
     out.push(("segmentation", segmentation(report)));
+    if !report.segmentation.contacts.is_empty() {
+        out.push(("segmentation_contacts", segmentation_contacts(report)));
+    }
     out.push(("bake", bake(report)));
     out
 }
@@ -319,6 +322,83 @@ pub fn segmentation(report: &SweepReport) -> Figure {
                 mark(&g.by_merge_fraction, g.default_merge_fraction, 100.0, &ms),
             ),
         ],
+    }
+}
+
+/// Issue 17: `auto` on the generated contact family, fans paired whole only (before) and in part
+/// (now): triangles in a matching part, and parts found against the true count.
+pub fn segmentation_contacts(report: &SweepReport) -> Figure {
+    let c = &report.segmentation.contacts;
+    // Numbers on the axis (the names do not fit); the kinds repeat in each variant, in order.
+    let categories: Vec<String> = (1..=c.len()).map(|i| i.to_string()).collect();
+    let mut kinds: Vec<&str> = Vec::new();
+    let mut variants: Vec<&str> = Vec::new();
+    for p in c {
+        let (kind, variant) = p.name.split_once('/').unwrap_or((&p.name, ""));
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+        if !variants.contains(&variant) {
+            variants.push(variant);
+        }
+    }
+    let x_label = format!(
+        "generated assembly: {} × ({})",
+        variants.join(", "),
+        kinds.iter().enumerate().map(|(i, k)| format!("{} {k}", i + 1)).collect::<Vec<_>>().join(", ")
+    );
+    let at = |offset: f64, f: &dyn Fn(&crate::sweep::ContactPoint) -> f64| -> Vec<(f64, f64)> {
+        c.iter().enumerate().map(|(i, p)| (i as f64 + offset, f(p))).collect()
+    };
+    let passing = |f: &dyn Fn(&crate::sweep::ContactPoint) -> (f64, usize)| {
+        c.iter().filter(|p| f(p).0 >= 0.99 && f(p).1 == p.truth_parts).count()
+    };
+    let (before, after) = (passing(&|p| p.whole), passing(&|p| p.partial));
+    let matched = Panel {
+        title: "triangles in a part that matches one original part (bar: 99%)".into(),
+        x_label: x_label.clone(),
+        y_label: "% of triangles".into(),
+        categories: categories.clone(),
+        series: vec![
+            Series::new("fans paired whole only (before)", Kind::BigPoints, 1, at(-0.15, &|p| 100.0 * p.whole.0)),
+            Series::new("fans paired in part (now)", Kind::BigPoints, 0, at(0.15, &|p| 100.0 * p.partial.0)),
+        ],
+        headroom: 0.25,
+        y_from_zero: true,
+        y_max: Some(100.0),
+        ..Panel::default()
+    };
+    let parts = Panel {
+        title: "parts found minus true parts".into(),
+        x_label,
+        y_label: "extra parts".into(),
+        categories,
+        series: vec![
+            Series::new(
+                "fans paired whole only (before)",
+                Kind::BigPoints,
+                1,
+                at(-0.15, &|p| p.whole.1 as f64 - p.truth_parts as f64),
+            ),
+            Series::new(
+                "fans paired in part (now)",
+                Kind::BigPoints,
+                0,
+                at(0.15, &|p| p.partial.1 as f64 - p.truth_parts as f64),
+            ),
+        ],
+        headroom: 0.25,
+        y_from_zero: true,
+        ..Panel::default()
+    };
+    Figure {
+        title: format!(
+            "Segmentation of touching parts (generated, merged into one unwelded mesh): {before} of {} at the bar before, {after} now",
+            c.len()
+        ),
+        columns: 1,
+        size: (1600, 1100),
+        panels: vec![matched, parts],
     }
 }
 

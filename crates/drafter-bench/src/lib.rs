@@ -7,6 +7,7 @@
 //! the [`sweep::SweepReport`] as JSON. Nothing here prints; progress goes through
 //! [`sweep::Progress`].
 
+pub mod assemblies;
 pub mod chart;
 pub mod figures;
 pub mod generate;

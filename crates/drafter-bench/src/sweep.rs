@@ -32,7 +32,7 @@ use drafter_lines::{
     depth_for_count,
 };
 use drafter_normals::{EnhanceOptions, enhance_faces};
-use drafter_segment::{SegmentMode, SegmentOptions, segment, segment_with_topologies};
+use drafter_segment::{FanPairing, SegmentMode, SegmentOptions, segment, segment_with_topologies};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -594,6 +594,40 @@ pub struct SegmentSweep {
     pub by_region_angle: Vec<SegmentPoint>,
     /// `auto` mode on each unique mesh alone over [`MERGE_FRACTIONS`] (parts summed).
     pub by_merge_fraction: Vec<SegmentPoint>,
+    /// `auto` mode on the generated contact family ([`crate::assemblies::contact_assemblies`]),
+    /// with fans paired whole only (before issue 17) and in part (the default).
+    #[serde(default)]
+    pub contacts: Vec<ContactPoint>,
+}
+
+/// Accuracy of `auto` on one generated contact assembly, before and after issue 17.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ContactPoint {
+    pub name: String,
+    pub triangles: usize,
+    pub truth_parts: usize,
+    /// [`FanPairing::Whole`]: fraction of triangles in a matching part, and parts found.
+    pub whole: (f64, usize),
+    /// [`FanPairing::Partial`] (the default): the same.
+    pub partial: (f64, usize),
+}
+
+/// [`ContactPoint`]s of the generated contact family.
+pub fn contact_accuracy() -> Vec<ContactPoint> {
+    crate::assemblies::contact_assemblies()
+        .iter()
+        .map(|a| {
+            let (scene, truth) = a.merged();
+            let measure = |fan_pairing| {
+                let (parts, _) = segment(&scene, &SegmentOptions { fan_pairing, ..SegmentOptions::default() });
+                let acc = crate::assemblies::accuracy(&parts, &truth);
+                (acc, (acc.matched, acc.parts))
+            };
+            let (acc, whole) = measure(FanPairing::Whole);
+            let (_, partial) = measure(FanPairing::Partial);
+            ContactPoint { name: a.name.clone(), triangles: truth.len(), truth_parts: acc.truth_parts, whole, partial }
+        })
+        .collect()
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -604,7 +638,7 @@ pub struct SegmentPoint {
 }
 
 pub fn sweep_segmentation(scene: &Scene, topologies: &[Topology], progress: &mut dyn Progress) -> SegmentSweep {
-    progress.stage("segmentation", (REGION_ANGLES.len() + MERGE_FRACTIONS.len() + 1) as u64);
+    progress.stage("segmentation", (REGION_ANGLES.len() + MERGE_FRACTIONS.len() + 2) as u64);
     let defaults = SegmentOptions::default();
     let (default_parts, _) = segment_with_topologies(scene, topologies, &defaults);
     progress.tick();
@@ -636,7 +670,10 @@ pub fn sweep_segmentation(scene: &Scene, topologies: &[Topology], progress: &mut
         by_merge_fraction.push(SegmentPoint { value: fraction, parts, ms });
         progress.tick();
     }
+    let contacts = contact_accuracy();
+    progress.tick();
     SegmentSweep {
+        contacts,
         default_parts: default_parts.len(),
         default_region_angle_deg: defaults.region_angle_deg,
         default_merge_fraction: defaults.merge_triangle_fraction,

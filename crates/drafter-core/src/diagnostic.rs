@@ -46,6 +46,9 @@ pub enum DiagnosticKind {
     InconsistentWinding,
     /// Non-manifold edges that could not be paired into solids; parts are cut there.
     UnpairedNonManifoldEdge,
+    /// Non-manifold edges whose faces could be paired into solids only in part; the faces left
+    /// over are free edges of their parts.
+    PartlyPairedNonManifoldEdge,
     /// Small components merged into a touching neighbour by segmentation.
     MergedSliver,
     /// A mesh whose line stage failed; it has no edges in the output.
@@ -80,6 +83,7 @@ impl DiagnosticKind {
             Self::DegenerateEdge => "edges along degenerate triangles",
             Self::InconsistentWinding => "edges between faces of inconsistent winding",
             Self::UnpairedNonManifoldEdge => "unpaired non-manifold edges",
+            Self::PartlyPairedNonManifoldEdge => "partly paired non-manifold edges",
             Self::MergedSliver => "small components merged",
             Self::LinesSkipped => "meshes without lines",
             Self::EdgesNotWritten => "primitives without edges",

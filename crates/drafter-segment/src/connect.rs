@@ -5,6 +5,7 @@ use drafter_core::{EDGE_NONE, Topology};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use crate::FanPairing;
 use crate::union_find::{ConcurrentUnionFind, UnionFind};
 
 /// Which vertex-connected components are inside-out (negative signed volume), so that edge
@@ -47,7 +48,11 @@ impl Orientation {
 pub(crate) struct FreeEdges {
     /// Non-manifold edges whose faces could not be paired, increasing.
     pub(crate) unpaired: Vec<u32>,
-    /// Faces with a boundary edge or an unpaired non-manifold edge.
+    /// Non-manifold edges whose faces were paired in part ([`partial_pairs`]), increasing.
+    pub(crate) partial: Vec<u32>,
+    /// Faces left without a partner at the edges of `partial`.
+    pub(crate) left_open: usize,
+    /// Faces with a boundary edge, an unpaired non-manifold edge, or no partner at a partly paired one.
     pub(crate) open_faces: Vec<bool>,
 }
 
@@ -55,14 +60,14 @@ pub(crate) struct FreeEdges {
 /// two faces of a manifold edge, and at a non-manifold edge the faces paired by the radial rule
 /// (see the crate docs). Returns the free edges: boundary edges, and non-manifold edges whose faces
 /// could not be paired (left unjoined).
-fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
+fn for_each_link(topo: &Topology, pairing: FanPairing, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
     let orientation = Orientation::new(topo);
-    let (mut unpaired, open) = (0..topo.edge_count())
+    let (mut unpaired, mut partial, open) = (0..topo.edge_count())
         .into_par_iter()
         .with_min_len(1 << 14)
         .fold(
-            || (Vec::new(), Vec::new(), Vec::new()),
-            |(mut unpaired, mut open, mut fan), e| {
+            || (Vec::new(), Vec::new(), Vec::new(), Vec::new()),
+            |(mut unpaired, mut partial, mut open, mut fan), e| {
                 let faces = topo.faces_of_edge(e);
                 match faces.len() {
                     0 => {}
@@ -73,41 +78,54 @@ fn for_each_link(topo: &Topology, link: impl Fn(u32, u32) + Sync) -> FreeEdges {
                         // join the first and the fan is paired without them (2,000 copies of one face
                         // would otherwise make 2,000 one-triangle parts, issue 21 class 3).
                         let distinct = distinct_faces(topo, faces, &link);
-                        let paired = match distinct.len() {
+                        let pairing = match distinct.len() {
                             1 => {
                                 open.push(distinct[0]);
-                                true
+                                Pairing::Full
                             }
                             2 => {
                                 link(distinct[0], distinct[1]);
-                                true
+                                Pairing::Full
                             }
-                            _ => radial_pairs(topo, &orientation, e, &distinct, &mut fan, &link),
+                            _ => radial_pairs(topo, &orientation, e, &distinct, pairing, &mut fan, &link),
                         };
-                        if !paired {
-                            unpaired.push(e as u32);
-                            open.extend_from_slice(faces);
+                        match pairing {
+                            Pairing::Full => {}
+                            Pairing::Partial => {
+                                // The faces left over are the fan's entries without a partner.
+                                let before = open.len();
+                                open.extend(fan.iter().filter(|x| x.1 == LEFT_OVER).map(|x| x.2));
+                                partial.push((e as u32, (open.len() - before) as u32));
+                            }
+                            Pairing::None => {
+                                unpaired.push(e as u32);
+                                open.extend_from_slice(faces);
+                            }
                         }
                     }
                 }
-                (unpaired, open, fan)
+                (unpaired, partial, open, fan)
             },
         )
-        .map(|(unpaired, open, _)| (unpaired, open))
+        .map(|(unpaired, partial, open, _)| (unpaired, partial, open))
         .reduce(
-            || (Vec::new(), Vec::new()),
-            |(mut u1, mut o1), (mut u2, mut o2)| {
+            || (Vec::new(), Vec::new(), Vec::new()),
+            |(mut u1, mut p1, mut o1), (mut u2, mut p2, mut o2)| {
                 u1.append(&mut u2);
+                p1.append(&mut p2);
                 o1.append(&mut o2);
-                (u1, o1)
+                (u1, p1, o1)
             },
         );
     unpaired.sort_unstable();
+    partial.sort_unstable();
+    let left_open = partial.iter().map(|&(_, n)| n as usize).sum();
+    let partial = partial.into_iter().map(|(e, _)| e).collect();
     let mut open_faces = vec![false; topo.faces.len()];
     for f in open {
         open_faces[f as usize] = true;
     }
-    FreeEdges { unpaired, open_faces }
+    FreeEdges { unpaired, partial, left_open, open_faces }
 }
 
 /// `faces` (of one edge) without their same-orientation copies: faces whose welded vertices are
@@ -146,6 +164,17 @@ fn distinct_faces(topo: &Topology, faces: &[u32], link: &impl Fn(u32, u32)) -> V
     distinct
 }
 
+/// How the faces around a non-manifold edge were paired.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pairing {
+    /// Every face has its partner.
+    Full,
+    /// Some faces were paired; the others (marked [`LEFT_OVER`] in the fan) have none here.
+    Partial,
+    /// Nothing was linked.
+    None,
+}
+
 /// Pairs the faces around non-manifold edge `e` into the wedges of the solids that meet there.
 ///
 /// Around the edge `a → b` (a < b), a face that runs `a → b` has its outward normal pointing to
@@ -153,28 +182,30 @@ fn distinct_faces(topo: &Topology, faces: &[u32], link: &impl Fn(u32, u32)) -> V
 /// that do not overlap, the faces sorted by angle therefore alternate `b → a`, `a → b`, and each
 /// solid fills the wedge from a `b → a` face to the next `a → b` face. Ties (coincident faces of
 /// two solids touching along a face) put `a → b` first: the empty wedge between two solids has zero
-/// width. Returns false, linking nothing, when the fan does not alternate.
+/// width. When the fan does not alternate, [`partial_pairs`] pairs what it can.
 fn radial_pairs(
     topo: &Topology,
     orientation: &Orientation,
     e: usize,
     faces: &[u32],
+    pairing: FanPairing,
     fan: &mut Vec<(f64, i8, u32)>,
     link: &impl Fn(u32, u32),
-) -> bool {
+) -> Pairing {
+    fan.clear();
     let [a, b] = topo.edges[e];
     let pa = topo.welded_positions[a as usize].as_dvec3();
     let axis = (topo.welded_positions[b as usize].as_dvec3() - pa).normalize_or_zero();
     if axis == DVec3::ZERO {
-        return false;
+        return Pairing::None;
     }
     let u = axis.any_orthonormal_vector();
     let v = axis.cross(u);
-    fan.clear();
     for &f in faces {
         let tri = topo.faces[f as usize];
         let Some(k) = topo.face_edges[f as usize].iter().position(|&x| x as usize == e) else {
-            return false;
+            fan.clear();
+            return Pairing::None;
         };
         let forward = tri[k] == a;
         let inside_out = orientation.inside_out.get(topo.face_component[f as usize] as usize).copied();
@@ -185,7 +216,10 @@ fn radial_pairs(
     }
     fan.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
     if !alternate(fan) {
-        return false;
+        return match pairing {
+            FanPairing::Partial => partial_pairs(fan, link),
+            FanPairing::Whole => Pairing::None,
+        };
     }
     let n = fan.len();
     for i in 0..n {
@@ -193,29 +227,58 @@ fn radial_pairs(
             link(fan[i].2, fan[(i + 1) % n].2);
         }
     }
-    true
+    Pairing::Full
 }
 
-/// Sign of a fan entry whose face runs `a → b`: it closes a solid's wedge.
-const CLOSES: i8 = 0;
-/// Sign of a fan entry whose face runs `b → a`: it opens a solid's wedge.
-const OPENS: i8 = 1;
-
-/// Angles closer than this (radians) count as equal around a non-manifold edge: coplanar faces of
-/// two solids that touch along a face differ by rounding only.
-const ANGLE_TIE: f64 = 1e-3;
-
-/// Orders a fan sorted by angle so that opening and closing faces alternate around the edge, if
-/// that is possible by reordering faces of equal angle (within [`ANGLE_TIE`]). The fan is rotated
-/// to start after its widest gap, so no run of equal angles wraps around. Within a run, closing
-/// faces go first (two solids touching along a face leave an empty wedge of zero width); when
-/// that does not alternate, each run is ordered to continue the alternation (a zero-thickness
-/// sheet between two wedges).
-fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
+/// Pairs what can be paired in a fan that does not alternate (issue 17): an odd count, or a
+/// closing face missing, where a part whose surface is cracked (a T-junction seam, its faces
+/// meeting the edge on one side only) touches a closed solid along one of the solid's edges.
+///
+/// The fan is put in the order [`alternate`] starts from (rotated to start after its widest gap,
+/// closing faces first among faces of equal angle). Then an opening face is paired with the
+/// next face around the edge when that one closes: the wedge between them holds no other face, so
+/// it is one solid's, whatever the rest of the fan is. Each face is paired at most once; faces
+/// left over get sign [`LEFT_OVER`] and are linked to nothing here (they are free edges of their
+/// part, as the crack makes them). A fan where no such pair exists links nothing
+/// ([`Pairing::None`], as before this rule). Overlapping solids can make an adjacent pair that
+/// belongs to two solids; partly paired edges are counted in a diagnostic for that reason.
+fn partial_pairs(fan: &mut [(f64, i8, u32)], link: &impl Fn(u32, u32)) -> Pairing {
     let n = fan.len();
-    if !n.is_multiple_of(2) {
-        return false;
+    // `alternate` may have unwrapped and reordered the fan: start again from angles in [-π, π).
+    for x in fan.iter_mut() {
+        x.0 = (x.0 + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
     }
+    fan.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+    rotate_after_widest_gap(fan);
+    for run in tie_runs(fan) {
+        fan[run].sort_by_key(|x| (x.1, x.2));
+    }
+    let mut paired = vec![false; n];
+    let mut any = false;
+    for i in 0..n {
+        let j = (i + 1) % n;
+        if i != j && !paired[i] && !paired[j] && fan[i].1 == OPENS && fan[j].1 == CLOSES {
+            link(fan[i].2, fan[j].2);
+            paired[i] = true;
+            paired[j] = true;
+            any = true;
+        }
+    }
+    if !any {
+        return Pairing::None;
+    }
+    for (entry, &p) in fan.iter_mut().zip(&paired) {
+        if !p {
+            entry.1 = LEFT_OVER;
+        }
+    }
+    Pairing::Partial
+}
+
+/// Rotates a fan sorted by angle to start after its widest gap and unwraps the angles, so that no
+/// run of equal angles wraps around.
+fn rotate_after_widest_gap(fan: &mut [(f64, i8, u32)]) {
+    let n = fan.len();
     let gap = |fan: &[(f64, i8, u32)], i: usize| {
         let next = if i + 1 == n { fan[0].0 + std::f64::consts::TAU } else { fan[i + 1].0 };
         next - fan[i].0
@@ -232,6 +295,11 @@ fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
             fan[i].0 += std::f64::consts::TAU;
         }
     }
+}
+
+/// The runs of entries of a rotated fan whose angles are equal (within [`ANGLE_TIE`]).
+fn tie_runs(fan: &[(f64, i8, u32)]) -> Vec<std::ops::Range<usize>> {
+    let n = fan.len();
     let mut runs = Vec::new();
     let mut start = 0;
     while start < n {
@@ -242,6 +310,33 @@ fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
         runs.push(start..end);
         start = end;
     }
+    runs
+}
+
+/// Sign of a fan entry whose face runs `a → b`: it closes a solid's wedge.
+const CLOSES: i8 = 0;
+/// Sign of a fan entry whose face runs `b → a`: it opens a solid's wedge.
+const OPENS: i8 = 1;
+/// Sign given by [`partial_pairs`] to a fan entry left without a partner.
+const LEFT_OVER: i8 = 2;
+
+/// Angles closer than this (radians) count as equal around a non-manifold edge: coplanar faces of
+/// two solids that touch along a face differ by rounding only.
+const ANGLE_TIE: f64 = 1e-3;
+
+/// Orders a fan sorted by angle so that opening and closing faces alternate around the edge, if
+/// that is possible by reordering faces of equal angle (within [`ANGLE_TIE`]). The fan is rotated
+/// to start after its widest gap, so no run of equal angles wraps around. Within a run, closing
+/// faces go first (two solids touching along a face leave an empty wedge of zero width); when
+/// that does not alternate, each run is ordered to continue the alternation (a zero-thickness
+/// sheet between two wedges).
+fn alternate(fan: &mut [(f64, i8, u32)]) -> bool {
+    let n = fan.len();
+    if !n.is_multiple_of(2) {
+        return false;
+    }
+    rotate_after_widest_gap(fan);
+    let runs = tie_runs(fan);
     let alternates = |fan: &[(f64, i8, u32)]| (0..n).all(|i| fan[i].1 != fan[(i + 1) % n].1);
     for run in &runs {
         fan[run.clone()].sort_by_key(|x| (x.1, x.2));
@@ -304,6 +399,10 @@ pub(crate) struct Labelling {
     pub(crate) count: u32,
     /// Non-manifold edges whose faces could not be paired, increasing.
     pub(crate) unpaired_edges: Vec<u32>,
+    /// Non-manifold edges whose faces were paired in part, increasing.
+    pub(crate) partial_edges: Vec<u32>,
+    /// Faces left without a partner at the edges of `partial_edges`.
+    pub(crate) left_open: usize,
     /// Per label: true when one of its faces has a free edge (the label is not a closed surface).
     pub(crate) open: Vec<bool>,
 }
@@ -316,14 +415,21 @@ impl Labelling {
                 open[l as usize] = true;
             }
         }
-        Self { labels, count, unpaired_edges: free.unpaired, open }
+        Self {
+            labels,
+            count,
+            unpaired_edges: free.unpaired,
+            partial_edges: free.partial,
+            left_open: free.left_open,
+            open,
+        }
     }
 }
 
 /// Edge-connected components.
-pub(crate) fn components(topo: &Topology) -> Labelling {
+pub(crate) fn components(topo: &Topology, pairing: FanPairing) -> Labelling {
     let uf = ConcurrentUnionFind::new(topo.faces.len());
-    let free = for_each_link(topo, |f, g| uf.union(f, g));
+    let free = for_each_link(topo, pairing, |f, g| uf.union(f, g));
     let mut uf = uf.into_sequential();
     attach_collapsed(topo, &mut uf);
     let (labels, count) = uf.labels();
@@ -344,12 +450,12 @@ pub(crate) fn face_normals(topo: &Topology) -> Vec<Vec3> {
 
 /// Crease-bounded regions: edge-connected faces joined only where the angle between their normals
 /// is below `angle_deg`. Faces without a normal join their first linked neighbour that has one.
-pub(crate) fn regions(topo: &Topology, angle_deg: f64) -> Labelling {
+pub(crate) fn regions(topo: &Topology, angle_deg: f64, pairing: FanPairing) -> Labelling {
     let normals = face_normals(topo);
     let cos_limit = angle_deg.clamp(0.0, 180.0).to_radians().cos() as f32;
     let uf = ConcurrentUnionFind::new(topo.faces.len());
     let degenerate_links = std::sync::Mutex::new(Vec::new());
-    let free = for_each_link(topo, |f, g| {
+    let free = for_each_link(topo, pairing, |f, g| {
         let (nf, ng) = (normals[f as usize], normals[g as usize]);
         if nf == Vec3::ZERO || ng == Vec3::ZERO {
             // Rare: a lock is cheaper than threading a list through every worker.
@@ -451,5 +557,34 @@ mod tests {
     fn fans_that_cannot_pair() {
         assert_eq!(pairs(&[(0.0, OPENS), (90.0, CLOSES), (180.0, OPENS)]), None, "odd count");
         assert_eq!(pairs(&[(0.0, OPENS), (90.0, OPENS), (180.0, CLOSES), (270.0, CLOSES)]), None, "overlapping");
+    }
+
+    /// Links made by [`partial_pairs`] on an entry list, and the faces left over.
+    fn partial(entries: &[(f64, i8)]) -> (Vec<(u32, u32)>, Vec<u32>) {
+        let mut fan = fan(entries);
+        let links = std::sync::Mutex::new(Vec::new());
+        let pairing = partial_pairs(&mut fan, &|f, g| links.lock().unwrap().push((f, g)));
+        let mut links = links.into_inner().unwrap();
+        links.sort_unstable();
+        let mut left: Vec<u32> = fan.iter().filter(|x| x.1 == LEFT_OVER).map(|x| x.2).collect();
+        left.sort_unstable();
+        if pairing == Pairing::None {
+            assert!(links.is_empty() && left.is_empty());
+        }
+        (links, left)
+    }
+
+    #[test]
+    fn a_cracked_part_on_a_solid_edge_is_paired_in_part() {
+        // A cover fills 0°..180° (its side opens at 0°, its bottom closes at 180°); a gasket with a
+        // crack touches the bottom from below with one face at 180° that opens its wedge, whose
+        // closing face is missing. The cover's faces pair; the gasket's face is left over, in
+        // either listing order.
+        assert_eq!(partial(&[(0.0, OPENS), (180.0, CLOSES), (180.0, OPENS)]), (vec![(0, 1)], vec![2]));
+        assert_eq!(partial(&[(0.0, OPENS), (180.0, OPENS), (180.0, CLOSES)]), (vec![(0, 2)], vec![1]));
+        // Across the wrap-around: the closing face at -180° + 1e-9 is the same half-plane.
+        assert_eq!(partial(&[(-179.999_999_9, CLOSES), (0.0, OPENS), (180.0, OPENS)]), (vec![(1, 0)], vec![2]));
+        // Nothing closes after an opening face: nothing is linked.
+        assert_eq!(partial(&[(0.0, OPENS), (90.0, OPENS), (180.0, OPENS)]), (vec![], vec![]));
     }
 }

@@ -27,7 +27,17 @@
 //!   each other are reordered to keep the alternation (coincident faces where two solids touch
 //!   along a face, zero-thickness sheets). Inside-out vertex-connected components (negative
 //!   signed volume) are read reversed. A fan that cannot be made to alternate (odd count, open
-//!   surfaces, overlapping solids) connects nothing and is reported as a diagnostic.
+//!   surfaces, overlapping solids) is paired **in part** (issue 17): in the same order (closing
+//!   faces first among equal angles), an opening face is linked to the next face around the edge
+//!   when that one closes, since the wedge between them holds no other face and so is one
+//!   solid's; faces left over are free edges of their parts. This is the case of a part with a
+//!   crack (a T-junction seam, as exporters leave where two faces of a B-rep are discretized
+//!   differently) along a rim that lies on the edges of a closed part it touches: a gasket under a
+//!   cover, a washer under a screw head. The edge has three faces, two of the closed part and one
+//!   of the cracked one; linking nothing there (as before) cut the closed part along the whole
+//!   rim, and a cover came out as two parts. Partly paired edges and the faces left over are
+//!   counted in a diagnostic, since overlapping solids can also make such a fan; a fan with no
+//!   such pair links nothing and is reported as unpaired.
 //!
 //!   Why not simply connect every face of a non-manifold edge, or none? On `obj/occt/motor.stl`
 //!   the first gives 12 vertex-connected blobs of several solids each; the second gives 85
@@ -87,6 +97,12 @@
 //! GearboxAssy: meshes that hold several separate solids, such as a bearing and its balls).
 //! Single meshes: motor.stl 17 solids, crank.off 1, bearing.stl 1.
 //!
+//! Parts that touch (issue 17; `tests/contacts.rs` over `drafter_bench::assemblies`, generated
+//! clamped gaskets, washers under screw heads, pins pressed into holes, stacked plates, covers over
+//! casings with a gasket, with matching, non-matching and cracked tessellation): every part
+//! recovered, 100% of triangles in a matching part, except a pin whose crack runs all the way
+//! around it, which is then two open pieces with no edge between them (see Limits).
+//!
 //! # Determinism
 //!
 //! Part ids depend only on the input: unions go through union-find forests whose roots are the
@@ -105,6 +121,12 @@
 //!   that does not weld, holding more than 1% of its part's triangles) stay separate parts:
 //!   over-segmentation is the price of purity.
 //! * Pairing assumes consistently oriented faces; a fan whose faces disagree is cut, not paired.
+//! * A crack that runs all the way around a part (a T-junction seam that separates its surface)
+//!   leaves two open pieces that share no edge; they stay two parts unless one is small. Stitching
+//!   open pieces whose free boundaries lie on each other (Barequet & Sharir 1995) joins them, but
+//!   measured on the merged ReciprocatingSaw it also joined different parts whose open rims meet
+//!   (96.8% → 88.6% of triangles in a matching part, even with a closure and a volume check), so
+//!   it is not done.
 //! * Regions follow creases only; a smooth fillet joins the faces on both sides of it.
 //!
 //! # Cost
@@ -189,6 +211,19 @@ impl std::str::FromStr for SegmentMode {
     }
 }
 
+/// How the faces around a non-manifold edge are paired when they do not alternate (see the crate
+/// docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FanPairing {
+    /// Pair only fans that alternate completely; any other fan links nothing (the rule before
+    /// issue 17, kept for comparison: `drafter bench` charts both).
+    Whole,
+    /// Also pair, in part, fans that do not alternate; the faces left over are free edges.
+    #[default]
+    Partial,
+}
+
 /// Options of [`segment`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SegmentOptions {
@@ -216,6 +251,9 @@ pub struct SegmentOptions {
     /// vertices are not capped. Default [`DEFAULT_MAX_ABSORBED_FRACTION`]; range 0–∞, 0 allows
     /// shared-vertex merges only.
     pub max_absorbed_fraction: f64,
+    /// How non-manifold fans that do not alternate are paired (all modes but `Nodes`). Default
+    /// [`FanPairing::Partial`].
+    pub fan_pairing: FanPairing,
     /// How positions are welded before connectivity is derived (all modes but `Nodes`). Default
     /// [`Weld::default`]. Ignored by [`segment_with_topologies`] for meshes whose topology is given.
     pub weld: Weld,
@@ -230,6 +268,7 @@ impl Default for SegmentOptions {
             merge_diagonal_fraction: DEFAULT_MERGE_DIAGONAL_FRACTION,
             touch_fraction: DEFAULT_TOUCH_FRACTION,
             max_absorbed_fraction: DEFAULT_MAX_ABSORBED_FRACTION,
+            fan_pairing: FanPairing::default(),
             weld: Weld::default(),
         }
     }
@@ -238,8 +277,9 @@ impl Default for SegmentOptions {
 /// Cuts `scene` into parts. Builds the welded topology of every mesh it needs; see
 /// [`segment_with_topologies`] to reuse topologies built elsewhere.
 ///
-/// Diagnostics (kind [`DiagnosticKind::UnpairedNonManifoldEdge`]) report non-manifold edges whose faces could not
-/// be paired, and how many small parts were merged.
+/// Diagnostics report non-manifold edges whose faces could not be paired
+/// ([`DiagnosticKind::UnpairedNonManifoldEdge`]) or were paired only in part
+/// ([`DiagnosticKind::PartlyPairedNonManifoldEdge`]), and how many small parts were merged.
 pub fn segment(scene: &Scene, options: &SegmentOptions) -> (Parts, Vec<Diagnostic>) {
     segment_with_topologies(scene, &[], options)
 }
@@ -314,6 +354,9 @@ struct MeshResult {
     /// `None` when the whole mesh is one part.
     table: Option<Arc<LabelTable>>,
     unpaired_edges: usize,
+    /// Non-manifold edges paired in part, and the faces left over there.
+    partial_edges: usize,
+    left_open: usize,
     before_merge: u32,
     merged: usize,
     untouched: usize,
@@ -337,8 +380,8 @@ fn segment_mesh(
         }
     };
     let mut labelling = match mode {
-        SegmentMode::Regions => connect::regions(topo, options.region_angle_deg),
-        _ => connect::components(topo),
+        SegmentMode::Regions => connect::regions(topo, options.region_angle_deg, options.fan_pairing),
+        _ => connect::components(topo, options.fan_pairing),
     };
     let before_merge = labelling.count;
     let (mut merged, mut untouched, mut kept) = (0, 0, 0);
@@ -356,7 +399,16 @@ fn segment_mesh(
         labelling.count = outcome.count;
     }
     let table = (labelling.count > 1).then(|| Arc::new(LabelTable::new(labelling.labels, labelling.count)));
-    MeshResult { table, unpaired_edges: labelling.unpaired_edges.len(), before_merge, merged, untouched, kept }
+    MeshResult {
+        table,
+        unpaired_edges: labelling.unpaired_edges.len(),
+        partial_edges: labelling.partial_edges.len(),
+        left_open: labelling.left_open,
+        before_merge,
+        merged,
+        untouched,
+        kept,
+    }
 }
 
 fn diagnostics<'a>(results: impl Iterator<Item = &'a MeshResult> + Clone) -> Vec<Diagnostic> {
@@ -368,6 +420,18 @@ fn diagnostics<'a>(results: impl Iterator<Item = &'a MeshResult> + Clone) -> Vec
             count: unpaired,
             first_example: format!(
                 "{unpaired} non-manifold edges could not be paired into solids (odd count or inconsistent orientation); parts are cut there"
+            ),
+        });
+    }
+    let partial: usize = results.clone().map(|r| r.partial_edges).sum();
+    if partial > 0 {
+        let left: usize = results.clone().map(|r| r.left_open).sum();
+        out.push(Diagnostic {
+            kind: DiagnosticKind::PartlyPairedNonManifoldEdge,
+            count: partial,
+            first_example: format!(
+                "{partial} non-manifold edges could be paired into solids only in part (odd count: a cracked part touching a solid \
+                 along its edge, or overlapping solids); {left} faces there were left unpaired, as free edges of their parts"
             ),
         });
     }

@@ -209,7 +209,10 @@ fn boundary_probes(topo: &Topology, labelling: &Labelling, small: &[bool]) -> Ve
             if e == EDGE_NONE {
                 continue;
             }
-            if topo.edge_valence(e as usize) == 1 || labelling.unpaired_edges.binary_search(&e).is_ok() {
+            if topo.edge_valence(e as usize) == 1
+                || labelling.unpaired_edges.binary_search(&e).is_ok()
+                || labelling.partial_edges.binary_search(&e).is_ok()
+            {
                 probes.push((l, tri[i]));
                 probes.push((l, tri[(i + 1) % 3]));
                 has_free[l as usize] = true;
