@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 
 mod cmd;
 mod exit;
+mod gpu_env;
 mod interrupt;
 
 #[derive(Debug, Parser)]
@@ -42,6 +43,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Before anything else, while the process has one thread (see the module's docs).
+    gpu_env::quiet_device_select();
     let cli = Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {
         Command::Bake(args) => cmd::bake::run(args),

@@ -5,7 +5,7 @@
 //! camera with the light fixed to it, which is what this module does: the key light is constant in
 //! view space ([`LIGHT_IN_VIEW`]).
 
-use glam::{Mat4, Vec3, Vec4Swizzles};
+use glam::{DVec3, Mat4, Vec3, Vec4Swizzles};
 
 use crate::style::View;
 
@@ -13,8 +13,15 @@ use crate::style::View;
 /// the right of the viewer, as in Gooch et al. 1999, Fig. 5.
 pub const LIGHT_IN_VIEW: Vec3 = Vec3::new(0.40, 0.72, 0.56);
 
-/// Margin around the fitted points, as a factor of their extent.
-pub const FIT_MARGIN: f32 = 1.06;
+/// Share of the frame left empty around the fitted points, across their larger relative side
+/// (half of it on each side): their projected bounding rectangle is centred and its width spans
+/// `1 − FIT_MARGIN` of the frame's width, or its height of the frame's height, whichever is the
+/// larger share.
+pub const FIT_MARGIN: f32 = 0.06;
+
+/// How many directions [`hull_sample`] keeps a point set's extreme points along (at most this
+/// many points are kept).
+pub const SUPPORT_DIRECTIONS: usize = 1024;
 
 /// A fitted camera. All positions are in render space (see [`crate::Model::origin`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,23 +36,36 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// Fits a camera looking from `view` at `points` so that all of them are inside the frame with
-    /// [`FIT_MARGIN`]. `aspect` is width / height.
+    /// Fits a camera looking from `view` at `points`: their projected bounding rectangle is
+    /// centred in the frame and fills it up to [`FIT_MARGIN`] (see there). `aspect` is width /
+    /// height.
+    ///
+    /// # How it works
+    /// In the view's orientation (camera looking down −z from `(cx, cy, z)`), orthographic is the
+    /// points' box scaled to the frame. In perspective a point `q` is at
+    /// `x = (q.x − cx) / ((z − q.z) tan_x)`, so it stays inside the band `|x| ≤ f` (`f = 1 −
+    /// FIT_MARGIN`) when `q.x + a q.z ≤ cx + a z` and `−q.x + a q.z ≤ −cx + a z` with `a = f
+    /// tan_x`: the frustum's side planes touch the points when `z = (R + L) / 2a`, `R = max(q.x +
+    /// a q.z)`, `L = max(−q.x + a q.z)`, and the same in y. The eye takes the farther of the two
+    /// distances, so the limiting axis fills `f` exactly; then each axis is centred at that
+    /// distance by bisection on `cx` (resp. `cy`), where the largest projection to the right
+    /// minus the largest to the left decreases monotonically.
     pub fn fit(points: &[Vec3], view: View, aspect: f32, orthographic: bool, fov_y_deg: f32) -> Camera {
         let rotation = view_rotation(view);
-        let rotated: Vec<Vec3> = points.iter().map(|p| rotation.transform_vector3(*p)).collect();
-        let (lo, hi) = rotated
-            .iter()
-            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let (lo, hi) = if lo.x <= hi.x { (lo, hi) } else { (Vec3::splat(-1.0), Vec3::splat(1.0)) };
-        let extent = (hi - lo).max(Vec3::splat(1e-6));
+        let rotated: Vec<DVec3> = points.iter().map(|p| rotation.transform_vector3(*p).as_dvec3()).collect();
+        let (lo, hi) =
+            rotated.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let (lo, hi) = if lo.x <= hi.x { (lo, hi) } else { (DVec3::splat(-1.0), DVec3::splat(1.0)) };
+        let extent = (hi - lo).max(DVec3::splat(1e-6));
         let radius = extent.length() * 0.5;
-        let cx = (lo.x + hi.x) * 0.5;
-        let cy = (lo.y + hi.y) * 0.5;
+        let fill = f64::from(1.0 - FIT_MARGIN);
+        let aspect = f64::from(aspect);
 
         let (eye, clip_from_view, near, far) = if orthographic {
-            let mut half_w = extent.x * 0.5 * FIT_MARGIN;
-            let mut half_h = extent.y * 0.5 * FIT_MARGIN;
+            let mut half_w = extent.x * 0.5 / fill;
+            let mut half_h = extent.y * 0.5 / fill;
             if half_w / half_h > aspect {
                 half_h = half_w / aspect;
             } else {
@@ -54,45 +74,72 @@ impl Camera {
             let z = hi.z + radius;
             let near = radius * 0.5;
             let far = z - lo.z + radius * 0.5;
-            let proj = glam::camera::rh::proj::directx::orthographic(-half_w, half_w, -half_h, half_h, near, far);
-            (Vec3::new(cx, cy, z), proj, near, far)
+            let proj = glam::camera::rh::proj::directx::orthographic(
+                -half_w as f32,
+                half_w as f32,
+                -half_h as f32,
+                half_h as f32,
+                near as f32,
+                far as f32,
+            );
+            (DVec3::new((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5, z), proj, near, far)
         } else {
-            let tan_y = (fov_y_deg.to_radians() * 0.5).tan();
+            let tan_y = (f64::from(fov_y_deg).to_radians() * 0.5).tan();
             let tan_x = tan_y * aspect;
-            // The distance that fits every point around (cx, cy), then (cx, cy) moved to centre the
-            // projected extent (nearer points spread further), a few times.
-            let (mut cx, mut cy) = (cx, cy);
-            let fit_z = |cx: f32, cy: f32| {
-                rotated
-                    .iter()
-                    .map(|q| {
-                        let need_x = (q.x - cx).abs() * FIT_MARGIN / tan_x;
-                        let need_y = (q.y - cy).abs() * FIT_MARGIN / tan_y;
-                        q.z + need_x.max(need_y)
-                    })
-                    .fold(hi.z + radius * 1e-3, f32::max)
-            };
-            let mut z = fit_z(cx, cy);
-            for _ in 0..4 {
-                let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f32::MAX, f32::MIN, f32::MAX, f32::MIN);
+            // The eye distance at which the frustum's two side planes of one axis touch the points.
+            let touching = |axis: fn(&DVec3) -> f64, slope: f64| {
+                let (mut plus, mut minus) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
                 for q in &rotated {
-                    let depth = z - q.z;
-                    let (x, y) = ((q.x - cx) / (depth * tan_x), (q.y - cy) / (depth * tan_y));
-                    (x_lo, x_hi, y_lo, y_hi) = (x_lo.min(x), x_hi.max(x), y_lo.min(y), y_hi.max(y));
+                    plus = plus.max(axis(q) + slope * q.z);
+                    minus = minus.max(-axis(q) + slope * q.z);
                 }
-                let depth = z - (lo.z + hi.z) * 0.5;
-                cx += (x_lo + x_hi) * 0.5 * depth * tan_x;
-                cy += (y_lo + y_hi) * 0.5 * depth * tan_y;
-                z = fit_z(cx, cy);
-            }
+                (plus + minus) / (2.0 * slope)
+            };
+            let z = touching(|q| q.x, fill * tan_x)
+                .max(touching(|q| q.y, fill * tan_y))
+                // Points on a line through the eye would have no depth: keep the eye in front.
+                .max(hi.z + radius * 1e-3);
+            // The centre of one axis at distance z: the largest projection on the positive side
+            // equals the largest on the negative side.
+            let centre = |axis: fn(&DVec3) -> f64, mut low: f64, mut high: f64| {
+                for _ in 0..64 {
+                    let c = 0.5 * (low + high);
+                    let (mut plus, mut minus) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+                    for q in &rotated {
+                        let depth = z - q.z;
+                        plus = plus.max((axis(q) - c) / depth);
+                        minus = minus.max((c - axis(q)) / depth);
+                    }
+                    if plus > minus {
+                        low = c;
+                    } else {
+                        high = c;
+                    }
+                }
+                0.5 * (low + high)
+            };
+            let (cx, cy) = (centre(|q| q.x, lo.x, hi.x), centre(|q| q.y, lo.y, hi.y));
             let near = ((z - hi.z) * 0.9).max(radius * 1e-3);
             let far = (z - lo.z) * 1.1 + radius * 1e-3;
-            let proj = glam::camera::rh::proj::directx::perspective(fov_y_deg.to_radians(), aspect, near, far);
-            (Vec3::new(cx, cy, z), proj, near, far)
+            let proj = glam::camera::rh::proj::directx::perspective(
+                fov_y_deg.to_radians(),
+                aspect as f32,
+                near as f32,
+                far as f32,
+            );
+            (DVec3::new(cx, cy, z), proj, near, far)
         };
+        let eye = eye.as_vec3();
         let view_from_render = Mat4::from_translation(-eye) * rotation;
         let position_in_render = rotation.inverse().transform_point3(eye);
-        Camera { view_from_render, clip_from_view, position_in_render, orthographic, near, far }
+        Camera {
+            view_from_render,
+            clip_from_view,
+            position_in_render,
+            orthographic,
+            near: near as f32,
+            far: far as f32,
+        }
     }
 
     /// The same camera with the image magnified by `zoom` about the frame's centre, then shifted by
@@ -124,6 +171,69 @@ pub fn view_rotation(view: View) -> Mat4 {
     let (az, el) = (view.azimuth_deg.to_radians(), view.elevation_deg.to_radians());
     let towards_eye = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
     glam::camera::rh::view::look_to_mat4(Vec3::ZERO, -towards_eye, Vec3::Y)
+}
+
+/// `n` unit directions spread evenly over the sphere (a Fibonacci lattice).
+pub fn sphere_directions(n: usize) -> Vec<Vec3> {
+    let golden_angle = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - y * y).max(0.0).sqrt();
+            let phi = golden_angle * i as f32;
+            Vec3::new(r * phi.cos(), y, r * phi.sin())
+        })
+        .collect()
+}
+
+/// Indices (ascending, each once) of the points of `points` that lie farthest along one of
+/// `directions`: vertices of the points' convex hull, whose projection bounds the projection of
+/// all of them up to the spacing of the directions.
+///
+/// How much the kept points' extent along a direction `u` can fall short of all points': with
+/// `d` the nearest of `directions` at angle `θ`, at most `sin θ` times the points' diameter in
+/// general, and `r (1 − cos θ)` for a sphere or the round parts of CAD models (cylinders,
+/// fillets) of radius `r`.
+pub fn support_points(points: &[Vec3], directions: &[Vec3]) -> Vec<usize> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    // Structure of arrays, so that the loop over directions vectorises.
+    let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = (
+        directions.iter().map(|d| d.x).collect(),
+        directions.iter().map(|d| d.y).collect(),
+        directions.iter().map(|d| d.z).collect(),
+    );
+    let mut best = vec![f32::NEG_INFINITY; directions.len()];
+    let mut arg = vec![0u32; directions.len()];
+    for (i, p) in points.iter().enumerate() {
+        for k in 0..best.len() {
+            let along = p.x * dx[k] + p.y * dy[k] + p.z * dz[k];
+            let better = along > best[k];
+            best[k] = if better { along } else { best[k] };
+            arg[k] = if better { i as u32 } else { arg[k] };
+        }
+    }
+    let mut indices: Vec<usize> = arg.into_iter().map(|i| i as usize).collect();
+    indices.sort_unstable();
+    indices.dedup();
+    indices
+}
+
+/// Indices of at most [`SUPPORT_DIRECTIONS`] points of `points` whose projection in any
+/// direction bounds theirs closely: all of them when there are no more, otherwise their
+/// [`support_points`] along as many [`sphere_directions`] (every direction within 4.8° of one of
+/// them). Measured shortfall of the kept points' extent (2,000 random directions): 0.35 % of a
+/// sphere's radius, 1.2 % of a cylinder's (its flat ends), inside [`FIT_MARGIN`].
+///
+/// What the camera frames. An affine map takes hull vertices to hull vertices, so a mesh's
+/// sample, computed once, serves every instance of it; the union over instances is sampled
+/// again, so a frame's fit costs the same for any model size.
+pub fn hull_sample(points: &[Vec3]) -> Vec<usize> {
+    if points.len() <= SUPPORT_DIRECTIONS {
+        return (0..points.len()).collect();
+    }
+    support_points(points, &sphere_directions(SUPPORT_DIRECTIONS))
 }
 
 #[cfg(test)]
@@ -158,6 +268,77 @@ mod tests {
                 assert!(max_ndc <= 1.0 && max_ndc > 0.8, "{ortho} {az} {el}: {max_ndc}");
             }
         }
+    }
+
+    /// The NDC bounding rectangle (x0, x1, y0, y1) of `points` seen by `camera`, and whether every
+    /// point is within the depth range.
+    fn projected_rect(camera: &Camera, points: &[Vec3]) -> ([f32; 4], bool) {
+        let clip = camera.clip_from_render();
+        let mut rect = [f32::MAX, f32::MIN, f32::MAX, f32::MIN];
+        let mut in_depth = true;
+        for p in points {
+            let c = clip * p.extend(1.0);
+            let ndc = c.xyz() / c.w;
+            in_depth &= c.w > 0.0 && ndc.z > 0.0 && ndc.z < 1.0;
+            rect = [rect[0].min(ndc.x), rect[1].max(ndc.x), rect[2].min(ndc.y), rect[3].max(ndc.y)];
+        }
+        (rect, in_depth)
+    }
+
+    #[test]
+    fn fit_centres_the_points_and_fills_the_frame_up_to_the_margin() {
+        let mut rng = drafter_textures::Pcg32::new(15, 6);
+        let mut r = || rng.next_signed() as f32;
+        for case in 0..400 {
+            // Boxes of random proportions, off the origin, filled with random points; some flat.
+            let scale = Vec3::new(r().abs() * 5.0 + 0.01, r().abs() * 5.0 + 0.01, r().abs() * 5.0 + 0.01)
+                * if case % 7 == 0 { Vec3::new(1.0, 0.0, 1.0) } else { Vec3::ONE };
+            let offset = Vec3::new(r(), r(), r()) * 3.0;
+            let points: Vec<Vec3> = (0..40).map(|_| offset + Vec3::new(r(), r(), r()) * scale).collect();
+            let view = View { azimuth_deg: r() * 180.0, elevation_deg: r() * 89.0 };
+            let aspect = [0.5, 1.0, 4.0 / 3.0, 16.0 / 9.0, 3.0][case % 5];
+            let fov = [20.0, 30.0, 60.0][case % 3];
+            for orthographic in [false, true] {
+                let camera = Camera::fit(&points, view, aspect, orthographic, fov);
+                let ([x0, x1, y0, y1], in_depth) = projected_rect(&camera, &points);
+                let what = format!("case {case} ortho {orthographic} {view:?} aspect {aspect} fov {fov}");
+                assert!(in_depth, "{what}: a point outside the depth range");
+                assert!((x0 + x1).abs() < 2e-3 && (y0 + y1).abs() < 2e-3, "{what}: off centre {x0} {x1} {y0} {y1}");
+                let fill = ((x1 - x0) * 0.5).max((y1 - y0) * 0.5);
+                assert!((fill - (1.0 - FIT_MARGIN)).abs() < 2e-3, "{what}: fills {fill}");
+            }
+        }
+    }
+
+    #[test]
+    fn support_points_bound_the_projection_of_round_parts() {
+        // A finely tessellated cylinder (radius 1, height 3, tilted) and a sphere: the kept points'
+        // extent along random directions against all points'.
+        let mut points = Vec::new();
+        for i in 0..720 {
+            let a = i as f32 * std::f32::consts::TAU / 720.0;
+            for h in [-1.5, 1.5] {
+                points.push(Mat4::from_rotation_x(0.3).transform_point3(Vec3::new(a.cos(), h, a.sin())));
+            }
+            for j in 1..180 {
+                let b = j as f32 * std::f32::consts::PI / 180.0;
+                points.push(Vec3::new(b.sin() * a.cos(), b.cos(), b.sin() * a.sin()) + Vec3::X * 4.0);
+            }
+        }
+        let kept = hull_sample(&points);
+        assert!(kept.len() <= SUPPORT_DIRECTIONS && kept.len() > 16, "{}", kept.len());
+        let mut rng = drafter_textures::Pcg32::new(15, 7);
+        let mut worst = 0.0f32;
+        for _ in 0..2000 {
+            let u = Vec3::new(rng.next_signed() as f32, rng.next_signed() as f32, rng.next_signed() as f32)
+                .normalize_or(Vec3::X);
+            let all = points.iter().map(|p| p.dot(u)).fold(f32::MIN, f32::max);
+            let some = kept.iter().map(|&i| points[i].dot(u)).fold(f32::MIN, f32::max);
+            assert!(some <= all);
+            worst = worst.max(all - some);
+        }
+        // Unit radius: the shortfall is a fraction of the parts' radius.
+        assert!(worst < 0.015, "worst shortfall {worst}");
     }
 
     #[test]

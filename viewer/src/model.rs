@@ -110,9 +110,13 @@ pub struct Model {
     pub bounds: Aabb,
     /// World position of the render-space origin.
     pub origin: DVec3,
-    /// Corners of every instance's bounding box, in render space: what the camera fit frames
-    /// (tighter than the scene's box for an assembly).
+    /// Corners of every instance's bounding box, in render space: they contain every drawn
+    /// vertex (the soft shadow's ground map covers their shadow).
     pub fit_points: Vec<glam::Vec3>,
+    /// Vertices of the drawn geometry's convex hull, in render space: what the camera frames
+    /// (tighter than [`Self::fit_points`]: a gear's or a shaft's box corners stick out of it):
+    /// each mesh's [`crate::camera::hull_sample`] placed by every instance, sampled again.
+    pub frame_points: Vec<glam::Vec3>,
     /// Whether the file carried `DRAFTER_illustration` data.
     pub baked: bool,
     /// The file's lookup textures (see [`Self::set_lookups`]).
@@ -209,6 +213,7 @@ impl Model {
         let mut label_to_part = Vec::new();
         let mut batches = Vec::new();
         let mut fit_points = Vec::new();
+        let mut hull_candidates = Vec::new();
         let mut bad_ids = 0usize;
         let mut missing_node_parts = 0usize;
         let mut short_part_lists = 0usize;
@@ -217,6 +222,8 @@ impl Model {
             let labels = &triangle_labels[mesh_index];
             let label_count = labels.iter().copied().max().map_or(1, |m| m + 1);
             let first_instance = instances.len() as u32;
+            let support: Vec<DVec3> =
+                crate::camera::hull_sample(&mesh.positions).into_iter().map(|i| mesh.positions[i].as_dvec3()).collect();
             for instance in scene.instances.iter().filter(|i| i.mesh.index() == mesh_index) {
                 let label_base = label_to_part.len() as u32;
                 let records = instance.node.and_then(|n| node_parts.get(&n.0).copied()).filter(|r| !r.is_empty());
@@ -273,6 +280,7 @@ impl Model {
                         );
                         render_from_object.transform_point3(corner).as_vec3()
                     }));
+                    hull_candidates.extend(support.iter().map(|&p| render_from_object.transform_point3(p).as_vec3()));
                 }
             }
             let last_instance = instances.len() as u32;
@@ -325,6 +333,9 @@ impl Model {
             .unwrap_or_default();
         notices.extend(lines.notices.iter().cloned());
 
+        let frame_points =
+            crate::camera::hull_sample(&hull_candidates).into_iter().map(|i| hull_candidates[i]).collect();
+
         let mut model = Model {
             batches,
             instances,
@@ -337,6 +348,7 @@ impl Model {
             bounds,
             origin,
             fit_points,
+            frame_points,
             baked: baked.is_some(),
             lookups: BakedLookups::default(),
             notices,

@@ -17,9 +17,10 @@ use crate::passes::enhance::{EnhanceBindings, EnhancePass, EnhanceSetup};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::lines::{self, LinesPass, LinesScene};
 use crate::passes::shadow::{self, ShadowPass};
+use crate::passes::upscale::UpscalePass;
 use crate::scene::SceneGpu;
 use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
-use crate::targets::{OUTPUT_FORMAT, SHADOW_REDUCTION, Targets};
+use crate::targets::{OUTPUT_FORMAT, SHADOW_REDUCTION, Target, Targets};
 
 /// A model on the GPU with what the camera fit needs.
 #[derive(Debug)]
@@ -30,6 +31,8 @@ struct LoadedScene {
     max: Vec3,
     /// See [`Model::fit_points`].
     fit_points: Vec<Vec3>,
+    /// See [`Model::frame_points`].
+    frame_points: Vec<Vec3>,
     /// World position of the render-space origin.
     origin: glam::DVec3,
     lines: LinesScene,
@@ -42,14 +45,20 @@ struct FrameTargets {
     enhance: EnhanceBindings,
     display: wgpu::BindGroup,
     lines: wgpu::BindGroup,
+    /// Reads `targets.output` (an interactive frame's reduced image).
+    upscale: wgpu::BindGroup,
 }
 
 /// What a recorded frame used.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameInfo {
     pub camera: Camera,
-    /// Render-target size (output size × supersampling).
+    /// Render-target size (output size × supersampling): the frame's pixels, whatever it was
+    /// drawn at.
     pub target_size: (u32, u32),
+    /// The size the passes drew at (and of the part-id target): `target_size`, or less for an
+    /// interactive frame ([`RenderOptions::drawn_size`]).
+    pub drawn_size: (u32, u32),
 }
 
 /// The passes and the device; holds at most one model.
@@ -62,8 +71,14 @@ pub struct Renderer {
     enhance: EnhancePass,
     display: DisplayPass,
     lines: LinesPass,
+    upscale: UpscalePass,
     scene: Option<LoadedScene>,
     targets: Option<FrameTargets>,
+    /// The targets of the other size (interactive and still frames alternate while dragging:
+    /// both sets are kept rather than made again at each switch).
+    spare_targets: Option<FrameTargets>,
+    /// Where an interactive frame is filtered up to when no output is given (headless).
+    upscaled: Option<Target>,
     last_frame: Option<FrameInfo>,
     /// The shadow of the frame being recorded.
     shadow_plan: shadow::ShadowPlan,
@@ -97,6 +112,7 @@ impl Renderer {
                 LinesPass::new(device, output_format),
             )
         })?;
+        let upscale = scoped(device, || UpscalePass::new(device, output_format))?;
         Ok(Renderer {
             gpu,
             frame_uniforms,
@@ -105,8 +121,11 @@ impl Renderer {
             enhance,
             display,
             lines,
+            upscale,
             scene: None,
             targets: None,
+            spare_targets: None,
+            upscaled: None,
             last_frame: None,
             shadow_plan: shadow::ShadowPlan { layers: Vec::new(), resolve: None },
             output_format,
@@ -129,8 +148,15 @@ impl Renderer {
         })?;
         let min = (model.bounds.min - model.origin).as_vec3();
         let max = (model.bounds.max - model.origin).as_vec3();
-        self.scene =
-            Some(LoadedScene { gpu, min, max, fit_points: model.fit_points.clone(), origin: model.origin, lines });
+        self.scene = Some(LoadedScene {
+            gpu,
+            min,
+            max,
+            fit_points: model.fit_points.clone(),
+            frame_points: model.frame_points.clone(),
+            origin: model.origin,
+            lines,
+        });
         Ok(())
     }
 
@@ -185,15 +211,24 @@ impl Renderer {
     /// Fits the camera for `options` and writes every pass's uniforms.
     fn prepare(&mut self, options: &RenderOptions) -> Result<FrameInfo, RenderError> {
         options.validate().map_err(RenderError::Options)?;
-        let size = options.target_size();
+        let size = options.drawn_size();
+        if self.targets.as_ref().is_some_and(|t| t.targets.size != size)
+            && self.spare_targets.as_ref().is_some_and(|t| t.targets.size == size)
+        {
+            std::mem::swap(&mut self.targets, &mut self.spare_targets);
+        }
         if self.targets.as_ref().is_none_or(|t| t.targets.size != size) {
+            if self.targets.is_some() {
+                self.spare_targets = self.targets.take();
+            }
             let device = &self.gpu.device;
             self.targets = Some(scoped(device, || {
                 let targets = Targets::new(device, size, self.output_format);
                 let enhance = self.enhance.bindings(device, &targets);
                 let display = self.display.bind_group(device, &targets);
                 let lines = self.lines.targets_bind_group(device, &targets);
-                FrameTargets { targets, enhance, display, lines }
+                let upscale = self.upscale.bind_group(device, &targets.output.view);
+                FrameTargets { targets, enhance, display, lines, upscale }
             })?);
         }
         let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
@@ -201,13 +236,14 @@ impl Renderer {
         let (min, max) = (scene.min, scene.max);
         let light_in_render = view_rotation(options.view).inverse().transform_vector3(LIGHT_IN_VIEW.normalize());
         let layers = shadow::layers(options.shadow, min, max, light_in_render);
-        // The model's instance boxes and their shadows on the ground.
-        let mut fit_points = scene.fit_points.clone();
+        // The model's hull and its shadows on the ground (every layer: a soft shadow's outer
+        // layers are faint, but a shadow cut by the frame's edge shows).
+        let mut frame_points = scene.frame_points.clone();
         for layer in &layers {
-            fit_points.extend(scene.fit_points.iter().map(|&c| shadow::project(layer, c)));
+            frame_points.extend(scene.frame_points.iter().map(|&c| shadow::project(layer, c)));
         }
         let aspect = size.0 as f32 / size.1 as f32;
-        let camera = Camera::fit(&fit_points, options.view, aspect, options.orthographic, options.fov_y_deg)
+        let camera = Camera::fit(&frame_points, options.view, aspect, options.orthographic, options.fov_y_deg)
             .zoomed(options.zoom, options.pan);
 
         let mut flags = 0;
@@ -217,7 +253,7 @@ impl Renderer {
         if options.splash_back {
             flags |= FLAG_SPLASH_BACK;
         }
-        let scale = options.supersample as f32;
+        let scale = options.pixel_scale();
         let frame = FrameUniforms {
             clip_from_render: camera.clip_from_render().to_cols_array_2d(),
             view_from_render: camera.view_from_render.to_cols_array_2d(),
@@ -234,7 +270,21 @@ impl Renderer {
         queue.write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&frame));
         self.gbuffer.prepare(queue, &scene.gpu.lookups, options);
         let mask_size = (size.0.div_ceil(SHADOW_REDUCTION), size.1.div_ceil(SHADOW_REDUCTION));
-        let plan = shadow::plan(options.shadow, &layers, camera.clip_from_render(), &scene.fit_points, mask_size);
+        // While the window drags, a penumbra or soft shadow is drawn as the hard one (one layer
+        // instead of many: measured on lavapipe, a soft shadow held orbiting at 4 frames/s); the
+        // framing above keeps the real mode's layers, so nothing jumps on release.
+        let drawn_shadow = match options.shadow {
+            ShadowMode::Penumbra | ShadowMode::Soft if options.interactive => ShadowMode::Hard,
+            mode => mode,
+        };
+        let drawn_layers;
+        let layers = if drawn_shadow == options.shadow {
+            &layers
+        } else {
+            drawn_layers = shadow::layers(drawn_shadow, min, max, light_in_render);
+            &drawn_layers
+        };
+        let plan = shadow::plan(drawn_shadow, layers, camera.clip_from_render(), &scene.fit_points, mask_size);
         self.shadow.prepare(queue, &plan);
         let radius = (max - min).length() * 0.5;
         self.enhance
@@ -246,14 +296,16 @@ impl Renderer {
             let uniforms = lines::uniforms(options, &camera, size.1);
             self.lines.prepare(&self.gpu.device, queue, &mut scene.lines, &uniforms, silhouettes);
         }
-        let info = FrameInfo { camera, target_size: size };
+        let info = FrameInfo { camera, target_size: options.target_size(), drawn_size: size };
         self.last_frame = Some(info);
         self.shadow_plan = plan;
         Ok(info)
     }
 
     /// Records a whole frame for `options` into `encoder`, the display pass writing `output`
-    /// (`None`: the renderer's own output texture, of the target size).
+    /// (`None`: the renderer's own output texture, of the target size). An interactive frame is
+    /// drawn into the renderer's reduced targets and filtered up into `output` (`None`: a
+    /// texture of the renderer's, which [`Self::render`] reads back).
     pub fn encode_frame(
         &mut self,
         options: &RenderOptions,
@@ -261,6 +313,9 @@ impl Renderer {
         output: Option<&wgpu::TextureView>,
     ) -> Result<FrameInfo, RenderError> {
         let info = self.prepare(options)?;
+        if options.interactive && output.is_none() {
+            self.ensure_upscaled(info.target_size)?;
+        }
         let (Some(scene), Some(frame)) = (self.scene.as_ref(), self.targets.as_ref()) else {
             return Err(RenderError::NoModel);
         };
@@ -272,12 +327,27 @@ impl Renderer {
         if options.enhancements.unsharp_mask {
             self.enhance.encode(encoder, targets, &frame.enhance);
         }
-        let output = output.unwrap_or(&targets.output.view);
-        self.display.encode(encoder, &frame.display, output);
+        let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };
+        self.display.encode(encoder, &frame.display, drawn);
         if options.lines {
-            self.lines.encode(encoder, &scene.lines, &frame.lines, output);
+            self.lines.encode(encoder, &scene.lines, &frame.lines, drawn);
+        }
+        if options.interactive {
+            let output = output.or(self.upscaled.as_ref().map(|t| &t.view)).ok_or(RenderError::NoModel)?;
+            self.upscale.encode(encoder, &frame.upscale, output);
         }
         Ok(info)
+    }
+
+    /// Makes the headless output of interactive frames `size` large.
+    fn ensure_upscaled(&mut self, size: (u32, u32)) -> Result<(), RenderError> {
+        if self.upscaled.as_ref().is_none_or(|t| (t.texture.width(), t.texture.height()) != size) {
+            let device = &self.gpu.device;
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+            self.upscaled =
+                Some(scoped(device, || Target::new(device, "upscaled output", size, self.output_format, usage))?);
+        }
+        Ok(())
     }
 
     /// Renders one frame offscreen and reads it back, down-sampled to `options.size`.
@@ -301,9 +371,14 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let Some(frame) = self.targets.as_ref() else { return Err(RenderError::NoModel) };
+        let source = if options.interactive {
+            self.upscaled.as_ref()
+        } else {
+            self.targets.as_ref().map(|frame| &frame.targets.output)
+        };
+        let Some(source) = source else { return Err(RenderError::NoModel) };
         encoder.copy_texture_to_buffer(
-            frame.targets.output.texture.as_image_copy(),
+            source.texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &readback,
                 layout: wgpu::TexelCopyBufferLayout {
@@ -324,10 +399,18 @@ impl Renderer {
     }
 
     /// The part drawn at target pixel (`x`, `y`) of the last frame (the G-buffer's part-id target,
-    /// read back), `None` for the background or outside the frame.
+    /// read back), `None` for the background or outside the frame. After an interactive frame the
+    /// pixel is looked up in its reduced part ids.
     pub fn pick(&self, x: u32, y: u32) -> Result<Option<u32>, RenderError> {
         let Some(frame) = self.targets.as_ref() else { return Ok(None) };
         let (w, h) = frame.targets.size;
+        let (x, y) = match self.last_frame {
+            Some(info) if info.drawn_size != info.target_size => (
+                (u64::from(x) * u64::from(info.drawn_size.0) / u64::from(info.target_size.0.max(1))) as u32,
+                (u64::from(y) * u64::from(info.drawn_size.1) / u64::from(info.target_size.1.max(1))) as u32,
+            ),
+            _ => (x, y),
+        };
         if x >= w || y >= h {
             return Ok(None);
         }

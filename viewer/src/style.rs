@@ -246,7 +246,16 @@ pub struct RenderOptions {
     /// whose shade comes from the projector) and the image-space crease edges see it; batches without enhanced
     /// normals keep theirs ([`crate::Model::has_enhanced_normals`]). Default false.
     pub enhanced_normals: bool,
+    /// A cheaper frame for while the user drags (the window sets it during a drag and clears it
+    /// when the mouse is still): every pass runs at 1/[`INTERACTIVE_SCALE`] of the resolution in
+    /// each direction and [`crate::passes::upscale`] filters the result up to the output size
+    /// (about a quarter of the cost on lavapipe). The frame keeps its size, camera and content;
+    /// picking reads the reduced part ids. Default false (full quality).
+    pub interactive: bool,
 }
+
+/// Divisor of the resolution of an [`RenderOptions::interactive`] frame, in each direction.
+pub const INTERACTIVE_SCALE: u32 = 2;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -271,6 +280,7 @@ impl Default for RenderOptions {
             hatch_period_px: DEFAULT_HATCH_PERIOD_PX,
             selected_part: None,
             enhanced_normals: false,
+            interactive: false,
         }
     }
 }
@@ -325,6 +335,19 @@ impl RenderOptions {
     /// Size of the render targets: the output size times the supersampling factor.
     pub fn target_size(&self) -> (u32, u32) {
         (self.size.0 * self.supersample, self.size.1 * self.supersample)
+    }
+
+    /// The size the passes draw at: [`Self::target_size`], divided by [`INTERACTIVE_SCALE`]
+    /// (rounded up) for an interactive frame.
+    pub fn drawn_size(&self) -> (u32, u32) {
+        let (w, h) = self.target_size();
+        if self.interactive { (w.div_ceil(INTERACTIVE_SCALE), h.div_ceil(INTERACTIVE_SCALE)) } else { (w, h) }
+    }
+
+    /// Drawn pixels per output pixel: what line widths and hatching periods are multiplied by.
+    pub fn pixel_scale(&self) -> f32 {
+        let scale = self.supersample.max(1) as f32;
+        if self.interactive { scale / INTERACTIVE_SCALE as f32 } else { scale }
     }
 }
 

@@ -96,7 +96,13 @@ impl Targets {
                 SHADOW_STENCIL_FORMAT,
                 U::RENDER_ATTACHMENT,
             ),
-            output: Target::new(device, "display output", size, output_format, U::RENDER_ATTACHMENT | U::COPY_SRC),
+            output: Target::new(
+                device,
+                "display output",
+                size,
+                output_format,
+                U::RENDER_ATTACHMENT | U::COPY_SRC | U::TEXTURE_BINDING,
+            ),
         }
     }
 }

@@ -5,7 +5,9 @@
 //!   the cool-to-warm shading sweeps over the surface as it turns). For one frame that is the
 //!   camera orbiting the other way with the light fixed to it, which is how the renderer draws it
 //!   ([`crate::camera`]): dragging right turns the object's front to the right.
-//! * wheel: zoom about the frame's centre; right or middle drag: pan.
+//! * wheel: zoom about the frame's centre; right or middle drag: pan. While a button drags, frames
+//!   are drawn at half resolution and filtered up ([`RenderOptions::interactive`]); the frame after
+//!   the release is full quality.
 //! * `1`–`7`: style (gradient, cel, gooch, goochel, phong, metal, hatch); `S`: next style.
 //! * `E` image-space edges, `L` baked lines, `H` next drop shadow (none, hard, penumbra, soft),
 //!   `O` orthographic, `R` reset the view.
@@ -329,6 +331,7 @@ pub fn run(model: Model, file: &Path, options: RenderOptions, writer: &Writer) -
         modifiers: ModifiersState::empty(),
         lasso: None,
         writer,
+        drag_frames: None,
     };
     event_loop.run_app(&mut app).map_err(|e| WindowError::Window(e.to_string()))?;
     match app.error {
@@ -369,6 +372,9 @@ struct App<'a> {
     /// The lasso being drawn (`Ctrl`+drag), in window pixels.
     lasso: Option<Vec<DVec2>>,
     writer: &'a Writer,
+    /// Frames drawn since the drag began, and when it began: with `DRAFTER_VIEW_STATS` set, the
+    /// frame rate of each drag is printed on release (measured in the event loop).
+    drag_frames: Option<(std::time::Instant, u32)>,
 }
 
 impl std::fmt::Debug for App<'_> {
@@ -449,12 +455,16 @@ impl App<'_> {
         let queue = &state.renderer.gpu().queue;
         queue.submit([encoder.finish()]);
         queue.present(frame);
+        if self.options.interactive {
+            let (_, frames) = self.drag_frames.get_or_insert((std::time::Instant::now(), 0));
+            *frames += 1;
+        }
         Ok(())
     }
 
     fn screenshot(&mut self) -> Result<(), WindowError> {
         let Some(state) = self.state.as_mut() else { return Ok(()) };
-        let options = RenderOptions { supersample: 2, ..self.options.clone() };
+        let options = RenderOptions { supersample: 2, interactive: false, ..self.options.clone() };
         let image = state.renderer.render(&options)?;
         let stem = self.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "drafter".into());
         let png = image.to_png().map_err(|e| WindowError::Window(e.to_string()))?;
@@ -671,6 +681,9 @@ impl App<'_> {
                     press.dragged |= moved > CLICK_SLOP_PX;
                     if press.dragged {
                         let button = press.button;
+                        // Cheaper frames while the mouse drags (half resolution on lavapipe's
+                        // per-pixel cost); full quality again on release.
+                        self.options.interactive = true;
                         if let Some(path) = self.lasso.as_mut() {
                             if path.last().is_none_or(|last| last.distance(now) >= 2.0) {
                                 path.push(now);
@@ -709,6 +722,17 @@ impl App<'_> {
                 }
                 ElementState::Released => {
                     let Some(press) = self.pressed.take() else { return Ok(()) };
+                    if std::mem::take(&mut self.options.interactive) {
+                        self.request_redraw();
+                    }
+                    if let Some((since, frames)) = self.drag_frames.take()
+                        && std::env::var_os("DRAFTER_VIEW_STATS").is_some()
+                    {
+                        // The first frame opens the interval: frames after it over its length.
+                        let seconds = since.elapsed().as_secs_f64();
+                        let rate = f64::from(frames.saturating_sub(1)) / seconds.max(1e-9);
+                        println!("drag: {frames} frames in {seconds:.2} s, {rate:.1} frames/s");
+                    }
                     if press.button != MouseButton::Left {
                         return Ok(());
                     }

@@ -1,5 +1,6 @@
-//! `drafter bench render FILE [--size WxH] [--frames N] [--json]`: frame time of every style as a
-//! ratio to `phong` in the same run.
+//! `drafter bench render FILE [--size WxH] [--frames N] [--interactive] [--json]`: frame time of
+//! every style as a ratio to `phong` in the same run; with `--interactive`, every case again as the
+//! window draws it while the user drags (`NAME~drag`).
 //!
 //! Frames are interleaved (one frame of each style in turn, after a warm-up of every style) so that
 //! drift of a shared, noisy machine hits every style alike; each style's time is the median of its
@@ -72,6 +73,11 @@ pub struct RenderArgs {
     /// Warm-up frames per style, not measured.
     #[arg(long, default_value_t = 3)]
     pub warmup: usize,
+    /// Also time every case as an interactive frame (`RenderOptions::interactive`, what the window
+    /// draws while the user drags: reduced resolution filtered up), as `NAME~drag`, in the same
+    /// interleaved run.
+    #[arg(long)]
+    pub interactive: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -167,9 +173,16 @@ fn render(args: RenderArgs) -> Result<()> {
             ..base.clone()
         },
     ));
+    if args.interactive {
+        let dragged: Vec<(String, RenderOptions)> = cases
+            .iter()
+            .map(|(name, options)| (format!("{name}~drag"), RenderOptions { interactive: true, ..options.clone() }))
+            .collect();
+        cases.extend(dragged);
+    }
 
     let t = Instant::now();
-    if let Some((_, illustration)) = cases.last() {
+    if let Some((_, illustration)) = cases.iter().find(|(name, _)| name == "illustration") {
         renderer.time_frame(illustration)?;
     }
     let first_frame = ms(t);
@@ -238,7 +251,7 @@ fn render(args: RenderArgs) -> Result<()> {
             report.device
         );
         for ((name, _), ms) in cases.iter().zip(&medians) {
-            out!("  {name:<13} {ms:8.2} ms  {:5.2}× phong", ms / phong);
+            out!("  {name:<18} {ms:8.2} ms  {:5.2}× phong", ms / phong);
         }
         out!(
             "  lines: {} hard-edge segments, {} silhouettes of {} candidates; silhouette query {:.3} ms per frame (CPU, median)",

@@ -71,7 +71,7 @@ pub fn notice(lines: &ModelLines) -> Option<&'static str> {
 
 /// The uniforms for a frame of `options` seen through `camera` on targets `target_height` high.
 pub fn uniforms(options: &RenderOptions, camera: &crate::Camera, target_height: u32) -> LinesUniforms {
-    let scale = options.supersample.max(1) as f32;
+    let scale = options.pixel_scale();
     let gooch = matches!(options.style, Style::Gooch | Style::Goochel | Style::Metal);
     // Pixel footprint: 2 / (P[1][1] · height), times the depth for a perspective camera.
     let footprint = 2.0 / (camera.clip_from_view.y_axis.y * target_height.max(1) as f32);

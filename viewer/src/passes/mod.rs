@@ -1,13 +1,14 @@
 //! The render passes, in frame order (Lux et al. 2013, Algorithm 1, extended with Gooch et al.'s
-//! drop shadow): [`gbuffer`] → [`shadow`] → [`enhance`] → [`display`] → [`lines`]. Each pass
-//! is one module with its WGSL beside it, owns its pipelines, and records its work inside a debug
-//! group named after it.
+//! drop shadow): [`gbuffer`] → [`shadow`] → [`enhance`] → [`display`] → [`lines`] (→ [`upscale`]
+//! for an interactive frame). Each pass is one module with its WGSL beside it, owns its pipelines,
+//! and records its work inside a debug group named after it.
 
 pub mod display;
 pub mod enhance;
 pub mod gbuffer;
 pub mod lines;
 pub mod shadow;
+pub mod upscale;
 
 /// A bind group layout entry for a uniform buffer.
 pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
