@@ -42,9 +42,10 @@ struct Part {
 
 const PART_SELECTED: u32 = 1u;
 const PART_REFERENCE: u32 = 2u;
-// The editor's highlights: the selection in a saturated orange, its reference part lighter.
-const SELECTED_TINT: vec4<f32> = vec4<f32>(1.0, 0.55, 0.1, 0.45);
-const REFERENCE_TINT: vec4<f32> = vec4<f32>(1.0, 0.85, 0.55, 0.55);
+// The editor's highlights: the selection in a saturated blue (away from the warm and grey tones
+// of the styles), its reference part in a lighter blue.
+const SELECTED_TINT: vec4<f32> = vec4<f32>(0.1, 0.35, 1.0, 0.5);
+const REFERENCE_TINT: vec4<f32> = vec4<f32>(0.55, 0.8, 1.0, 0.6);
 
 struct Lookups {
     flags: u32,
