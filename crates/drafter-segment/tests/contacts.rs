@@ -8,28 +8,15 @@
 //! Cases known to miss the bar are listed with the reason, and the tests check that they still
 //! miss it, so that a fix has to take them off the list (a gap is visible, never skipped).
 
+mod common;
+
 use std::path::PathBuf;
 
 use drafter_bench::assemblies::{Accuracy, accuracy, contact_assemblies, flatten};
 use drafter_core::{PartId, Scene};
 use drafter_segment::{Parts, SegmentMode, SegmentOptions, segment};
 
-const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/models/");
-
-/// Loads a model, failing loudly when the corpus is missing: a test that skips its data tests
-/// nothing.
-fn load(relative: &str) -> Scene {
-    let path = PathBuf::from(MODELS).join(relative);
-    assert!(
-        path.is_file(),
-        "test model {} is missing: ../shared/models must sit next to the repository",
-        path.display()
-    );
-    match drafter_io::import(&path) {
-        Ok(imported) => imported.scene,
-        Err(e) => panic!("cannot import {}: {e}", path.display()),
-    }
-}
+use common::load;
 
 fn run(scene: &Scene, mode: SegmentMode) -> (Parts, String) {
     let (parts, diagnostics) = segment(scene, &SegmentOptions { mode, ..Default::default() });
@@ -124,7 +111,7 @@ const GLTF_GAPS: [&str; 6] = [
 
 #[test]
 fn merged_gltf_assemblies_come_back_as_their_parts() {
-    let dir = PathBuf::from(MODELS).join("gltf");
+    let dir = PathBuf::from(common::MODELS).join("gltf");
     assert!(dir.is_dir(), "{} is missing: ../shared/models must sit next to the repository", dir.display());
     let mut failed = Vec::new();
     for name in GLTF_ASSEMBLIES {

@@ -5,28 +5,13 @@
 //! its parts: at least 99% of triangles land in a part whose triangles all come from one original
 //! instance. Figures are printed; run with `--nocapture` to see them.
 
-use std::path::PathBuf;
+mod common;
 
 use drafter_core::{Instance, InstanceId, Mesh, MeshId, PartId, Scene, SourceFormat, Topology, Weld};
 use drafter_segment::{Parts, SegmentMode, SegmentOptions, segment};
 use glam::DMat4;
 
-const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/models/");
-
-/// Loads a model, failing loudly when the corpus is missing: a test that skips its data tests
-/// nothing.
-fn load(relative: &str) -> Scene {
-    let path = PathBuf::from(MODELS).join(relative);
-    assert!(
-        path.is_file(),
-        "test model {} is missing: ../shared/models must sit next to the repository",
-        path.display()
-    );
-    match drafter_io::import(&path) {
-        Ok(imported) => imported.scene,
-        Err(e) => panic!("cannot import {}: {e}", path.display()),
-    }
-}
+use common::load;
 
 /// Every instance's triangles in world space, concatenated into one mesh and one instance, with
 /// the original instance of each triangle.
