@@ -12,6 +12,7 @@
 //! quantity is f64, as in the file.
 
 use drafter_bounds::Projector;
+use drafter_core::gradient::{MAX_POWER, MAX_QUANTIZATION, MIN_POWER};
 use drafter_format::{BoxRecord, GradientRecord, PartRecord, PartStyle, ProjectorRecord, TransferCurve};
 use glam::{DMat4, DQuat, DVec2, DVec3, DVec4, Mat4};
 
@@ -395,11 +396,11 @@ pub fn manipulate(
 /// A keyboard edit of the gradient, style or tone of every selected part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Adjust {
-    /// q by this many steps (clamped to 1..=255).
+    /// q by this many steps (clamped to 1..=[`MAX_QUANTIZATION`]).
     Q(i32),
     /// f by this many [`F_STEP`]s (clamped to [0, 1], kept on the step grid).
     F(i32),
-    /// p times [`P_FACTOR`] to this power (clamped to [0.01, 10]).
+    /// p times [`P_FACTOR`] to this power (clamped to [[`MIN_POWER`], [`MAX_POWER`]]).
     P(i32),
     /// The next transfer curve γ.
     NextTransfer,
@@ -414,12 +415,12 @@ impl Adjust {
     pub fn apply(self, params: &PartParams) -> PartParams {
         let mut p = *params;
         match self {
-            Adjust::Q(k) => p.q = (i64::from(p.q) + i64::from(k)).clamp(1, 255) as u32,
+            Adjust::Q(k) => p.q = (i64::from(p.q) + i64::from(k)).clamp(1, i64::from(MAX_QUANTIZATION)) as u32,
             Adjust::F(k) => {
                 let steps = (p.f / F_STEP).round() as i32 + k;
                 p.f = (steps as f32 * F_STEP).clamp(0.0, 1.0);
             }
-            Adjust::P(k) => p.p = (p.p * P_FACTOR.powi(k)).clamp(0.01, 10.0),
+            Adjust::P(k) => p.p = (p.p * P_FACTOR.powi(k)).clamp(MIN_POWER, MAX_POWER),
             Adjust::NextTransfer => {
                 let all = TransferCurve::ALL;
                 let at = all.iter().position(|&c| c == p.transfer).unwrap_or(0);

@@ -20,9 +20,9 @@
 
 use std::f64::consts::{FRAC_PI_4, TAU};
 
-use drafter_core::{Instance, Mesh, MeshId, PartId, Scene, SourceFormat};
+use drafter_core::{Mesh, PartId, Scene, SourceFormat};
 use drafter_segment::Parts;
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 
 /// A solid part in world space: positions (f64) and outward triangles.
 #[derive(Clone, Debug, Default)]
@@ -411,15 +411,7 @@ pub fn flatten(scene: &Scene) -> (Scene, Vec<u32>) {
 }
 
 fn single_mesh_scene(mesh: Mesh, name: &str) -> Scene {
-    let mut scene = Scene::new(SourceFormat::Stl);
-    scene.meshes.push(mesh);
-    scene.instances.push(Instance {
-        name: name.to_owned(),
-        mesh: MeshId(0),
-        node: None,
-        world_from_object: DMat4::IDENTITY,
-    });
-    scene
+    Scene::single_mesh(SourceFormat::Stl, mesh, name)
 }
 
 /// How well a segmentation of a single-instance scene recovers the true parts.

@@ -14,7 +14,7 @@
 //! | [`open_box`] | boundary edges |
 //! | [`single_triangle`] | one face, three boundary edges, no interior |
 
-use drafter_core::{Instance, Mesh, MeshId, Scene, SourceFormat, TriangleGroup};
+use drafter_core::{Mesh, Scene, SourceFormat, TriangleGroup};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 
 /// A triangle mesh as plain arrays.
@@ -46,15 +46,7 @@ impl TriMesh {
 
     /// A scene of this mesh placed once, at the identity.
     pub fn to_scene(&self, name: &str) -> Scene {
-        let mut scene = Scene::new(SourceFormat::Obj);
-        scene.meshes.push(self.to_mesh(name));
-        scene.instances.push(Instance {
-            name: name.to_owned(),
-            mesh: MeshId(0),
-            node: None,
-            world_from_object: DMat4::IDENTITY,
-        });
-        scene
+        Scene::single_mesh(SourceFormat::Obj, self.to_mesh(name), name)
     }
 
     /// Positions moved by `world_from_object` (computed in f64, stored in f32).

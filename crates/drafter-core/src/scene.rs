@@ -214,6 +214,20 @@ impl Scene {
         }
     }
 
+    /// A scene of one mesh placed once, at the identity, in an instance named `name` (what STL,
+    /// OFF and PLY import to, and what the merged and generated test scenes are).
+    pub fn single_mesh(format: SourceFormat, mesh: Mesh, name: &str) -> Self {
+        let mut scene = Self::new(format);
+        scene.meshes.push(mesh);
+        scene.instances.push(Instance {
+            name: name.to_owned(),
+            mesh: MeshId(0),
+            node: None,
+            world_from_object: DMat4::IDENTITY,
+        });
+        scene
+    }
+
     pub fn mesh(&self, id: MeshId) -> &Mesh {
         &self.meshes[id.index()]
     }

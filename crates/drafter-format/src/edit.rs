@@ -13,6 +13,8 @@ use std::collections::{BTreeMap, HashMap};
 use serde::Deserialize;
 use serde_json::value::RawValue;
 
+use drafter_core::gradient::GradientParams;
+
 use crate::ext::{EXTENSION, FORMAT_VERSION, PartRecord};
 use crate::{FormatError, split_container};
 
@@ -126,16 +128,15 @@ pub fn validate(record: &PartRecord) -> Result<(), String> {
     if !projector.matrix.iter().all(|v| v.is_finite()) {
         return Err("the projector matrix is not finite".into());
     }
+    // q, f and p as the bake holds them (whole q, f32 f and p), checked by the one range check
+    // the bake's config uses.
     let gradient = &record.gradient;
-    if !(1.0..=255.0).contains(&gradient.q) || gradient.q.fract() != 0.0 {
+    if !(gradient.q >= 1.0 && gradient.q <= f64::from(u32::MAX)) || gradient.q.fract() != 0.0 {
         return Err(format!("q {} must be a whole number in 1..=255", gradient.q));
     }
-    if !(0.0..=1.0).contains(&gradient.f) {
-        return Err(format!("f {} is out of range [0, 1]", gradient.f));
-    }
-    if !(0.01..=10.0).contains(&gradient.p) {
-        return Err(format!("p {} is out of range [0.01, 10]", gradient.p));
-    }
+    GradientParams { q: gradient.q as u32, f: gradient.f as f32, p: gradient.p as f32 }
+        .validate()
+        .map_err(|e| e.to_string())?;
     if let Some(flat) = record.flat
         && !(0.0..=1.0).contains(&flat)
     {

@@ -1,7 +1,7 @@
 //! The common output of the single-mesh readers (STL, OFF, PLY) before it becomes a [`Scene`].
 
 use drafter_core::{DiagnosticKind, Diagnostics, Mesh, Scene, SourceFormat, TriangleGroup};
-use glam::{DMat4, Vec3};
+use glam::Vec3;
 
 use crate::error::ParseError;
 
@@ -47,15 +47,7 @@ pub(crate) fn single_mesh_scene(
             "no triangle with finite vertex positions".to_owned()
         }));
     }
-    let mut scene = Scene::new(format);
-    scene.meshes.push(mesh);
-    scene.instances.push(drafter_core::Instance {
-        name: name.to_owned(),
-        mesh: drafter_core::MeshId(0),
-        node: None,
-        world_from_object: DMat4::IDENTITY,
-    });
-    Ok(scene)
+    Ok(Scene::single_mesh(format, mesh, name))
 }
 
 /// Drops triangles that use a non-finite position (NaN or infinite), keeping `groups` consistent,

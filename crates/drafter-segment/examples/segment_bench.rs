@@ -8,9 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use drafter_core::{Instance, Mesh, MeshId, Scene, SourceFormat, Topology, Weld};
+use drafter_core::{Mesh, Scene, SourceFormat, Topology, Weld};
 use drafter_segment::{SegmentMode, SegmentOptions, segment, segment_with_topologies};
-use glam::DMat4;
 
 fn model(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models").join(relative)
@@ -38,15 +37,7 @@ fn merged(scene: &Scene) -> Scene {
             if flip { [t[0], t[2], t[1]] } else { t }
         }));
     }
-    let mut out = Scene::new(SourceFormat::Stl);
-    out.meshes.push(mesh);
-    out.instances.push(Instance {
-        name: "merged".into(),
-        mesh: MeshId(0),
-        node: None,
-        world_from_object: DMat4::IDENTITY,
-    });
-    out
+    Scene::single_mesh(SourceFormat::Stl, mesh, "merged")
 }
 
 fn median(mut f: impl FnMut() -> Duration, runs: usize) -> Duration {

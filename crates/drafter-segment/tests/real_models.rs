@@ -7,9 +7,8 @@
 
 mod common;
 
-use drafter_core::{Instance, InstanceId, Mesh, MeshId, PartId, Scene, SourceFormat, Topology, Weld};
+use drafter_core::{InstanceId, Mesh, PartId, Scene, SourceFormat, Topology, Weld};
 use drafter_segment::{Parts, SegmentMode, SegmentOptions, segment};
-use glam::DMat4;
 
 use common::load;
 
@@ -30,14 +29,7 @@ fn merged(scene: &Scene) -> (Scene, Vec<u32>) {
             origin.push(i as u32);
         }
     }
-    let mut out = Scene::new(SourceFormat::Stl);
-    out.meshes.push(mesh);
-    out.instances.push(Instance {
-        name: "merged".into(),
-        mesh: MeshId(0),
-        node: None,
-        world_from_object: DMat4::IDENTITY,
-    });
+    let out = Scene::single_mesh(SourceFormat::Stl, mesh, "merged");
     (out, origin)
 }
 
