@@ -36,6 +36,24 @@ struct LoadedScene {
     /// World position of the render-space origin.
     origin: glam::DVec3,
     lines: LinesScene,
+    /// The parts' style hints, bit [`crate::Style::index`] each, and whether some part has none:
+    /// which G-buffer pipeline a frame needs ([`crate::passes::gbuffer::frame_styles`]).
+    part_hints: u32,
+    unhinted_parts: bool,
+}
+
+/// The style-hint bits of a part table, and whether some part has no hint.
+fn style_hints(parts: &[crate::gpu_types::PartGpu]) -> (u32, bool) {
+    let mut hints = 0;
+    let mut unhinted = parts.is_empty();
+    for part in parts {
+        match part.style_hint {
+            crate::gpu_types::NO_STYLE => unhinted = true,
+            k if k < 32 => hints |= 1 << k,
+            _ => unhinted = true,
+        }
+    }
+    (hints, unhinted)
 }
 
 /// Targets of one size with their bind groups.
@@ -148,6 +166,7 @@ impl Renderer {
         })?;
         let min = (model.bounds.min - model.origin).as_vec3();
         let max = (model.bounds.max - model.origin).as_vec3();
+        let (part_hints, unhinted_parts) = style_hints(&model.part_table());
         self.scene = Some(LoadedScene {
             gpu,
             min,
@@ -156,6 +175,8 @@ impl Renderer {
             frame_points: model.frame_points.clone(),
             origin: model.origin,
             lines,
+            part_hints,
+            unhinted_parts,
         });
         Ok(())
     }
@@ -164,8 +185,9 @@ impl Renderer {
     /// parts storage buffer, nothing else (Lux et al. 2013 §4: no re-processing at edit time). The
     /// model must be the one [`Self::set_model`] uploaded.
     pub fn update_parts(&mut self, model: &Model) -> Result<(), RenderError> {
-        let scene = self.scene.as_ref().ok_or(RenderError::NoModel)?;
+        let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
         let parts = model.part_table();
+        (scene.part_hints, scene.unhinted_parts) = style_hints(&parts);
         let bytes: &[u8] = bytemuck::cast_slice(&parts);
         if bytes.len() as u64 > scene.gpu.buffers.parts.size() {
             return Err(RenderError::Options(format!(
@@ -232,6 +254,8 @@ impl Renderer {
             })?);
         }
         let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
+        let styles = crate::passes::gbuffer::frame_styles(options, scene.part_hints, scene.unhinted_parts);
+        self.gbuffer.specialise(&self.gpu.device, styles);
 
         let (min, max) = (scene.min, scene.max);
         let light_in_render = view_rotation(options.view).inverse().transform_vector3(LIGHT_IN_VIEW.normalize());
@@ -289,7 +313,7 @@ impl Renderer {
         let radius = (max - min).length() * 0.5;
         self.enhance
             .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
-        self.display.prepare(queue, &display::uniforms(options, radius, options.orthographic));
+        self.display.prepare(&self.gpu.device, queue, &display::uniforms(options, radius, options.orthographic));
         if options.lines {
             let view = world_view(&camera, scene.origin);
             let silhouettes = scene.lines.lines.silhouettes(view);

@@ -9,7 +9,7 @@
 
 use crate::gpu_types::{DISPLAY_CREASES, DISPLAY_OUTLINES, DISPLAY_SHADOW, DISPLAY_UNSHARP, DisplayUniforms};
 use crate::passes::enhance::{CREASE_ANGLE_DEG, DEPTH_EDGE_THRESHOLD, UNSHARP_STRENGTH};
-use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
+use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline_with, texture_entry, uniform_entry};
 use crate::style::{RenderOptions, ShadowMode, Style};
 use crate::targets::Targets;
 
@@ -64,7 +64,13 @@ pub fn uniforms(options: &RenderOptions, scene_radius: f32, orthographic: bool) 
 #[derive(Debug)]
 pub struct DisplayPass {
     layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+    /// The pipelines compiled so far, by their `FLAGS` constant: each frame draws with the one
+    /// that has exactly its flags (see `display.wgsl`; the G-buffer pass's docs say why).
+    pipelines: std::collections::BTreeMap<u32, wgpu::RenderPipeline>,
+    flags: u32,
     uniforms: wgpu::Buffer,
     sampler: wgpu::Sampler,
 }
@@ -96,8 +102,6 @@ impl DisplayPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline =
-            fullscreen_pipeline(device, "display pipeline", &pipeline_layout, &module, "fs_main", format, None);
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display uniforms"),
             size: size_of::<DisplayUniforms>() as u64,
@@ -110,7 +114,35 @@ impl DisplayPass {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        DisplayPass { layout, pipeline, uniforms, sampler }
+        let mut pass = DisplayPass {
+            layout,
+            module,
+            pipeline_layout,
+            format,
+            pipelines: std::collections::BTreeMap::new(),
+            flags: 0,
+            uniforms,
+            sampler,
+        };
+        pass.specialise(device, 0);
+        pass
+    }
+
+    /// Compiles (once) and selects the pipeline for `flags`.
+    fn specialise(&mut self, device: &wgpu::Device, flags: u32) {
+        self.flags = flags;
+        self.pipelines.entry(flags).or_insert_with(|| {
+            fullscreen_pipeline_with(
+                device,
+                "display pipeline",
+                &self.pipeline_layout,
+                &self.module,
+                "fs_main",
+                self.format,
+                None,
+                &[("FLAGS", f64::from(flags))],
+            )
+        });
     }
 
     pub fn bind_group(&self, device: &wgpu::Device, targets: &Targets) -> wgpu::BindGroup {
@@ -133,7 +165,8 @@ impl DisplayPass {
         })
     }
 
-    pub fn prepare(&self, queue: &wgpu::Queue, uniforms: &DisplayUniforms) {
+    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, uniforms: &DisplayUniforms) {
+        self.specialise(device, uniforms.flags);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
     }
 
@@ -149,7 +182,8 @@ impl DisplayPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            let Some(pipeline) = self.pipelines.get(&self.flags) else { return };
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, 0..1);
         }

@@ -28,6 +28,14 @@ const DISPLAY_CREASES: u32 = 2u;
 const DISPLAY_UNSHARP: u32 = 4u;
 const DISPLAY_SHADOW: u32 = 8u;
 
+// The flags this pipeline can apply (a pipeline constant, display.rs): the code of the others is
+// compiled out, which a CPU rasteriser needs (it runs both sides of every branch).
+override FLAGS: u32 = 15u;
+
+fn has(flag: u32) -> bool {
+    return (FLAGS & flag) != 0u && (u.flags & flag) != 0u;
+}
+
 @group(0) @binding(0) var<uniform> u: Display;
 @group(0) @binding(1) var color_tex: texture_2d<f32>;
 @group(0) @binding(2) var id_tex: texture_2d<u32>;
@@ -146,7 +154,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var c: vec3<f32>;
     if id == 0u {
         c = u.background.rgb;
-        if (u.flags & DISPLAY_SHADOW) != 0u {
+        if has(DISPLAY_SHADOW) {
             // Four bilinear taps half a mask texel apart: a 3×3 tent over the half-resolution mask.
             let uv = frag.xy / vec2<f32>(textureDimensions(id_tex));
             let o = 0.5 / vec2<f32>(textureDimensions(shadow_tex));
@@ -159,7 +167,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         }
     } else {
         c = textureLoad(color_tex, p, 0).rgb;
-        if (u.flags & DISPLAY_UNSHARP) != 0u {
+        if has(DISPLAY_UNSHARP) {
             // Unsharp mask of the depth buffer (Luft et al. 2006): ΔD = G∗D − D < 0 where a pixel
             // lies behind its surroundings; darken it in proportion.
             let delta = blurred_at(p) - d;
@@ -168,7 +176,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         if id == u.selected {
             c = mix(c, u.highlight_color.rgb, u.highlight_color.a);
         }
-        if (u.flags & DISPLAY_CREASES) != 0u {
+        if has(DISPLAY_CREASES) {
             // Right and down only, so the line is one pixel wide per unit of radius.
             let n = textureLoad(normal_tex, p, 0).xyz;
             if crease_towards(p, id, n, x, r) || crease_towards(p, id, n, y, r) {
@@ -176,7 +184,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             }
         }
     }
-    if (u.flags & DISPLAY_OUTLINES) != 0u {
+    if has(DISPLAY_OUTLINES) {
         var outline = outline_towards(p, id, d, x, r, outer) || outline_towards(p, id, d, -x, r, outer)
             || outline_towards(p, id, d, y, r, outer) || outline_towards(p, id, d, -y, r, outer);
         if id != 0u && !outline {

@@ -90,6 +90,15 @@ const LOOKUP_METAL_SPHERE: u32 = 256u;
 
 const PI: f32 = 3.14159265358979;
 
+// The styles this pipeline can draw, bit `Style::index` each (a pipeline constant, gbuffer.rs
+// "Specialised pipelines"): the others' code is compiled out. With one bit set, that style is drawn
+// whatever the frame and part say.
+override STYLES: u32 = 0x7fu;
+
+fn may_draw(style: u32) -> bool {
+    return (STYLES & (1u << style)) != 0u;
+}
+
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
 @group(0) @binding(2) var<storage, read> label_to_part: array<u32>;
@@ -433,15 +442,24 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> GBufferO
     if frame.use_part_styles != 0u && part.style_hint != NO_STYLE {
         style = part.style_hint;
     }
-    var color: vec3<f32>;
-    switch style {
-        case STYLE_GRADIENT: { color = shade_gradient(s, part); }
-        case STYLE_CEL: { color = shade_cel(s); }
-        case STYLE_GOOCH: { color = shade_gooch(s); }
-        case STYLE_GOOCHEL: { color = shade_goochel(s); }
-        case STYLE_METAL: { color = shade_metal(s, part, normal); }
-        case STYLE_HATCH: { color = shade_hatch(s); }
-        default: { color = shade_phong(s); }
+    if countOneBits(STYLES) == 1u {
+        style = firstTrailingBit(STYLES);
+    }
+    var color = s.base;
+    if may_draw(STYLE_GRADIENT) && style == STYLE_GRADIENT {
+        color = shade_gradient(s, part);
+    } else if may_draw(STYLE_CEL) && style == STYLE_CEL {
+        color = shade_cel(s);
+    } else if may_draw(STYLE_GOOCH) && style == STYLE_GOOCH {
+        color = shade_gooch(s);
+    } else if may_draw(STYLE_GOOCHEL) && style == STYLE_GOOCHEL {
+        color = shade_goochel(s);
+    } else if may_draw(STYLE_METAL) && style == STYLE_METAL {
+        color = shade_metal(s, part, normal);
+    } else if may_draw(STYLE_HATCH) && style == STYLE_HATCH {
+        color = shade_hatch(s);
+    } else if may_draw(STYLE_PHONG) {
+        color = shade_phong(s);
     }
     if part.flat >= 0.0 {
         color = vec3<f32>(part.flat);
