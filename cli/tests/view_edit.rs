@@ -95,7 +95,7 @@ fn render(path: &Path) -> (Vec<u8>, Vec<Option<u32>>) {
 }
 
 /// A pixel well inside part `id` (its 9×9 neighbourhood all that part), nearest its region's
-/// centroid.
+/// centroid, left of the editing panel (anchored to the window's top-right corner, 8 points in).
 fn inside(ids: &[Option<u32>], id: u32) -> Option<(i32, i32)> {
     let (w, h) = (SIZE.0 as i32, SIZE.1 as i32);
     let at = |x: i32, y: i32| ids[(y * w + x) as usize];
@@ -111,7 +111,7 @@ fn inside(ids: &[Option<u32>], id: u32) -> Option<(i32, i32)> {
         .filter(|&(x, y)| {
             x >= 4
                 && y >= 4
-                && x < w - 4
+                && x < w - 16 - drafter_viewer::panel::PANEL_WIDTH as i32
                 && y < h - 4
                 && (-4..=4).all(|dy| (-4..=4).all(|dx| at(x + dx, y + dy) == Some(id)))
         })

@@ -117,6 +117,16 @@ impl Gpu {
     }
 
     /// "name (backend, device type)", e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
+    /// The resolution divisor of interactive frames on this adapter
+    /// ([`crate::RenderOptions::interactive_scale`]): larger on a CPU rasteriser.
+    pub fn interactive_scale(&self) -> u32 {
+        if self.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+            crate::style::CPU_INTERACTIVE_SCALE
+        } else {
+            crate::style::INTERACTIVE_SCALE
+        }
+    }
+
     pub fn description(&self) -> String {
         let info = self.adapter.get_info();
         format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)

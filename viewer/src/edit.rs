@@ -408,6 +408,17 @@ pub enum Adjust {
     NextStyle,
     /// Shaded, then each of [`FLAT_GREYS`], then shaded again.
     NextFlat,
+    /// q set (the panel's slider; clamped as [`Adjust::Q`]).
+    SetQ(u32),
+    /// f set (clamped to [0, 1]).
+    SetF(f32),
+    /// p set (clamped as [`Adjust::P`]).
+    SetP(f32),
+    SetTransfer(TransferCurve),
+    /// The style hint set, `None`: the scene's style.
+    SetStyle(Option<PartStyle>),
+    /// The flat grey set (clamped to [0, 1]), `None`: shaded.
+    SetFlat(Option<f32>),
 }
 
 impl Adjust {
@@ -439,6 +450,13 @@ impl Adjust {
                     Some(g) => FLAT_GREYS.iter().position(|&x| x == g).and_then(|at| FLAT_GREYS.get(at + 1)).copied(),
                 };
             }
+            Adjust::SetQ(q) => p.q = q.clamp(1, MAX_QUANTIZATION),
+            Adjust::SetF(f) if f.is_finite() => p.f = f.clamp(0.0, 1.0),
+            Adjust::SetP(power) if power.is_finite() => p.p = power.clamp(MIN_POWER, MAX_POWER),
+            Adjust::SetTransfer(curve) => p.transfer = curve,
+            Adjust::SetStyle(style) => p.style = style,
+            Adjust::SetFlat(flat) => p.flat = flat.filter(|g| g.is_finite()).map(|g| g.clamp(0.0, 1.0)),
+            Adjust::SetF(_) | Adjust::SetP(_) => {}
         }
         p
     }
@@ -462,6 +480,8 @@ pub struct Editor {
     first: Vec<Option<PartRecord>>,
     pub selection: Selection,
     gesture: Option<Gesture>,
+    /// The selection as a panel widget found it when it was grabbed ([`Self::adjust_live`]).
+    live: Option<Vec<Target>>,
     undo: Vec<Change>,
     redo: Vec<Change>,
 }
@@ -483,6 +503,7 @@ impl Editor {
             records,
             selection: Selection::default(),
             gesture: None,
+            live: None,
             undo: Vec::new(),
             redo: Vec::new(),
         }
@@ -579,6 +600,32 @@ impl Editor {
         self.commit(changes)
     }
 
+    /// An edit from a panel widget that is held (a slider being dragged): every selected part gets
+    /// `adjust` applied to its parameters as they were when the widget was grabbed, the undo
+    /// history is left alone until [`Self::end_live`]. The parts changed.
+    pub fn adjust_live(&mut self, adjust: Adjust) -> Vec<u32> {
+        if self.live.is_none() {
+            self.live = Some(self.targets());
+        }
+        let updates: Vec<(u32, PartParams)> =
+            self.live.iter().flatten().map(|t| (t.id, adjust.apply(&t.params))).collect();
+        self.set_params(&updates)
+    }
+
+    /// The panel widget is released: one undo step from the parameters when it was grabbed to
+    /// the current ones. False when nothing changed.
+    pub fn end_live(&mut self) -> bool {
+        let Some(targets) = self.live.take() else { return false };
+        let parts: Vec<(u32, PartParams, PartParams)> = targets
+            .iter()
+            .filter_map(|t| {
+                let now = self.params(t.id)?;
+                (now != t.params).then_some((t.id, t.params, now))
+            })
+            .collect();
+        self.push(parts)
+    }
+
     /// Undoes the last step; the parts it changed.
     pub fn undo(&mut self) -> Vec<u32> {
         let Some(change) = self.undo.pop() else { return Vec::new() };
@@ -597,6 +644,10 @@ impl Editor {
 
     pub fn can_undo(&self) -> bool {
         !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
     }
 
     /// The parts whose records differ from the file on disk (as loaded, or last saved).
@@ -962,5 +1013,35 @@ mod tests {
         let toml = editor.overrides_toml("x.glb");
         assert_eq!(toml.matches("[[part]]").count(), 2, "{toml}");
         assert!(toml.contains("style = \"gradient\""), "{toml}");
+    }
+
+    #[test]
+    fn a_held_slider_is_one_undo_step_from_where_it_was_grabbed() {
+        let mut editor = Editor::new(vec![Some(record(0, [0.0; 3])), Some(record(1, [3.0, 0.0, 0.0]))]);
+        editor.selection.click(Some(0));
+        editor.selection.toggle(1);
+        // Dragged through three values: each applies to the grabbed parameters, none is a step.
+        for q in [12, 40, 25] {
+            assert_eq!(editor.adjust_live(Adjust::SetQ(q)), vec![0, 1]);
+        }
+        assert!(!editor.can_undo());
+        assert!(editor.end_live());
+        assert_eq!((editor.params(0).unwrap().q, editor.params(1).unwrap().q), (25, 25));
+        assert_eq!(editor.undo(), vec![0, 1]);
+        assert_eq!((editor.params(0).unwrap().q, editor.params(1).unwrap().q), (10, 10));
+        assert!(!editor.can_undo(), "one step only");
+        assert_eq!(editor.redo(), vec![0, 1]);
+        assert_eq!(editor.params(1).unwrap().q, 25);
+        // A release without a change adds nothing; the set values are clamped.
+        assert!(!editor.end_live());
+        editor.adjust_live(Adjust::SetFlat(Some(2.0)));
+        assert!(editor.end_live());
+        editor.adjust_live(Adjust::SetP(f32::NAN));
+        assert!(!editor.end_live());
+        assert_eq!(editor.params(0).unwrap().flat, Some(1.0));
+        assert_eq!(editor.params(0).unwrap().p, 1.0);
+        let style = Adjust::SetStyle(Some(PartStyle::Hatch)).apply(&editor.params(0).unwrap());
+        assert_eq!(style.style, Some(PartStyle::Hatch));
+        assert_eq!(Adjust::SetQ(0).apply(&style).q, 1);
     }
 }

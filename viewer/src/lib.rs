@@ -52,6 +52,7 @@ pub mod gpu_types;
 pub mod image;
 pub mod lookups;
 pub mod model;
+pub mod panel;
 pub mod passes;
 pub mod renderer;
 pub mod scene;

@@ -209,6 +209,16 @@ impl Renderer {
         Ok(())
     }
 
+    /// The texture the last frame recorded without an output ([`Self::encode_frame`] with `None`)
+    /// was drawn into: the renderer's output, or for an interactive frame the one it was filtered
+    /// up into. Of the target size, in the renderer's output format.
+    pub fn output_texture(&self) -> Option<&wgpu::Texture> {
+        match self.last_frame {
+            Some(info) if info.drawn_size != info.target_size => self.upscaled.as_ref().map(|t| &t.texture),
+            _ => self.targets.as_ref().map(|frame| &frame.targets.output.texture),
+        }
+    }
+
     /// The camera and size of the last frame recorded.
     pub fn last_frame(&self) -> Option<FrameInfo> {
         self.last_frame
@@ -348,7 +358,7 @@ impl Renderer {
         if options.shadow != ShadowMode::None {
             self.shadow.encode(encoder, targets, &scene.gpu, &self.shadow_plan);
         }
-        if options.enhancements.unsharp_mask {
+        if options.drawn_enhancements().unsharp_mask {
             self.enhance.encode(encoder, targets, &frame.enhance);
         }
         let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };

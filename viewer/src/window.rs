@@ -6,8 +6,8 @@
 //!   camera orbiting the other way with the light fixed to it, which is how the renderer draws it
 //!   ([`crate::camera`]): dragging right turns the object's front to the right.
 //! * wheel: zoom about the frame's centre; right or middle drag: pan. While a button drags, frames
-//!   are drawn at half resolution and filtered up ([`RenderOptions::interactive`]); the frame after
-//!   the release is full quality.
+//!   are drawn at reduced resolution and filtered up ([`RenderOptions::interactive`], at the
+//!   adapter's [`crate::Gpu::interactive_scale`]); the frame after the release is full quality.
 //! * `1`–`7`: style (gradient, cel, gooch, goochel, phong, metal, hatch); `S`: next style.
 //! * `E` image-space edges, `L` baked lines, `H` next drop shadow (none, hard, penumbra, soft),
 //!   `O` orthographic, `R` reset the view.
@@ -34,6 +34,9 @@
 //!   records into the file (atomically; every other byte stays), `Ctrl`+`E` writes
 //!   `<file stem>.edits.toml` beside it, the overrides that `drafter bake --config` applies to the
 //!   source model to re-create the edits.
+//! * the panel ([`crate::panel`], `F1` shows or hides it) lists the selection and sets its style, q,
+//!   f, p, γ and flat grey, the tool, undo/redo, save and export; events it uses do not reach the
+//!   view. The selection's projectors are drawn over the frame as handles.
 //!
 //! Everything an event changes goes through pure functions ([`Orbit`], [`action_for_key`],
 //! [`Action::apply`]) that are unit-tested without a display; the event loop only routes events
@@ -56,6 +59,7 @@ use winit::window::{Window, WindowId};
 use crate::context::{Gpu, RenderError};
 use crate::edit::{Adjust, Editor, PartBox, ScreenView, Tool, parts_in_lasso};
 use crate::model::Model;
+use crate::panel::{self, Handle, Overlay, PanelAction, PanelPart, PanelView};
 use crate::renderer::Renderer;
 use crate::style::{Enhancements, RenderOptions, ShadowMode, Style, View, ZOOM_RANGE};
 
@@ -332,6 +336,7 @@ pub fn run(model: Model, file: &Path, options: RenderOptions, writer: &Writer) -
         lasso: None,
         writer,
         drag_frames: None,
+        parts_version: 0,
     };
     event_loop.run_app(&mut app).map_err(|e| WindowError::Window(e.to_string()))?;
     match app.error {
@@ -345,6 +350,13 @@ struct WindowState {
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
     renderer: Renderer,
+    overlay: Overlay,
+    /// The surface can be copied into: the frame is drawn into the renderer's own output and
+    /// copied, so that a redraw for the panel alone (a hover, a click on it) reuses the last frame
+    /// instead of drawing the model again.
+    reuse: bool,
+    /// What the frame in the renderer's output shows: the options and the part table's version.
+    drawn: Option<(RenderOptions, u64)>,
 }
 
 /// A button held down: which, where it went down, and whether it has moved past a click.
@@ -375,6 +387,9 @@ struct App<'a> {
     /// Frames drawn since the drag began, and when it began: with `DRAFTER_VIEW_STATS` set, the
     /// frame rate of each drag is printed on release (measured in the event loop).
     drag_frames: Option<(std::time::Instant, u32)>,
+    /// Bumped at every upload of the part table (an edit, a selection): a frame drawn before is
+    /// stale.
+    parts_version: u64,
 }
 
 impl std::fmt::Debug for App<'_> {
@@ -414,8 +429,13 @@ impl App<'_> {
             .ok_or_else(|| WindowError::Window("the surface supports no format".into()))?;
         let gpu = Gpu::with_adapter(instance, adapter)?;
         let size = window.inner_size();
+        let reuse = capabilities.usages.contains(wgpu::TextureUsages::COPY_DST);
+        let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        if reuse {
+            usage |= wgpu::TextureUsages::COPY_DST;
+        }
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            usage,
             format,
             width: size.width.max(1),
             height: size.height.max(1),
@@ -426,9 +446,10 @@ impl App<'_> {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&gpu.device, &config);
+        let overlay = Overlay::new(&window, &gpu.device, format);
         let mut renderer = Renderer::with_gpu(gpu, format)?;
         renderer.set_model(&self.model)?;
-        Ok(WindowState { window, surface, config, renderer })
+        Ok(WindowState { window, surface, config, renderer, overlay, reuse, drawn: None })
     }
 
     fn redraw(&mut self) -> Result<(), WindowError> {
@@ -449,15 +470,125 @@ impl App<'_> {
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let device = state.renderer.gpu().device.clone();
+        let queue = state.renderer.gpu().queue.clone();
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window frame") });
-        state.renderer.encode_frame(&self.options, &mut encoder, Some(&view))?;
-        let queue = &state.renderer.gpu().queue;
+        let key = (self.options.clone(), self.parts_version);
+        let fresh = state.reuse && state.drawn.as_ref() == Some(&key);
+        // While dragging every frame is new: it is drawn straight into the window, not kept.
+        let keep = state.reuse && !self.options.interactive;
+        if !fresh {
+            let output = if keep { None } else { Some(&view) };
+            state.renderer.encode_frame(&self.options, &mut encoder, output)?;
+            state.drawn = keep.then_some(key);
+            if self.options.interactive {
+                let (_, frames) = self.drag_frames.get_or_insert((std::time::Instant::now(), 0));
+                *frames += 1;
+            }
+        }
+        if keep || fresh {
+            let drawn = state.renderer.output_texture().ok_or(RenderError::NoModel)?;
+            encoder.copy_texture_to_texture(
+                drawn.as_image_copy(),
+                frame.texture.as_image_copy(),
+                wgpu::Extent3d { width: state.config.width, height: state.config.height, depth_or_array_layers: 1 },
+            );
+        }
+        let panel_view = self.panel_view();
+        let handles = self.handles();
+        let lasso = self.lasso.clone();
+        let Some(state) = self.state.as_mut() else { return Ok(()) };
+        let show_panel = state.overlay.panel;
+        let mut actions = Vec::new();
+        let size = (state.config.width, state.config.height);
+        let again = state.overlay.draw(&state.window, &device, &queue, &mut encoder, &view, size, |ctx| {
+            if show_panel {
+                actions = panel::show(ctx, &panel_view);
+            }
+            panel::paint_overlay(ctx, &handles, lasso.as_deref());
+        });
         queue.submit([encoder.finish()]);
         queue.present(frame);
-        if self.options.interactive {
-            let (_, frames) = self.drag_frames.get_or_insert((std::time::Instant::now(), 0));
-            *frames += 1;
+        if again {
+            state.window.request_redraw();
+        }
+        for action in actions {
+            self.panel_action(action)?;
+        }
+        Ok(())
+    }
+
+    /// What the panel shows now.
+    fn panel_view(&self) -> PanelView {
+        let selection = &self.editor.selection;
+        let mut ids = selection.parts.clone();
+        if let Some(r) = selection.reference
+            && let Some(at) = ids.iter().position(|&id| id == r)
+        {
+            ids.remove(at);
+            ids.insert(0, r);
+        }
+        PanelView {
+            file: self.file_name(),
+            parts: self.model.parts.len(),
+            selected: ids
+                .iter()
+                .map(|&id| PanelPart {
+                    id,
+                    name: self.model.part(id).map(|p| p.name.clone()).unwrap_or_default(),
+                    reference: selection.reference == Some(id),
+                    params: self.editor.params(id),
+                })
+                .collect(),
+            tool: self.tool,
+            unsaved: self.editor.unsaved().len(),
+            can_undo: self.editor.can_undo(),
+            can_redo: self.editor.can_redo(),
+            scene_style: self.options.style.to_string(),
+        }
+    }
+
+    /// The selected parts' projectors on screen (the last frame's camera).
+    fn handles(&self) -> Vec<Handle> {
+        let Some(view) = self.screen_view() else { return Vec::new() };
+        let selection = &self.editor.selection;
+        selection
+            .parts
+            .iter()
+            .filter_map(|&id| {
+                let p = self.editor.params(id)?;
+                Some(Handle {
+                    anchor: view.project(p.anchor)?,
+                    end: view.project(p.anchor + p.direction * p.scale),
+                    reference: selection.reference == Some(id),
+                })
+            })
+            .collect()
+    }
+
+    /// Carries out what the panel asked for, as the keys would.
+    fn panel_action(&mut self, action: PanelAction) -> Result<(), WindowError> {
+        match action {
+            PanelAction::Tool(tool) => {
+                self.tool = tool;
+                println!("tool: {}", self.tool.map_or("turn the object", Tool::name));
+                self.refresh_title();
+            }
+            PanelAction::Live(adjust) => {
+                let ids = self.editor.adjust_live(adjust);
+                self.parts_changed(&ids)?;
+            }
+            PanelAction::EndLive => {
+                if self.editor.end_live() {
+                    let ids = self.editor.selection.parts.clone();
+                    self.list_edited(&ids);
+                    self.refresh_title();
+                }
+            }
+            PanelAction::Undo => self.edit(EditCommand::Undo)?,
+            PanelAction::Redo => self.edit(EditCommand::Redo)?,
+            PanelAction::Save => self.save(),
+            PanelAction::Export => self.export(),
         }
         Ok(())
     }
@@ -486,7 +617,9 @@ impl App<'_> {
         if !failures.is_empty() {
             eprintln!("drafter: screenshot not saved ({})", failures.join("; "));
         }
-        // The screenshot drew at another size: the next frame resizes the targets back.
+        // The screenshot drew at another size: the next frame resizes the targets back and draws
+        // the model again.
+        state.drawn = None;
         state.window.request_redraw();
         Ok(())
     }
@@ -538,6 +671,7 @@ impl App<'_> {
         if let Some(state) = self.state.as_mut() {
             state.renderer.update_parts(&self.model)?;
         }
+        self.parts_version += 1;
         if !selection.is_empty() {
             println!("selected {} part(s):", selection.parts.len());
             for &id in &selection.parts {
@@ -563,6 +697,7 @@ impl App<'_> {
         if let Some(state) = self.state.as_mut() {
             state.renderer.update_parts(&self.model)?;
         }
+        self.parts_version += 1;
         self.refresh_title();
         Ok(())
     }
@@ -660,6 +795,31 @@ impl App<'_> {
     }
 
     fn handle(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) -> Result<(), WindowError> {
+        if !matches!(event, WindowEvent::RedrawRequested)
+            && let Some(state) = self.state.as_mut()
+        {
+            let (consumed, repaint) = state.overlay.on_event(&state.window, &event);
+            if repaint {
+                state.window.request_redraw();
+            }
+            // The panel's own clicks, drags and keys; a press that began on the model is ours
+            // to the end (its release may land on the panel).
+            let ours = match &event {
+                WindowEvent::MouseInput { state: ElementState::Released, .. } | WindowEvent::CursorMoved { .. } => {
+                    self.pressed.is_some() || !consumed
+                }
+                WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. } | WindowEvent::KeyboardInput { .. } => {
+                    !consumed
+                }
+                _ => true,
+            };
+            if !ours {
+                if let WindowEvent::CursorMoved { position, .. } = event {
+                    self.cursor = position;
+                }
+                return Ok(());
+            }
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -797,6 +957,13 @@ impl App<'_> {
                 if ctrl {
                     return Ok(());
                 }
+                if event.logical_key == Key::Named(NamedKey::F1) {
+                    if let Some(state) = self.state.as_mut() {
+                        state.overlay.panel = !state.overlay.panel;
+                        state.window.request_redraw();
+                    }
+                    return Ok(());
+                }
                 match action_for_key(&event.logical_key) {
                     Some(Action::Quit) => event_loop.exit(),
                     Some(Action::Screenshot) => self.screenshot()?,
@@ -820,6 +987,7 @@ impl ApplicationHandler for App<'_> {
         }
         match self.open(event_loop) {
             Ok(state) => {
+                self.options.interactive_scale = state.renderer.gpu().interactive_scale();
                 state.window.request_redraw();
                 self.state = Some(state);
             }

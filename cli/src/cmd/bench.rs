@@ -174,9 +174,13 @@ fn render(args: RenderArgs) -> Result<()> {
         },
     ));
     if args.interactive {
+        // At the window's scale for this adapter.
+        let interactive_scale = renderer.gpu().interactive_scale();
         let dragged: Vec<(String, RenderOptions)> = cases
             .iter()
-            .map(|(name, options)| (format!("{name}~drag"), RenderOptions { interactive: true, ..options.clone() }))
+            .map(|(name, options)| {
+                (format!("{name}~drag"), RenderOptions { interactive: true, interactive_scale, ..options.clone() })
+            })
             .collect();
         cases.extend(dragged);
     }

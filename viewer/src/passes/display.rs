@@ -27,7 +27,7 @@ pub const HIGHLIGHT_COLOR: [f32; 4] = [1.0, 0.55, 0.1, 0.45];
 /// The display uniforms of `options`, for a scene of `scene_radius` (view units) seen through an
 /// orthographic camera or not.
 pub fn uniforms(options: &RenderOptions, scene_radius: f32, orthographic: bool) -> DisplayUniforms {
-    let e = options.enhancements;
+    let e = options.drawn_enhancements();
     let mut flags = 0;
     if e.outlines {
         flags |= DISPLAY_OUTLINES;

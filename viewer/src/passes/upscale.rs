@@ -1,17 +1,17 @@
 //! Upscale pass: the last step of an interactive frame ([`crate::RenderOptions::interactive`]).
 //!
 //! # Why
-//! On lavapipe nearly all of a frame's time is per pixel: measured on the sample assembly at
-//! 1024×768, every style costs the same as Phong within 4 %, a soft shadow adds 2 % and edges 19 %,
-//! and a perf profile puts over 95 % of the time in the JIT-compiled shader and rasteriser code of
-//! llvmpipe. So a frame drawn while the user drags is drawn with every pass at
-//! 1/[`crate::style::INTERACTIVE_SCALE`] of the resolution in each direction (a quarter of the
-//! pixels), then this pass filters it up to the output with one bilinear tap per pixel. Still
-//! frames are drawn at full resolution as before.
+//! On lavapipe nearly all of a frame's time is per pixel: a perf profile puts over 95 % of it in
+//! the JIT-compiled shader and rasteriser code of llvmpipe (and before the G-buffer and display
+//! pipelines were specialised, every style cost the same as Phong: the CPU ran every style's
+//! code). So a frame drawn while the user drags is drawn with every pass at
+//! 1/[`crate::RenderOptions::interactive_scale`] of the resolution in each direction (2 on a GPU,
+//! 3 on a CPU rasteriser), then this pass filters it up to the output with one bilinear tap per
+//! pixel. Still frames are drawn at full resolution as before.
 //!
 //! # Limits
 //! The dragged image is softer and its one-pixel lines are drawn at the reduced resolution (so
-//! twice as wide after upscaling at scale 2).
+//! `interactive_scale` times as wide after upscaling).
 
 use crate::passes::{FILTERABLE, color_attachment, fullscreen_pipeline, sampler_entry, texture_entry};
 

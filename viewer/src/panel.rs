@@ -1,0 +1,418 @@
+//! The editing panel of `drafter view` and the on-screen projector handles (Lux et al. 2013 §4),
+//! drawn with egui over the frame by the viewer's own wgpu device.
+//!
+//! [`show`] is the panel as a function of plain data ([`PanelView`]) returning what the user asked
+//! for ([`PanelAction`]); the window applies the actions through the same editor calls as the keys,
+//! so undo, save and export treat them alike. A slider that is held changes the selection live and
+//! makes one undo step when released ([`crate::edit::Editor::adjust_live`]). [`paint_overlay`] draws
+//! each selected part's projector (anchor, direction and scale as a line from the anchor) and the
+//! lasso being drawn. [`Overlay`] owns egui's context, its winit input state and its wgpu renderer.
+
+use drafter_core::gradient::{MAX_POWER, MAX_QUANTIZATION, MIN_POWER};
+use drafter_format::{PartStyle, TransferCurve};
+use glam::DVec2;
+
+use crate::edit::{Adjust, PartParams, Tool};
+
+/// The panel's width in logical points (it is anchored to the window's top-right corner).
+pub const PANEL_WIDTH: f32 = 250.0;
+
+/// Selected parts listed by name before the list scrolls.
+const LISTED_ROWS: f32 = 8.0;
+
+/// One selected part as the panel lists it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PanelPart {
+    pub id: u32,
+    pub name: String,
+    pub reference: bool,
+    /// `None`: the part has no baked record (not editable).
+    pub params: Option<PartParams>,
+}
+
+/// Everything the panel shows.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PanelView {
+    pub file: String,
+    pub parts: usize,
+    /// The selection, the reference part first.
+    pub selected: Vec<PanelPart>,
+    pub tool: Option<Tool>,
+    pub unsaved: usize,
+    pub can_undo: bool,
+    pub can_redo: bool,
+    /// The style parts without a hint are drawn in.
+    pub scene_style: String,
+}
+
+/// What the user did in the panel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PanelAction {
+    /// The drag tool (`None`: dragging turns the object).
+    Tool(Option<Tool>),
+    /// A value changed by a held or clicked widget: applied to the selection as it was when the
+    /// widget was grabbed.
+    Live(Adjust),
+    /// The widget was released: one undo step.
+    EndLive,
+    Undo,
+    Redo,
+    Save,
+    Export,
+}
+
+/// A selected part's projector on screen, in window pixels (y down).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Handle {
+    pub anchor: DVec2,
+    /// `anchor + scale · direction`, projected: where ω's parameter reaches 1.
+    pub end: Option<DVec2>,
+    pub reference: bool,
+}
+
+/// The panel: tools, the selection with its parameters, the edits of the selection (the reference
+/// part's values are shown; a change sets every selected part), undo/redo, save and export.
+pub fn show(ctx: &egui::Context, view: &PanelView) -> Vec<PanelAction> {
+    let mut actions = Vec::new();
+    egui::Window::new("drafter")
+        .id(egui::Id::unique("drafter panel"))
+        .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
+        .default_width(PANEL_WIDTH)
+        .resizable(false)
+        .collapsible(true)
+        .show(ctx, |ui| {
+            ui.set_width(PANEL_WIDTH - 16.0);
+            let unsaved = if view.unsaved > 0 { format!(", {} unsaved", view.unsaved) } else { String::new() };
+            ui.label(format!("{}: {} parts{unsaved}", view.file, view.parts));
+            ui.horizontal_wrapped(|ui| {
+                ui.label("drag:");
+                let mut tool = view.tool;
+                ui.selectable_value(&mut tool, None, "turn");
+                for t in Tool::ALL {
+                    ui.selectable_value(&mut tool, Some(t), t.name());
+                }
+                if tool != view.tool {
+                    actions.push(PanelAction::Tool(tool));
+                }
+            });
+            ui.separator();
+            selection(ui, view, &mut actions);
+            ui.separator();
+            ui.horizontal(|ui| {
+                if ui.add_enabled(view.can_undo, egui::Button::new("undo")).clicked() {
+                    actions.push(PanelAction::Undo);
+                }
+                if ui.add_enabled(view.can_redo, egui::Button::new("redo")).clicked() {
+                    actions.push(PanelAction::Redo);
+                }
+                if ui.button("save").on_hover_text("Ctrl+S: write the edits into the file").clicked() {
+                    actions.push(PanelAction::Save);
+                }
+                if ui.button("export").on_hover_text("Ctrl+E: the edits as drafter bake --config TOML").clicked() {
+                    actions.push(PanelAction::Export);
+                }
+            });
+            egui::CollapsingHeader::new("keys and gestures").default_open(false).show(ui, |ui| {
+                for line in KEY_HELP {
+                    ui.label(*line);
+                }
+            });
+        });
+    actions
+}
+
+/// The panel's summary of the keys (README "Editing" has the long form).
+const KEY_HELP: &[&str] = &[
+    "click: select, Shift+click: add/remove",
+    "click a selected part: make it the reference",
+    "Ctrl+drag: lasso, drag: the tool (or turn)",
+    "A anchor, X scale, D direction, V projector line",
+    "[ ] q, , . f, - = p, T transfer, Y style, G flat",
+    "Ctrl+Z / Ctrl+Y undo / redo, Ctrl+S save, Ctrl+E export",
+    "s style, e edges, l lines, h shadow, p screenshot, F1 panel",
+];
+
+fn selection(ui: &mut egui::Ui, view: &PanelView, actions: &mut Vec<PanelAction>) {
+    if view.selected.is_empty() {
+        ui.label("nothing selected: click a part");
+        return;
+    }
+    ui.label(format!("{} selected", view.selected.len()));
+    egui::ScrollArea::vertical().max_height(LISTED_ROWS * 18.0).show(ui, |ui| {
+        for part in &view.selected {
+            let mark = if part.reference { "▶ " } else { "  " };
+            let text = match &part.params {
+                Some(p) => format!(
+                    "{mark}{} {}: {} q{} f{:.2} p{:.2} {}{}",
+                    part.id,
+                    part.name,
+                    p.style.map_or("scene", PartStyle::name),
+                    p.q,
+                    p.f,
+                    p.p,
+                    p.transfer.name(),
+                    p.flat.map(|g| format!(" flat {g:.2}")).unwrap_or_default()
+                ),
+                None => format!("{mark}{} {} (not editable)", part.id, part.name),
+            };
+            ui.monospace(text);
+        }
+    });
+    let Some(p) = view.selected.iter().find_map(|part| part.params) else { return };
+    ui.separator();
+    let mut style = p.style;
+    egui::ComboBox::from_label("style")
+        .selected_text(style.map_or(format!("scene ({})", view.scene_style), |s| s.name().to_owned()))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut style, None, format!("scene ({})", view.scene_style));
+            for s in PartStyle::ALL {
+                ui.selectable_value(&mut style, Some(s), s.name());
+            }
+        });
+    if style != p.style {
+        actions.extend([PanelAction::Live(Adjust::SetStyle(style)), PanelAction::EndLive]);
+    }
+    let mut q = p.q;
+    let r = ui.add(egui::Slider::new(&mut q, 1..=MAX_QUANTIZATION).text("q bands"));
+    live(&r, q != p.q, Adjust::SetQ(q), actions);
+    let mut f = p.f;
+    let r = ui.add(egui::Slider::new(&mut f, 0.0..=1.0).text("f smooth"));
+    live(&r, f != p.f, Adjust::SetF(f), actions);
+    let mut power = p.p;
+    let r = ui.add(egui::Slider::new(&mut power, MIN_POWER..=MAX_POWER).logarithmic(true).text("p power"));
+    live(&r, power != p.p, Adjust::SetP(power), actions);
+    let mut transfer = p.transfer;
+    egui::ComboBox::from_label("transfer γ").selected_text(transfer.name()).show_ui(ui, |ui| {
+        for c in TransferCurve::ALL {
+            ui.selectable_value(&mut transfer, c, c.name());
+        }
+    });
+    if transfer != p.transfer {
+        actions.extend([PanelAction::Live(Adjust::SetTransfer(transfer)), PanelAction::EndLive]);
+    }
+    ui.horizontal(|ui| {
+        let mut flat = p.flat.is_some();
+        let r = ui.checkbox(&mut flat, "flat grey");
+        if r.changed() {
+            let grey = flat.then_some(p.flat.unwrap_or(0.5));
+            actions.extend([PanelAction::Live(Adjust::SetFlat(grey)), PanelAction::EndLive]);
+        }
+        if let Some(g) = p.flat {
+            let mut grey = g;
+            let r = ui.add(egui::Slider::new(&mut grey, 0.0..=1.0));
+            live(&r, grey != g, Adjust::SetFlat(Some(grey)), actions);
+        }
+    });
+}
+
+/// A slider's change: applied live while it is held, one undo step when it is let go (or at
+/// once for a click or a key on it).
+fn live(response: &egui::Response, changed: bool, adjust: Adjust, actions: &mut Vec<PanelAction>) {
+    if changed {
+        actions.push(PanelAction::Live(adjust));
+    }
+    if (changed || response.drag_stopped()) && !response.dragged() {
+        actions.push(PanelAction::EndLive);
+    }
+}
+
+/// The projector handles of the selection and the lasso in progress, over the frame (window
+/// pixels; egui's points are pixels / `pixels_per_point`).
+pub fn paint_overlay(ctx: &egui::Context, handles: &[Handle], lasso: Option<&[DVec2]>) {
+    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("drafter handles")));
+    let scale = 1.0 / ctx.pixels_per_point();
+    let at = |p: DVec2| egui::pos2(p.x as f32 * scale, p.y as f32 * scale);
+    for h in handles {
+        let colour =
+            if h.reference { egui::Color32::from_rgb(140, 205, 255) } else { egui::Color32::from_rgb(30, 90, 255) };
+        let outline = egui::Stroke::new(4.0, egui::Color32::from_black_alpha(150));
+        let stroke = egui::Stroke::new(2.0, colour);
+        let anchor = at(h.anchor);
+        if let Some(end) = h.end.map(at) {
+            painter.line_segment([anchor, end], outline);
+            painter.line_segment([anchor, end], stroke);
+            // A bar across the end: where the gradient's parameter reaches 1.
+            let along = (end - anchor).normalized();
+            let across = egui::vec2(-along.y, along.x) * 7.0;
+            painter.line_segment([end - across, end + across], outline);
+            painter.line_segment([end - across, end + across], stroke);
+        }
+        painter.circle(anchor, 5.0, colour, outline);
+    }
+    if let Some(path) = lasso.filter(|p| p.len() >= 2) {
+        let points: Vec<egui::Pos2> = path.iter().map(|&p| at(p)).collect();
+        painter.add(egui::Shape::line(points, egui::Stroke::new(1.5, egui::Color32::from_rgb(30, 90, 255))));
+    }
+}
+
+/// egui in the window: its context, winit input and wgpu renderer.
+pub struct Overlay {
+    pub ctx: egui::Context,
+    input: egui_winit::State,
+    renderer: egui_wgpu::Renderer,
+    /// The panel is shown (F1 toggles it); the handles always are.
+    pub panel: bool,
+}
+
+impl std::fmt::Debug for Overlay {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Overlay").field("panel", &self.panel).finish_non_exhaustive()
+    }
+}
+
+impl Overlay {
+    pub fn new(window: &winit::window::Window, device: &wgpu::Device, format: wgpu::TextureFormat) -> Overlay {
+        let ctx = egui::Context::default();
+        let input = egui_winit::State::new(
+            ctx.clone(),
+            egui::ViewportId::ROOT,
+            window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(device.limits().max_texture_dimension_2d as usize),
+        );
+        let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
+        Overlay { ctx, input, renderer, panel: true }
+    }
+
+    /// Gives egui the event; true when egui used it (a click on the panel), so that the viewer
+    /// does not act on it too.
+    pub fn on_event(&mut self, window: &winit::window::Window, event: &winit::event::WindowEvent) -> (bool, bool) {
+        let response = self.input.on_window_event(window, event);
+        (response.consumed, response.repaint)
+    }
+
+    /// Runs `ui` and draws its output over `target` (the frame already drawn there). True when
+    /// egui wants another frame soon (an animation).
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw(
+        &mut self,
+        window: &winit::window::Window,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+        ui: impl FnMut(&egui::Context),
+    ) -> bool {
+        let raw = self.input.take_egui_input(window);
+        let output = self.ctx.run_pass(raw, ui);
+        self.input.handle_platform_output(window, output.platform_output);
+        let primitives = self.ctx.tessellate(output.shapes, output.pixels_per_point);
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                self.renderer.update_texture(device, queue, *id, delta);
+            }
+        }
+        let screen =
+            egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point: output.pixels_per_point };
+        let extra = self.renderer.update_buffers(device, queue, encoder, &primitives, &screen);
+        if !extra.is_empty() {
+            queue.submit(extra);
+        }
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui overlay"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.renderer.render(&mut pass.forget_lifetime(), &primitives, &screen);
+        }
+        for id in &output.textures_delta.free {
+            self.renderer.free_texture(id);
+        }
+        output.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params(q: u32) -> PartParams {
+        PartParams {
+            anchor: glam::DVec3::ZERO,
+            direction: glam::DVec3::X,
+            scale: 1.0,
+            q,
+            f: 0.5,
+            p: 1.0,
+            transfer: TransferCurve::Identity,
+            style: None,
+            flat: None,
+        }
+    }
+
+    /// Runs the panel once over `view` with `events` (a headless egui pass, no window).
+    fn run(ctx: &egui::Context, view: &PanelView, events: Vec<egui::Event>) -> Vec<PanelAction> {
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 600.0))),
+            events,
+            ..Default::default()
+        };
+        let mut actions = Vec::new();
+        let _ = ctx.run_pass(input, |ctx| actions = show(ctx, view));
+        actions
+    }
+
+    #[test]
+    fn the_panel_lists_the_selection_and_a_click_on_a_tool_selects_it() {
+        let ctx = egui::Context::default();
+        let view = PanelView {
+            file: "a.glb".into(),
+            parts: 3,
+            selected: vec![
+                PanelPart { id: 2, name: "bolt".into(), reference: true, params: Some(params(7)) },
+                PanelPart { id: 0, name: "plate".into(), reference: false, params: None },
+            ],
+            scene_style: "gradient".into(),
+            ..Default::default()
+        };
+        // Nothing done: nothing asked for (two passes: egui lays a window out on its first).
+        assert!(run(&ctx, &view, vec![]).is_empty());
+        assert!(run(&ctx, &view, vec![]).is_empty());
+        // Click the "anchor" tool's button.
+        let Some(rect) = find_text(&ctx, &view, "anchor") else { panic!("the anchor tool is not on the panel") };
+        let at = rect.center();
+        let click = vec![
+            egui::Event::PointerMoved(at),
+            egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed: true,
+                modifiers: Default::default(),
+            },
+        ];
+        run(&ctx, &view, click);
+        let release = vec![egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed: false,
+            modifiers: Default::default(),
+        }];
+        assert_eq!(run(&ctx, &view, release), vec![PanelAction::Tool(Some(Tool::Anchor))]);
+    }
+
+    /// The rectangle of the panel's widget labelled `text`, from the shapes of a pass.
+    fn find_text(ctx: &egui::Context, view: &PanelView, text: &str) -> Option<egui::Rect> {
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 600.0))),
+            ..Default::default()
+        };
+        let output = ctx.run_pass(input, |ctx| {
+            show(ctx, view);
+        });
+        output.shapes.iter().find_map(|clipped| match &clipped.shape {
+            egui::Shape::Text(t) if t.galley.job.text == text => Some(t.visual_bounding_rect()),
+            _ => None,
+        })
+    }
+}
