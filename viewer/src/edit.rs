@@ -567,15 +567,20 @@ impl Editor {
     /// Ends the drag: one undo step from the parameters at its start to the current ones.
     pub fn end(&mut self) -> bool {
         let Some(g) = self.gesture.take() else { return false };
-        let parts: Vec<(u32, PartParams, PartParams)> = g
-            .targets
+        let parts = self.changed_since(&g.targets);
+        self.push(parts)
+    }
+
+    /// The parts of `targets` whose parameters differ now from the ones they hold, before and
+    /// after.
+    fn changed_since(&self, targets: &[Target]) -> Vec<(u32, PartParams, PartParams)> {
+        targets
             .iter()
             .filter_map(|t| {
                 let now = self.params(t.id)?;
                 (now != t.params).then_some((t.id, t.params, now))
             })
-            .collect();
-        self.push(parts)
+            .collect()
     }
 
     /// A click with the anchor tool: the reference's anchor moves under `cursor` in its reference
@@ -616,13 +621,7 @@ impl Editor {
     /// the current ones. False when nothing changed.
     pub fn end_live(&mut self) -> bool {
         let Some(targets) = self.live.take() else { return false };
-        let parts: Vec<(u32, PartParams, PartParams)> = targets
-            .iter()
-            .filter_map(|t| {
-                let now = self.params(t.id)?;
-                (now != t.params).then_some((t.id, t.params, now))
-            })
-            .collect();
+        let parts = self.changed_since(&targets);
         self.push(parts)
     }
 

@@ -9,7 +9,7 @@
 
 use crate::gpu_types::{DISPLAY_CREASES, DISPLAY_OUTLINES, DISPLAY_SHADOW, DISPLAY_UNSHARP, DisplayUniforms};
 use crate::passes::enhance::{CREASE_ANGLE_DEG, DEPTH_EDGE_THRESHOLD, UNSHARP_STRENGTH};
-use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline_with, texture_entry, uniform_entry};
+use crate::passes::{FLOAT, UINT, color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
 use crate::style::{RenderOptions, ShadowMode, Style};
 use crate::targets::Targets;
 
@@ -132,7 +132,7 @@ impl DisplayPass {
     fn specialise(&mut self, device: &wgpu::Device, flags: u32) {
         self.flags = flags;
         self.pipelines.entry(flags).or_insert_with(|| {
-            fullscreen_pipeline_with(
+            fullscreen_pipeline(
                 device,
                 "display pipeline",
                 &self.pipeline_layout,

@@ -89,6 +89,7 @@ impl EnhancePass {
             "fs_blur",
             BLUR_FORMAT,
             None,
+            &[],
         );
         let uniform = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {

@@ -85,22 +85,10 @@ pub(crate) fn color_attachment(
     })
 }
 
-/// Pipeline state of a full-screen triangle (the `vs_fullscreen` entry point of a pass's WGSL).
-pub(crate) fn fullscreen_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    fragment_entry: &str,
-    format: wgpu::TextureFormat,
-    blend: Option<wgpu::BlendState>,
-) -> wgpu::RenderPipeline {
-    fullscreen_pipeline_with(device, label, layout, module, fragment_entry, format, blend, &[])
-}
-
-/// [`fullscreen_pipeline`] with the fragment shader's pipeline constants (`override`s) set.
+/// Pipeline state of a full-screen triangle (the `vs_fullscreen` entry point of a pass's WGSL),
+/// with the fragment shader's pipeline constants (`override`s) set.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn fullscreen_pipeline_with(
+pub(crate) fn fullscreen_pipeline(
     device: &wgpu::Device,
     label: &str,
     layout: &wgpu::PipelineLayout,

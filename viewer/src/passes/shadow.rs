@@ -301,6 +301,7 @@ impl ShadowPass {
             "fs_resolve",
             SHADOW_MASK_FORMAT,
             None,
+            &[],
         );
 
         let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);

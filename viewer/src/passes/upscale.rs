@@ -38,7 +38,7 @@ impl UpscalePass {
             immediate_size: 0,
         });
         let pipeline =
-            fullscreen_pipeline(device, "upscale pipeline", &pipeline_layout, &module, "fs_main", format, None);
+            fullscreen_pipeline(device, "upscale pipeline", &pipeline_layout, &module, "fs_main", format, None, &[]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("upscale sampler"),
             mag_filter: wgpu::FilterMode::Linear,
