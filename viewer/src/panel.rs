@@ -296,7 +296,7 @@ impl Overlay {
         ui: impl FnMut(&egui::Context),
     ) -> bool {
         let raw = self.input.take_egui_input(window);
-        let output = self.ctx.run_pass(raw, ui);
+        let mut output = self.ctx.run_pass(raw, ui);
         self.input.handle_platform_output(window, output.platform_output);
         let primitives = self.ctx.tessellate(output.shapes, output.pixels_per_point);
         for (id, deltas) in &output.textures_delta.set {
@@ -329,6 +329,8 @@ impl Overlay {
         for id in &output.textures_delta.free {
             self.renderer.free_texture(id);
         }
+        // Applied above (epaint checks in debug builds that no delta is dropped unapplied).
+        output.textures_delta.clear();
         output.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero())
     }
 }
@@ -359,7 +361,7 @@ mod tests {
             ..Default::default()
         };
         let mut actions = Vec::new();
-        let _ = ctx.run_pass(input, |ctx| actions = show(ctx, view));
+        ctx.run_pass(input, |ctx| actions = show(ctx, view)).drop_without_applying_deltas();
         actions
     }
 
@@ -410,9 +412,11 @@ mod tests {
         let output = ctx.run_pass(input, |ctx| {
             show(ctx, view);
         });
-        output.shapes.iter().find_map(|clipped| match &clipped.shape {
+        let rect = output.shapes.iter().find_map(|clipped| match &clipped.shape {
             egui::Shape::Text(t) if t.galley.job.text == text => Some(t.visual_bounding_rect()),
             _ => None,
-        })
+        });
+        output.drop_without_applying_deltas();
+        rect
     }
 }
