@@ -262,7 +262,7 @@ fn edge_visibility_decodes_and_recounts() {
                 triangles,
                 &topology.welded_of_vertex,
                 &edges.visibility,
-                &edges.silhouette_normals,
+                &edges.silhouette_normals.decoded_all(),
             )
             .unwrap_or_else(|e| panic!("{}: mesh {m} primitive {p}: {e}", input.display()));
             decoded += 1;

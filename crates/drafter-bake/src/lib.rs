@@ -27,7 +27,7 @@ use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
 use drafter_format::{
     BakeOutput, BoxRecord, ConeBvhData, Container, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord,
     HardEdgeClass, InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges,
-    ProjectorRecord, RootExtension, TextureImage, VertexData, Written,
+    ProjectorRecord, RootExtension, StoredNormals, TextureImage, VertexData, Written,
 };
 use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
@@ -414,7 +414,7 @@ fn compute_lines(
                                 .map(|&e| hard_edge_code(feature.classes[e as usize]))
                                 .collect(),
                             visibility: v.visibility,
-                            silhouette_normals: v.silhouette_normals,
+                            silhouette_normals: StoredNormals::Byte(v.silhouette_normals),
                         }),
                         Ok(_) => None,
                         Err(e) => {
@@ -517,10 +517,8 @@ fn silhouettes_of(
                 _ => mesh.triangles[t][k],
             };
             corners.push(3 * t as u32 + k as u32);
-            normals.push([
-                drafter_core::snorm16_decode(e.silhouette_normals[2 * i]),
-                drafter_core::snorm16_decode(e.silhouette_normals[2 * i + 1]),
-            ]);
+            let decoded = |j: usize| e.silhouette_normals.decoded(j).unwrap_or(glam::Vec3::ZERO);
+            normals.push([decoded(2 * i), decoded(2 * i + 1)]);
             points.push(mesh.positions[vertex as usize]);
         }
     }
@@ -530,16 +528,9 @@ fn silhouettes_of(
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
     let index = SilhouetteIndex::from_candidates(corners.clone(), normals.clone(), points, &options);
+    // The hierarchies store no candidate order (format 0.2): a reader derives it from the
+    // candidates in the Khronos order, as the index was built from them here.
     let arrays = index.to_arrays();
-    // The index renumbers its candidates in the Gauss map's storage order; the file keeps the
-    // Khronos encoding order. So each stored order maps a storage position to a file candidate:
-    // the index's candidate k (corner c) is file candidate `file_of[k]`. Corners are unique.
-    let mut by_corner = vec![u32::MAX; 3 * mesh.triangles.len()];
-    for (i, &c) in corners.iter().enumerate() {
-        by_corner[c as usize] = i as u32;
-    }
-    let file_of: Vec<u32> = arrays.candidate_edges.iter().map(|&c| by_corner[c as usize]).collect();
-    let remap = |order: &[u32]| -> Vec<u32> { order.iter().map(|&k| file_of[k as usize]).collect() };
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",
         HierarchyChoice::ConeBvh { .. } => "coneBvh",
@@ -553,15 +544,18 @@ fn silhouettes_of(
         gauss_map: arrays.gauss_map.map(|g| GaussMapData {
             base: g.base,
             max_depth: g.max_depth,
+            overlap: g.overlap,
             node_caps: g.node_caps,
             nodes: g.nodes,
-            order: remap(&g.order),
         }),
         cone_bvh: arrays.cone_bvh.map(|b| ConeBvhData {
+            normal_level: b.normal_level,
+            leaf_size: b.leaf_size,
             node_boxes: b.node_boxes,
             node_cones: b.node_cones,
             nodes: b.nodes,
-            order: remap(&b.order),
+            splits: b.splits,
+            split_starts: b.split_starts,
         }),
     })
 }

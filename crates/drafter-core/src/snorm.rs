@@ -1,12 +1,13 @@
-//! Unit vectors as glTF's normalized signed integers (`normalized: true`): SHORT for
-//! `EXT_mesh_primitive_edge_visibility`'s `silhouetteNormals`, BYTE for our compact
-//! `_ENHANCED_NORMAL`. One definition for the writer (drafter-lines, drafter-format) and every
-//! reader, so the decoded values are bit-identical wherever they are computed.
+//! Unit vectors as glTF's normalized signed integers (`normalized: true`): BYTE for
+//! `EXT_mesh_primitive_edge_visibility`'s `silhouetteNormals` (the merged draft's recommendation)
+//! and for our compact `_ENHANCED_NORMAL`; SHORT where a reader meets it in another writer's file.
+//! One definition for the writer (drafter-lines, drafter-format) and every reader, so the decoded
+//! values are bit-identical wherever they are computed.
 //!
-//! Why SHORT for silhouettes: with BYTE normals 3–15 % of the silhouette edges of a view change
-//! (the dragon 8 %, fandisk 15 %, its worst view all of them), with SHORT 0.01–0.16 %, measured by
-//! drafter-lines' `examples/normal_precision.rs` (docs/bench.md). Shading normals have no such
-//! threshold: 8 bits per axis (within 0.4°) is what gltfpack gives `NORMAL` too.
+//! Silhouette normals are encoded by [`snorm8_encode_direction`]: of the 8 lattice points around
+//! `127·n`, the one whose direction is nearest `n`. Our hierarchies answer exactly for the decoded
+//! values; what the quantization changes against `f32` face normals (edges within a fraction of a
+//! degree of tangent) is measured by drafter-lines' `examples/normal_precision.rs` (docs/bench.md).
 
 use glam::Vec3;
 
@@ -19,6 +20,37 @@ fn encode(n: Vec3, m: f32) -> [f32; 3] {
 /// A unit vector as normalized signed bytes.
 pub fn snorm8_encode(n: Vec3) -> [i8; 3] {
     encode(n, 127.0).map(|c| c as i8)
+}
+
+/// A unit vector as the normalized signed bytes whose direction is nearest to it: of the 8 points
+/// `floor`/`ceil` of `127·n` per component, the one with the largest cosine to `n` after
+/// normalisation (ties: the first in floor-before-ceil order, x slowest). Per-component rounding
+/// ([`snorm8_encode`]) ignores that the decoded vector is renormalised by every consumer (a facing
+/// test compares signs); choosing by angle halves the mean angular error. A non-finite or zero `n`
+/// encodes as [`snorm8_encode`] does.
+pub fn snorm8_encode_direction(n: Vec3) -> [i8; 3] {
+    let plain = snorm8_encode(n);
+    if !n.is_finite() || n == Vec3::ZERO {
+        return plain;
+    }
+    let n = n.as_dvec3().normalize();
+    let s = n * 127.0;
+    let (lo, hi) = (s.floor(), s.ceil());
+    let mut best = (f64::NEG_INFINITY, plain);
+    for k in 0..8 {
+        let pick = |axis: usize, l: f64, h: f64| if k >> (2 - axis) & 1 == 0 { l } else { h };
+        let c = glam::DVec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
+            .clamp(glam::DVec3::splat(-127.0), glam::DVec3::splat(127.0));
+        let length = c.length();
+        if length == 0.0 {
+            continue;
+        }
+        let cos = c.dot(n) / length;
+        if cos > best.0 {
+            best = (cos, [c.x as i8, c.y as i8, c.z as i8]);
+        }
+    }
+    best.1
 }
 
 /// What a glTF reader decodes from normalized signed bytes: `max(c / 127, −1)` per component
@@ -82,5 +114,31 @@ mod tests {
         assert_eq!(snorm8_decode([-128, 0, 127]), Vec3::new(-1.0, 0.0, 1.0));
         assert_eq!(snorm16_encode(Vec3::new(1.0, -1.0, 0.0)), [32767, -32767, 0]);
         assert_eq!(snorm16_decode([i16::MIN, 0, 32767]), Vec3::new(-1.0, 0.0, 1.0));
+    }
+
+    #[test]
+    fn the_direction_encoder_is_never_worse_than_rounding_and_better_on_average() {
+        let angle = |n: Vec3, c: [i8; 3]| {
+            let back = snorm8_decode(c).as_dvec3().normalize();
+            n.as_dvec3().normalize().dot(back).clamp(-1.0, 1.0).acos().to_degrees()
+        };
+        let mut s = 11u64;
+        let (mut plain, mut direction) = (0.0, 0.0);
+        for _ in 0..20000 {
+            let mut r = || {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+            };
+            let Some(n) = Vec3::new(r(), r(), r()).try_normalize() else { continue };
+            let (a, b) = (angle(n, snorm8_encode(n)), angle(n, snorm8_encode_direction(n)));
+            assert!(b <= a + 1e-9, "{n}: {b}° against {a}°");
+            plain += a;
+            direction += b;
+        }
+        assert!(direction < 0.8 * plain, "mean error {direction} against {plain}");
+        assert_eq!(snorm8_encode_direction(Vec3::Z), [0, 0, 127]);
+        assert_eq!(snorm8_encode_direction(Vec3::ZERO), [0, 0, 0]);
     }
 }

@@ -1,6 +1,9 @@
 //! A glTF document under construction: the JSON tree plus one binary buffer that new buffer views
 //! append to. Only this module touches buffer/bufferView/accessor bookkeeping.
 
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
@@ -38,7 +41,7 @@ pub(crate) const COMPACTION_SAFE_EXTENSIONS: &[&str] = &[
 
 /// Keys whose integer values are accessor indices, anywhere inside our extension's objects.
 const OWN_ACCESSOR_KEYS: &[&str] =
-    &["partLabels", "hardEdgeClasses", "nodeCaps", "nodes", "order", "nodeBoxes", "nodeCones"];
+    &["partLabels", "hardEdgeClasses", "nodeCaps", "nodes", "nodeBoxes", "nodeCones", "splits", "splitStarts"];
 const EDGE_VISIBILITY: &str = "EXT_mesh_primitive_edge_visibility";
 /// Accessor-valued keys of EXT_mesh_primitive_edge_visibility (`indices` inside `lineStrings`).
 const EDGE_VISIBILITY_ACCESSOR_KEYS: &[&str] = &["visibility", "silhouetteNormals", "indices"];
@@ -79,11 +82,17 @@ fn renumbering(keep: &[bool]) -> Vec<u32> {
 pub(crate) struct Doc {
     pub json: Map<String, Value>,
     pub bin: Vec<u8>,
+    /// The buffer views this writer pushed, by a hash of their bytes, and the accessors it pushed,
+    /// by their JSON: an identical push reuses the first. Meshes that share their data in the input
+    /// (two glTF meshes on the same accessors, as CAD exports write a part used with two
+    /// materials) are baked separately but come out byte-identical, and are stored once again.
+    pushed_views: HashMap<u64, Vec<usize>>,
+    pushed_accessors: HashMap<String, usize>,
 }
 
 impl Doc {
     pub fn new(json: Map<String, Value>) -> Self {
-        Self { json, bin: Vec::new() }
+        Self { json, bin: Vec::new(), pushed_views: HashMap::new(), pushed_accessors: HashMap::new() }
     }
 
     /// Starts from a source document, moving every buffer's bytes into the one binary buffer and
@@ -151,6 +160,23 @@ impl Doc {
 
     /// Appends `bytes` as a new buffer view (4-byte aligned) and returns its index.
     pub fn push_view(&mut self, bytes: &[u8], target: Option<u32>, stride: Option<usize>) -> usize {
+        let key = {
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (bytes, target, stride).hash(&mut h);
+            h.finish()
+        };
+        let same = |doc: &Doc, v: usize| {
+            let view = &doc.array("bufferViews")[v];
+            let number = |k: &str| view.get(k).and_then(Value::as_u64);
+            let start = number("byteOffset").unwrap_or(0) as usize;
+            number("target") == target.map(u64::from)
+                && number("byteStride") == stride.map(|s| s as u64)
+                && doc.bin.get(start..start + bytes.len()) == Some(bytes)
+                && number("byteLength") == Some(bytes.len() as u64)
+        };
+        if let Some(&v) = self.pushed_views.get(&key).and_then(|vs| vs.iter().find(|&&v| same(self, v))) {
+            return v;
+        }
         self.align(4);
         let mut view = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
         if let Some(t) = target {
@@ -162,13 +188,21 @@ impl Doc {
         self.bin.extend_from_slice(bytes);
         let views = self.array_mut("bufferViews");
         views.push(view);
-        views.len() - 1
+        let index = views.len() - 1;
+        self.pushed_views.entry(key).or_default().push(index);
+        index
     }
 
     fn push_accessor(&mut self, accessor: Value) -> usize {
+        let key = accessor.to_string();
+        if let Some(&a) = self.pushed_accessors.get(&key) {
+            return a;
+        }
         let accessors = self.array_mut("accessors");
         accessors.push(accessor);
-        accessors.len() - 1
+        let index = accessors.len() - 1;
+        self.pushed_accessors.insert(key, index);
+        index
     }
 
     /// VEC3 float vertex attribute; `with_bounds` adds min/max (required for POSITION).
@@ -196,13 +230,22 @@ impl Doc {
         }))
     }
 
-    /// VEC3 SHORT normalized (`drafter_core::snorm`), tightly packed, read only by an extension.
-    pub fn push_snorm16_vec3(&mut self, values: &[[i16; 3]]) -> usize {
-        let bytes: Vec<u8> = values.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    /// VEC3 unit vectors in their stored component type (BYTE or SHORT normalized, or FLOAT),
+    /// tightly packed, read only by an extension.
+    pub fn push_unit_vec3(&mut self, values: &crate::StoredNormals) -> usize {
+        use crate::StoredNormals;
+        let (component, normalized, bytes): (u32, bool, Vec<u8>) = match values {
+            StoredNormals::Byte(v) => (BYTE, true, v.iter().flatten().map(|&c| c as u8).collect()),
+            StoredNormals::Short(v) => (SHORT, true, v.iter().flatten().flat_map(|c| c.to_le_bytes()).collect()),
+            StoredNormals::Float(v) => (FLOAT, false, v.iter().flatten().flat_map(|c| c.to_le_bytes()).collect()),
+        };
         let view = self.push_view(&bytes, None, None);
-        self.push_accessor(json!({
-            "bufferView": view, "componentType": SHORT, "normalized": true, "count": values.len(), "type": "VEC3"
-        }))
+        let mut accessor =
+            json!({"bufferView": view, "componentType": component, "count": values.len(), "type": "VEC3"});
+        if normalized {
+            accessor["normalized"] = true.into();
+        }
+        self.push_accessor(accessor)
     }
 
     /// Appends a material and returns its index.
@@ -312,6 +355,9 @@ impl Doc {
     /// to accessors from places unknown here, so it is left as it is, and so is a document that refers
     /// to an accessor or buffer view it does not have (nothing to renumber it to). `Err` says why.
     pub fn compact(&mut self, own_extension: &str) -> Result<(), &'static str> {
+        // Views and accessors are renumbered below: nothing may be reused by index afterwards.
+        self.pushed_views.clear();
+        self.pushed_accessors.clear();
         let used = self.array("extensionsUsed").iter().filter_map(Value::as_str).map(str::to_owned).collect::<Vec<_>>();
         if used.iter().any(|e| e != own_extension && !COMPACTION_SAFE_EXTENSIONS.contains(&e.as_str())) {
             return Err("the input uses extensions drafter does not know");

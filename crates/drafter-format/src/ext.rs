@@ -397,26 +397,34 @@ pub struct GaussMapRecord {
     /// 0 octahedron, 1 icosahedron.
     pub base: u32,
     pub max_depth: u32,
+    /// Overlapping-bin factor in circumradii (0: strict bins).
+    pub overlap: f32,
     /// FLOAT, 4 per node: cap centre and cull threshold.
     pub node_caps: u32,
-    /// UNSIGNED_INT, 4 per node: first child, child count, first own arc, end of own arcs.
+    /// Unsigned integers, 4 per node: first child, child count, first own arc, end of own arcs
+    /// (positions in the storage order the bin rule gives).
     pub nodes: u32,
-    /// UNSIGNED_INT: candidate index of each stored arc.
-    pub order: u32,
 }
 
 /// Normal-cone BVH arrays (accessors). See drafter-lines' `ConeBvhArrays`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]
 pub struct ConeBvhRecord {
+    /// Gauss-map level of the normal split.
+    pub normal_level: u32,
+    /// Leaf size of the binary tree before pruning.
+    pub leaf_size: u32,
     /// FLOAT, 6 per node: box min, max.
     pub node_boxes: u32,
     /// FLOAT, 4 per node: cone axis and cull threshold.
     pub node_cones: u32,
-    /// UNSIGNED_INT, 4 per node: first child, child count, first own candidate, end.
+    /// Unsigned integers, 4 per node: first child, child count, start and end of the subtree's
+    /// candidates in the replayed tree's order.
     pub nodes: u32,
-    /// UNSIGNED_INT: candidate index of each stored candidate.
-    pub order: u32,
+    /// UNSIGNED_BYTE: the split of every inner node of the dual-space trees, in preorder.
+    pub splits: u32,
+    /// Unsigned integers: where each dual-space tree's splits start.
+    pub split_starts: u32,
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@ use crate::ext::{
     EDGE_VISIBILITY_EXTENSION, EXTENSION, FORMAT_VERSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension,
     RootExtension, TexturesRecord,
 };
-use crate::writer::{ConeBvhData, GaussMapData, MeshSilhouettes, PrimitiveEdges};
+use crate::writer::{ConeBvhData, GaussMapData, MeshSilhouettes, PrimitiveEdges, StoredNormals};
 
 /// What a baked file carries in `DRAFTER_illustration`.
 #[derive(Clone, Debug, PartialEq)]
@@ -183,8 +183,8 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
                 };
                 let silhouette_normals = match accessor("silhouetteNormals") {
-                    Some(a) => read_snorm16_vec3s(&doc, a, data()?)?,
-                    None => Vec::new(),
+                    Some(a) => read_unit_vec3s(&doc, a, data()?)?,
+                    None => StoredNormals::default(),
                 };
                 let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
                     Some(a) => narrow(read_scalars(&doc, a as usize, data()?)?, "hardEdgeClasses above 8 bits")?,
@@ -220,18 +220,27 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     Some(g) => Some(GaussMapData {
                         base: g.base,
                         max_depth: g.max_depth,
+                        overlap: g.overlap,
                         node_caps: f32s(g.node_caps)?,
                         nodes: u32s(g.nodes)?,
-                        order: u32s(g.order)?,
                     }),
                     None => None,
                 },
                 cone_bvh: match s.cone_bvh {
                     Some(b) => Some(ConeBvhData {
+                        normal_level: b.normal_level,
+                        leaf_size: b.leaf_size,
                         node_boxes: f32s(b.node_boxes)?,
                         node_cones: f32s(b.node_cones)?,
                         nodes: u32s(b.nodes)?,
-                        order: u32s(b.order)?,
+                        splits: u32s(b.splits)?
+                            .into_iter()
+                            .map(|v| {
+                                u8::try_from(v)
+                                    .map_err(|_| FormatError::Invalid(format!("/meshes/{m}: splits above 8 bits")))
+                            })
+                            .collect::<Result<_, _>>()?,
+                        split_starts: u32s(b.split_starts)?,
                     }),
                     None => None,
                 },
@@ -406,8 +415,8 @@ fn derived_candidates(
                 .try_into()
                 .map_err(|_| format!("primitive {}: triangle numbers beyond 32 bits", all[i].1))?;
             corners.push(corner);
-            for n in &e.silhouette_normals[2 * k..2 * k + 2] {
-                normals.extend(drafter_core::snorm16_decode(*n).to_array());
+            for n in [2 * k, 2 * k + 1].into_iter().filter_map(|i| e.silhouette_normals.decoded(i)) {
+                normals.extend(n.to_array());
             }
         }
     }
@@ -461,10 +470,9 @@ fn accessor_elements<'a>(
     Ok((0..count).map(move |i| &buffer[start + i * stride..start + i * stride + size]))
 }
 
-/// Reads a VEC3 accessor of unit vectors as normalized shorts: SHORT normalized as stored, BYTE
-/// normalized and FLOAT decoded then re-encoded (`drafter_core::snorm`): the three component types
-/// the merged `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
-fn read_snorm16_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[i16; 3]>, FormatError> {
+/// Reads a VEC3 accessor of unit vectors as stored: BYTE or SHORT normalized, or FLOAT, the three
+/// component types the merged `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
+fn read_unit_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<StoredNormals, FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
     let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
     if a.get("type").and_then(Value::as_str) != Some("VEC3") {
@@ -472,16 +480,15 @@ fn read_snorm16_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec
     }
     let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
     match (a.get("componentType").and_then(Value::as_u64), normalized) {
-        (Some(5122), true) => Ok(accessor_elements(doc, accessor, buffer, 6)?
-            .map(|c| std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
-            .collect()),
-        (Some(5120), true) => Ok(accessor_elements(doc, accessor, buffer, 3)?
-            .map(|c| drafter_core::snorm16_encode(drafter_core::snorm8_decode([c[0] as i8, c[1] as i8, c[2] as i8])))
-            .collect()),
-        (Some(5126), _) => Ok(read_vec3s(doc, accessor, buffer)?
-            .into_iter()
-            .map(|v| drafter_core::snorm16_encode(glam::Vec3::from(v)))
-            .collect()),
+        (Some(5120), true) => Ok(StoredNormals::Byte(
+            accessor_elements(doc, accessor, buffer, 3)?.map(|c| [c[0] as i8, c[1] as i8, c[2] as i8]).collect(),
+        )),
+        (Some(5122), true) => Ok(StoredNormals::Short(
+            accessor_elements(doc, accessor, buffer, 6)?
+                .map(|c| std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
+                .collect(),
+        )),
+        (Some(5126), false) => Ok(StoredNormals::Float(read_vec3s(doc, accessor, buffer)?)),
         _ => Err(bad("silhouetteNormals must be FLOAT, or BYTE or SHORT normalized")),
     }
 }
@@ -528,7 +535,7 @@ pub struct ByteSections {
     pub khronos_edges: u64,
     /// `DRAFTER_illustration` per primitive: part labels and hard-edge classes.
     pub labels: u64,
-    /// `DRAFTER_illustration` silhouette hierarchies (nodes, bounds, `order` permutations).
+    /// `DRAFTER_illustration` silhouette hierarchies (nodes, bounds, split bytes).
     pub hierarchies: u64,
     /// Images (the input's and the baked lookup textures).
     pub textures: u64,
@@ -589,7 +596,7 @@ pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -
         if let Some(sil) = mesh.pointer(&format!("/extensions/{EXTENSION}/silhouettes")) {
             for hierarchy in ["gaussMap", "coneBvh"] {
                 for (key, a) in sil.get(hierarchy).and_then(Value::as_object).into_iter().flatten() {
-                    if !matches!(key.as_str(), "base" | "maxDepth") {
+                    if !matches!(key.as_str(), "base" | "maxDepth" | "overlap" | "normalLevel" | "leafSize") {
                         count_view(view_of(a), &mut s.hierarchies);
                     }
                 }

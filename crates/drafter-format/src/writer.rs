@@ -95,11 +95,58 @@ impl SamplerDesc {
 pub struct PrimitiveEdges {
     /// 2 bits per triangle edge (the draft's `visibility`).
     pub visibility: Vec<u8>,
-    /// The draft's `silhouetteNormals`: two VEC3 normalized-short normals per edge encoded as 1, in
-    /// encoding order (`drafter_core::snorm`).
-    pub silhouette_normals: Vec<[i16; 3]>,
+    /// The draft's `silhouetteNormals`: two VEC3 normals per edge encoded as 1, in encoding order,
+    /// in the component type stored (the bake writes BYTE normalized).
+    pub silhouette_normals: StoredNormals,
     /// [`crate::ext::HardEdgeClass`] code of each edge encoded as 2, in encoding order.
     pub hard_edge_classes: Vec<u8>,
+}
+
+/// Unit vectors in one of the component types the merged `EXT_mesh_primitive_edge_visibility`
+/// allows for `silhouetteNormals`, as stored; [`StoredNormals::decoded`] is what a glTF reader
+/// computes from them (`drafter_core::snorm`), the values our hierarchies are exact for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StoredNormals {
+    /// BYTE normalized (what the bake writes).
+    Byte(Vec<[i8; 3]>),
+    /// SHORT normalized.
+    Short(Vec<[i16; 3]>),
+    /// FLOAT.
+    Float(Vec<[f32; 3]>),
+}
+
+impl Default for StoredNormals {
+    fn default() -> Self {
+        StoredNormals::Byte(Vec::new())
+    }
+}
+
+impl StoredNormals {
+    pub fn len(&self) -> usize {
+        match self {
+            StoredNormals::Byte(v) => v.len(),
+            StoredNormals::Short(v) => v.len(),
+            StoredNormals::Float(v) => v.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Vector `i` as a glTF reader decodes it (not renormalised); `None` past the end.
+    pub fn decoded(&self, i: usize) -> Option<glam::Vec3> {
+        match self {
+            StoredNormals::Byte(v) => v.get(i).map(|&c| drafter_core::snorm8_decode(c)),
+            StoredNormals::Short(v) => v.get(i).map(|&c| drafter_core::snorm16_decode(c)),
+            StoredNormals::Float(v) => v.get(i).map(|&c| glam::Vec3::from(c)),
+        }
+    }
+
+    /// Every vector decoded (see [`StoredNormals::decoded`]).
+    pub fn decoded_all(&self) -> Vec<glam::Vec3> {
+        (0..self.len()).filter_map(|i| self.decoded(i)).collect()
+    }
 }
 
 impl PrimitiveEdges {
@@ -148,21 +195,28 @@ pub struct MeshSilhouettes {
     pub cone_bvh: Option<ConeBvhData>,
 }
 
+/// The Gauss-map hierarchy as stored (drafter-lines' `GaussMapArrays`): no candidate order, a
+/// reader assigns the arcs to their cells again.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GaussMapData {
     pub base: u32,
     pub max_depth: u32,
+    pub overlap: f32,
     pub node_caps: Vec<f32>,
     pub nodes: Vec<u32>,
-    pub order: Vec<u32>,
 }
 
+/// The cone BVH as stored (drafter-lines' `ConeBvhArrays`): no candidate order, a reader replays
+/// the recorded splits.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConeBvhData {
+    pub normal_level: u32,
+    pub leaf_size: u32,
     pub node_boxes: Vec<f32>,
     pub node_cones: Vec<f32>,
     pub nodes: Vec<u32>,
-    pub order: Vec<u32>,
+    pub splits: Vec<u8>,
+    pub split_starts: Vec<u32>,
 }
 
 /// A mesh's vertices re-laid out by the normal stage: every output vertex copies the attributes of
@@ -272,7 +326,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
                 let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
                 let mut ext = json!({"visibility": visibility, "material": material});
                 if !edges.silhouette_normals.is_empty() {
-                    ext["silhouetteNormals"] = doc.push_snorm16_vec3(&edges.silhouette_normals).into();
+                    ext["silhouetteNormals"] = doc.push_unit_vec3(&edges.silhouette_normals).into();
                 }
                 if !edges.hard_edge_classes.is_empty() {
                     hard_edge_classes = Some(doc.push_typed_scalars(
@@ -483,21 +537,24 @@ fn edge_material_json() -> Value {
     })
 }
 
-/// The mesh's hierarchies: integer arrays in the smallest unsigned type that holds them (the
-/// `order` permutations are u16 below 65,536 candidates), float arrays as FLOAT.
+/// The mesh's hierarchies: integer arrays in the smallest unsigned type that holds them, float
+/// arrays as FLOAT, split bytes as UNSIGNED_BYTE.
 fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord {
     let gauss_map = sil.gauss_map.as_ref().map(|g| GaussMapRecord {
         base: g.base,
         max_depth: g.max_depth,
+        overlap: g.overlap,
         node_caps: doc.push_f32_scalars(&g.node_caps) as u32,
         nodes: doc.push_scalars(&g.nodes, None) as u32,
-        order: doc.push_scalars(&g.order, None) as u32,
     });
     let cone_bvh = sil.cone_bvh.as_ref().map(|b| ConeBvhRecord {
+        normal_level: b.normal_level,
+        leaf_size: b.leaf_size,
         node_boxes: doc.push_f32_scalars(&b.node_boxes) as u32,
         node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
         nodes: doc.push_scalars(&b.nodes, None) as u32,
-        order: doc.push_scalars(&b.order, None) as u32,
+        splits: doc.push_typed_scalars(UNSIGNED_BYTE, &b.splits, b.splits.len()) as u32,
+        split_starts: doc.push_scalars(&b.split_starts, None) as u32,
     });
     SilhouettesRecord {
         candidates: sil.candidate_corners.len() as u32,

@@ -87,10 +87,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
 use crate::gauss::{BaseSolid, QueryCounts, arc_paths, base_cells};
-use crate::tree::{
-    breadth_first, check_breadth_first, check_permutation, for_each_in_subtrees, push_children, widest_level,
-    with_levels,
-};
+use crate::tree::{breadth_first, check_breadth_first, for_each_in_subtrees, push_children, widest_level, with_levels};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cone's half-angle.
@@ -155,18 +152,35 @@ impl Default for ConeBvhOptions {
 }
 
 /// The flat arrays of a [`ConeBvh`], ready for glTF buffer views.
+///
+/// The storage order of the candidates is not stored: [`ConeBvh::from_arrays`] builds the binary
+/// tree again, replaying the recorded split of every inner node (`splits`) with the builder's
+/// arithmetic instead of searching for it, which gives the builder's candidate order; `nodes`
+/// then refer to ranges of that order.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ConeBvhArrays {
     /// 6 `f32` per node: box min x, y, z, max x, y, z of the candidate points below.
     pub node_boxes: Vec<f32>,
     /// 4 `f32` per node: cone axis x, y, z and `sin α + margin` (≥ 1: never culled).
     pub node_cones: Vec<f32>,
-    /// 4 `u32` per node, nodes breadth-first from the root: first child, child count, first own
-    /// candidate and end of own candidates (into `order`; only leaves own candidates).
+    /// 4 `u32` per node, nodes breadth-first from the root: first child, child count, and the
+    /// range of the node's candidates (its whole subtree) in the binary tree's preorder candidate
+    /// order; the children's ranges tile their parent's in order.
     pub nodes: Vec<u32>,
-    /// Candidate index of each stored candidate.
-    pub order: Vec<u32>,
+    /// The Gauss-map level of the normal split (see [`NormalSplit::Level`]).
+    pub normal_level: u32,
+    /// The leaf size the binary tree was cut at ([`ConeBvhOptions::leaf_size`]).
+    pub leaf_size: u32,
+    /// One byte per inner node of each dual-space tree, in preorder: `axis · 32 + bin`, the split
+    /// between bins `bin − 1` and `bin` of [`DUAL_BINS`] on that axis, or [`MEDIAN_SPLIT`].
+    pub splits: Vec<u8>,
+    /// Where each dual-space tree's bytes start in `splits`, one per tree in the order the normal
+    /// split emits them.
+    pub split_starts: Vec<u32>,
 }
+
+/// The split byte of an inner node split at the median of its widest axis of centres.
+pub const MEDIAN_SPLIT: u8 = u8::MAX;
 
 /// See the module docs.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,13 +192,19 @@ pub struct ConeBvh {
     widest: usize,
     /// The leaves' candidates in blocks, leaf after leaf.
     stream: Stream,
-    /// The serialised form: `[first_child, child_count, arc_start, arc_end]` per node.
+    /// The query layout: `[first_child, child_count, arc_start, arc_end]` per node, own
+    /// candidates in `order`.
     flat: Vec<[u32; 4]>,
+    /// The stored layout: first child, child count and the subtree's range of the preorder
+    /// candidate order (see [`ConeBvhArrays::nodes`]).
+    stored: Vec<[u32; 4]>,
     boxes: Vec<[f32; 6]>,
     cones: Vec<[f32; 4]>,
     order: Vec<u32>,
     leaf_size: u32,
     normal_level: Option<u8>,
+    splits: Vec<u8>,
+    split_starts: Vec<u32>,
     predicted_ns: f64,
 }
 
@@ -400,6 +420,8 @@ struct Tree {
     nodes: Vec<[u32; 4]>,
     children: Vec<Vec<u32>>,
     order: Vec<u32>,
+    /// The split byte of every inner node of the dual-space trees, in preorder.
+    splits: Vec<u8>,
 }
 
 impl Tree {
@@ -420,8 +442,15 @@ impl Tree {
     /// Appends `sub` (built on its own) as the next child of node `at`: its node indices, skip
     /// pointers and ranges are shifted past this tree's.
     fn append_child(&mut self, at: usize, sub: Tree) {
-        let (node_offset, arc_offset) = (self.nodes.len() as u32, self.order.len() as u32);
+        let node_offset = self.nodes.len() as u32;
         self.children[at].push(node_offset);
+        self.extend(sub);
+    }
+
+    /// Appends `sub` (built on its own) at the end of this tree, as [`Tree::open`] would start it.
+    fn extend(&mut self, sub: Tree) {
+        let (node_offset, arc_offset) = (self.nodes.len() as u32, self.order.len() as u32);
+        self.splits.extend(sub.splits);
         self.nodes.extend(
             sub.nodes
                 .into_iter()
@@ -449,7 +478,10 @@ impl ConeBvh {
             NormalSplit::Level(l) => Some(l.min(6)),
             NormalSplit::Auto => Some(normal_level_for_count(n)),
         };
-        let tree = build_tree(points, &unit, leaf_size, normal_level);
+        let (tree, split_starts) = match build_tree(points, &unit, leaf_size, normal_level, None) {
+            Ok(built) => built,
+            Err(_) => unreachable!("a build without a replay script does not fail"),
+        };
         // The candidates in tree order, so that every node's bounds read one contiguous range
         // (gathering through `order` per node and level missed the cache on every candidate).
         let (tree_points, tree_unit): (Vec<Vec3>, Vec<[DVec3; 2]>) =
@@ -517,17 +549,25 @@ impl ConeBvh {
         let boxes: Vec<[f32; 6]> = source.iter().map(|&i| boxes[i]).collect();
         let cones: Vec<[f32; 4]> = source.iter().map(|&i| cones[i]).collect();
         let planes: Vec<PlaneBound> = source.iter().map(|&i| planes[i]).collect();
+        let stored: Vec<[u32; 4]> = flat
+            .iter()
+            .zip(&source)
+            .map(|(&[first, count, _, _], &i)| [first, count, tree.nodes[i][0], tree.nodes[i][1]])
+            .collect();
         let a = assemble(&flat, &boxes, &cones, &planes, &order, normals, points);
         let mut bvh = ConeBvh {
             nodes: a.nodes,
             widest: a.widest,
             stream: a.stream,
             flat,
+            stored,
             boxes,
             cones,
             order,
             leaf_size,
             normal_level,
+            splits: tree.splits,
+            split_starts,
             predicted_ns: 0.0,
         };
         if !eyes.is_empty() {
@@ -653,23 +693,36 @@ impl ConeBvh {
         counts
     }
 
-    /// The flat arrays (see [`ConeBvhArrays`]).
-    pub fn to_arrays(&self) -> ConeBvhArrays {
-        ConeBvhArrays {
+    /// The flat arrays (see [`ConeBvhArrays`]); `None` for a tree without a normal split
+    /// ([`NormalSplit::Off`]), whose obvhs build cannot be replayed from split bytes.
+    pub fn to_arrays(&self) -> Option<ConeBvhArrays> {
+        Some(ConeBvhArrays {
             node_boxes: self.boxes.iter().flatten().copied().collect(),
             node_cones: self.cones.iter().flatten().copied().collect(),
-            nodes: self.flat.iter().flatten().copied().collect(),
-            order: self.order.clone(),
-        }
+            nodes: self.stored.iter().flatten().copied().collect(),
+            normal_level: u32::from(self.normal_level?),
+            leaf_size: self.leaf_size,
+            splits: self.splits.clone(),
+            split_starts: self.split_starts.clone(),
+        })
     }
 
-    /// Rebuilds a hierarchy from its arrays and the candidates, checking the tree and that every
-    /// box and cone really bounds the candidates below it.
+    /// Rebuilds a hierarchy from its arrays and the candidates: the binary tree is built again by
+    /// replaying its recorded splits (which gives the builder's candidate order), the stored
+    /// nodes must tile that order, and every box and cone must really bound the candidates below
+    /// it, so a corrupted file cannot make a query drop a silhouette.
     pub fn from_arrays(arrays: &ConeBvhArrays, normals: &[[Vec3; 2]], points: &[Vec3]) -> Result<Self, ArraysError> {
         if points.len() != normals.len() {
             return Err(ArraysError::Length { array: "points", expected: normals.len(), found: points.len() });
         }
-        check_permutation(&arrays.order, normals.len())?;
+        let normal_level = u8::try_from(arrays.normal_level).ok().filter(|&l| l <= 6).ok_or(ArraysError::Value {
+            array: "normal_level",
+            index: 0,
+            value: f64::from(arrays.normal_level),
+        })?;
+        if !(1..=4096).contains(&arrays.leaf_size) {
+            return Err(ArraysError::Value { array: "leaf_size", index: 0, value: f64::from(arrays.leaf_size) });
+        }
         let count = arrays.nodes.len() / 4;
         if count == 0 || arrays.nodes.len() != 4 * count {
             return Err(ArraysError::Length { array: "nodes", expected: 4 * count.max(1), found: arrays.nodes.len() });
@@ -688,10 +741,20 @@ impl ConeBvh {
                 found: arrays.node_cones.len(),
             });
         }
-        let flat: Vec<[u32; 4]> = arrays.nodes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let stored: Vec<[u32; 4]> = arrays.nodes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let boxes: Vec<[f32; 6]> =
             arrays.node_boxes.chunks_exact(6).map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]]).collect();
         let cones: Vec<[f32; 4]> = arrays.node_cones.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let unit: Vec<[DVec3; 2]> = normals.par_iter().map(|&n| unit_pair(n)).collect();
+        let (tree, _) = build_tree(
+            points,
+            &unit,
+            arrays.leaf_size,
+            Some(normal_level),
+            Some((&arrays.splits, &arrays.split_starts)),
+        )?;
+        drop(unit);
+        let (flat, order) = query_layout(&stored, &tree.order)?;
         let parent = check_breadth_first(&flat, normals.len())?;
         let mut axes = Vec::with_capacity(count);
         for (i, c) in cones.iter().enumerate() {
@@ -704,7 +767,7 @@ impl ConeBvh {
             }
             axes.push(axis.normalize_or_zero());
         }
-        for_each_in_subtrees(&flat, &parent, &arrays.order, |node, k| {
+        for_each_in_subtrees(&flat, &parent, &order, |node, k| {
             let b = boxes[node];
             let p = points[k as usize];
             let inside = b[0] <= p.x && p.x <= b[3] && b[1] <= p.y && p.y <= b[4] && b[2] <= p.z && p.z <= b[5];
@@ -720,25 +783,66 @@ impl ConeBvh {
         })?;
         // The plane offsets are not stored: they follow from the boxes and the candidates.
         let mut acc: Vec<PlaneAcc> = boxes.iter().map(PlaneAcc::new).collect();
-        for_each_in_subtrees(&flat, &parent, &arrays.order, |node, k| {
+        for_each_in_subtrees(&flat, &parent, &order, |node, k| {
             acc[node].add(unit_pair(normals[k as usize]), points[k as usize]);
             Ok(())
         })?;
         let planes: Vec<PlaneBound> = acc.iter().zip(&cones).map(|(a, c)| a.finish(c)).collect();
-        let a = assemble(&flat, &boxes, &cones, &planes, &arrays.order, normals, points);
+        let a = assemble(&flat, &boxes, &cones, &planes, &order, normals, points);
         Ok(ConeBvh {
             nodes: a.nodes,
             widest: a.widest,
             stream: a.stream,
             flat,
+            stored,
             boxes,
             cones,
-            order: arrays.order.clone(),
-            leaf_size: 0,
-            normal_level: None,
+            order,
+            leaf_size: arrays.leaf_size,
+            normal_level: Some(normal_level),
+            splits: arrays.splits.clone(),
+            split_starts: arrays.split_starts.clone(),
             predicted_ns: 0.0,
         })
     }
+}
+
+/// The query layout of a stored tree (see [`ConeBvhArrays::nodes`]) over the preorder candidate
+/// order `preorder`: the leaves' ranges gathered breadth-first into `order`, each node's own range
+/// into it. The stored ranges must tile: the root holds every candidate and each node's children
+/// split its range in order, so every candidate lands in exactly one leaf.
+fn query_layout(stored: &[[u32; 4]], preorder: &[u32]) -> Result<(Vec<[u32; 4]>, Vec<u32>), ArraysError> {
+    let n = preorder.len();
+    if stored.first().is_none_or(|r| r[2] != 0 || r[3] as usize != n) {
+        return Err(ArraysError::Tree { node: 0 });
+    }
+    let mut flat = Vec::with_capacity(stored.len());
+    let mut order = Vec::with_capacity(n);
+    for (i, &[first, count, start, end]) in stored.iter().enumerate() {
+        let bad = ArraysError::Tree { node: i };
+        if start > end || end as usize > n {
+            return Err(bad);
+        }
+        if count > 0 {
+            let kids = stored.get(first as usize..first as usize + count as usize).ok_or(bad.clone())?;
+            let mut at = start;
+            for kid in kids {
+                if kid[2] != at {
+                    return Err(bad);
+                }
+                at = kid[3];
+            }
+            if at != end {
+                return Err(bad);
+            }
+            flat.push([first, count, order.len() as u32, order.len() as u32]);
+        } else {
+            let from = order.len() as u32;
+            order.extend_from_slice(&preorder[start as usize..end as usize]);
+            flat.push([first, count, from, order.len() as u32]);
+        }
+    }
+    Ok((flat, order))
 }
 
 /// For each node, the fraction of `eyes` that test its bound and the fraction for which it is not
@@ -811,44 +915,92 @@ fn collapse_by_cost(
     collapse
 }
 
-/// The whole tree: normal cells (if any) on top, a spatial BVH below each.
-fn build_tree(points: &[Vec3], unit: &[[DVec3; 2]], leaf_size: u32, normal_level: Option<u8>) -> Tree {
+/// The whole tree: normal cells (if any) on top, a spatial BVH below each. With `replay`
+/// (`splits`, `split_starts` of [`ConeBvhArrays`]) the dual-space trees take the recorded splits
+/// instead of searching for them (only with a normal level: the obvhs tree of
+/// [`NormalSplit::Off`] cannot be replayed).
+fn build_tree(
+    points: &[Vec3],
+    unit: &[[DVec3; 2]],
+    leaf_size: u32,
+    normal_level: Option<u8>,
+    replay: Option<(&[u8], &[u32])>,
+) -> Result<(Tree, Vec<u32>), ArraysError> {
     let mut tree = Tree::default();
     let ids: Vec<u32> = (0..points.len() as u32).collect();
-    match normal_level {
-        None => spatial(&mut tree, &ids, points, leaf_size),
-        Some(level) => {
-            let base = base_cells(BaseSolid::Icosahedron);
-            let paths = arc_paths(unit, &base, level, f64::from(crate::gauss::DEFAULT_OVERLAP));
-            let dual = dual_points(points, unit);
-            let split = NormalSplitter { paths: &paths, level, dual: &dual, leaf_size };
-            split.node(&mut tree, ids, 0);
+    let Some(level) = normal_level else {
+        if replay.is_some() {
+            return Err(ArraysError::Value { array: "normal_level", index: 0, value: f64::NAN });
         }
-    }
-    tree
+        spatial(&mut tree, &ids, points, leaf_size);
+        return Ok((tree, Vec::new()));
+    };
+    let base = base_cells(BaseSolid::Icosahedron);
+    let paths = arc_paths(unit, &base, level, f64::from(crate::gauss::DEFAULT_OVERLAP));
+    let dual = dual_points(points, unit);
+    let split = NormalSplitter { paths: &paths, level };
+    // Three passes: the normal split lists its dual-space trees, they are built (or replayed) on
+    // the thread pool, and the normal split runs again, splicing them in where it asks for them.
+    let mut jobs: Vec<Vec<u32>> = Vec::new();
+    split.node(&mut Tree::default(), ids.clone(), 0, leaf_size, &mut |_, ids| jobs.push(ids));
+    let records =
+        |ids: &[u32]| -> Vec<DualRecord> { ids.iter().map(|&id| DualRecord { b: dual[id as usize], id }).collect() };
+    let built: Vec<Tree> = match replay {
+        None => jobs
+            .par_iter()
+            .map(|ids| {
+                let mut sub = Tree::default();
+                dual_node(&mut sub, &mut records(ids), leaf_size, 0);
+                sub
+            })
+            .collect(),
+        Some((splits, starts)) => {
+            if starts.len() != jobs.len() {
+                return Err(ArraysError::Length { array: "split_starts", expected: jobs.len(), found: starts.len() });
+            }
+            let bad = |index: usize| ArraysError::Value { array: "split_starts", index, value: f64::NAN };
+            jobs.par_iter()
+                .enumerate()
+                .map(|(j, ids)| {
+                    let from = starts[j] as usize;
+                    let to = starts.get(j + 1).map_or(splits.len(), |&e| e as usize);
+                    let script = splits.get(from..to).ok_or_else(|| bad(j))?;
+                    let mut sub = Tree::default();
+                    let mut at = 0;
+                    replay_dual_node(&mut sub, &mut records(ids), leaf_size, script, &mut at)?;
+                    if at != script.len() { Err(bad(j)) } else { Ok(sub) }
+                })
+                .collect::<Result<_, _>>()?
+        }
+    };
+    let mut starts = Vec::with_capacity(built.len());
+    let mut built = built.into_iter();
+    split.node(&mut tree, ids, 0, leaf_size, &mut |tree, _| {
+        if let Some(sub) = built.next() {
+            starts.push(tree.splits.len() as u32);
+            tree.extend(sub);
+        }
+    });
+    Ok((tree, starts))
 }
 
 /// Splits candidates by the Gauss-map cell their arc is stored in (see [`arc_paths`]).
 struct NormalSplitter<'a> {
     paths: &'a [(u32, u8)],
     level: u8,
-    dual: &'a [DualBox],
-    leaf_size: u32,
 }
 
-impl NormalSplitter<'_> {
-    /// The dual-space tree over `ids`, whose normals are close (see [`dual_node`]).
-    fn spatial(&self, tree: &mut Tree, ids: &[u32]) {
-        let mut records: Vec<DualRecord> = ids.iter().map(|&id| DualRecord { b: self.dual[id as usize], id }).collect();
-        dual_node(tree, &mut records, self.leaf_size, 0);
-    }
+/// Where the normal split asks for a dual-space tree over some candidates, emitted at the end
+/// of the tree.
+type DualSink<'a> = dyn FnMut(&mut Tree, Vec<u32>) + 'a;
 
+impl NormalSplitter<'_> {
     /// Emits the subtree of `ids`, whose arcs all went down at least `depth` cells and share
-    /// their first `depth` digits: arcs that stop here get a spatial BVH of their own, the
-    /// others are grouped by their next cell.
-    fn node(&self, tree: &mut Tree, ids: Vec<u32>, depth: u8) {
-        if depth > self.level || ids.len() <= self.leaf_size as usize {
-            self.spatial(tree, &ids);
+    /// their first `depth` digits: arcs that stop here get a dual-space tree of their own (from
+    /// `sink`), the others are grouped by their next cell.
+    fn node(&self, tree: &mut Tree, ids: Vec<u32>, depth: u8, leaf_size: u32, sink: &mut DualSink<'_>) {
+        if depth > self.level || ids.len() <= leaf_size as usize {
+            sink(tree, ids);
             return;
         }
         let digit = |i: u32| {
@@ -868,47 +1020,22 @@ impl NormalSplitter<'_> {
         let parts = usize::from(!stay.is_empty()) + groups.iter().filter(|g| !g.is_empty()).count();
         if parts == 1 && stay.is_empty() {
             let only = groups.into_iter().find(|g| !g.is_empty()).unwrap_or_default();
-            self.node(tree, only, depth + 1);
+            self.node(tree, only, depth + 1, leaf_size, sink);
             return;
         }
         if parts == 1 {
-            self.spatial(tree, &stay);
+            sink(tree, stay);
             return;
         }
         let at = tree.open();
-        let total = stay.len() + groups.iter().map(Vec::len).sum::<usize>();
-        if total > PARALLEL_CANDIDATES {
-            // The stay-here candidates first, then the groups by cell, as below.
-            let work: Vec<(Vec<u32>, bool)> = std::iter::once((stay, true))
-                .chain(groups.into_iter().map(|g| (g, false)))
-                .filter(|(ids, _)| !ids.is_empty())
-                .collect();
-            let subtrees: Vec<Tree> = work
-                .into_par_iter()
-                .map(|(ids, here)| {
-                    let mut sub = Tree::default();
-                    if here {
-                        self.spatial(&mut sub, &ids)
-                    } else {
-                        self.node(&mut sub, ids, depth + 1)
-                    }
-                    sub
-                })
-                .collect();
-            for sub in subtrees {
-                tree.append_child(at, sub);
-            }
-            tree.close(at, false);
-            return;
-        }
         if !stay.is_empty() {
             let child = tree.nodes.len() as u32;
-            self.spatial(tree, &stay);
+            sink(tree, stay);
             tree.children[at].push(child);
         }
         for g in groups.into_iter().filter(|g| !g.is_empty()) {
             let child = tree.nodes.len() as u32;
-            self.node(tree, g, depth + 1);
+            self.node(tree, g, depth + 1, leaf_size, sink);
             tree.children[at].push(child);
         }
         tree.close(at, false);
@@ -982,16 +1109,8 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
         tree.close(at, true);
         return;
     }
-    let mut bounds = EMPTY_BOX;
-    for r in records.iter() {
-        let c = r.centre();
-        grow(&mut bounds, &[c, c]);
-    }
-    let bin_of = |c: f32, a: usize| {
-        let ext = bounds[1][a] - bounds[0][a];
-        // `as` saturates (NaN to 0): no bin index leaves the range.
-        (((c - bounds[0][a]) / ext * DUAL_BINS as f32) as usize).min(DUAL_BINS - 1)
-    };
+    let bounds = centre_bounds(records);
+    let bin_of = |c: f32, a: usize| bin_of(&bounds, c, a);
     // Axes whose centres all coincide (or are not finite) offer no split.
     let splittable: [bool; 4] =
         std::array::from_fn(|a| (bounds[1][a] - bounds[0][a]).partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater));
@@ -1050,30 +1169,12 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
             }
         }
     }
-    let mid = match best {
-        Some((_, a, split)) => {
-            let mut left = 0;
-            for j in 0..records.len() {
-                if bin_of(records[j].centre()[a], a) < split {
-                    records.swap(left, j);
-                    left += 1;
-                }
-            }
-            left
-        }
-        None => {
-            // Median of the widest axis of centres (all equal: any halves).
-            let a = (0..4).max_by(|&x, &y| {
-                (bounds[1][x] - bounds[0][x]).total_cmp(&(bounds[1][y] - bounds[0][y])).then(y.cmp(&x))
-            });
-            let mid = records.len() / 2;
-            if let Some(a) = a {
-                records
-                    .select_nth_unstable_by(mid, |x, y| x.centre()[a].total_cmp(&y.centre()[a]).then(x.id.cmp(&y.id)));
-            }
-            mid
-        }
+    let split = match best {
+        Some((_, a, split)) => (a as u8) << 5 | split as u8,
+        None => MEDIAN_SPLIT,
     };
+    tree.splits.push(split);
+    let mid = apply_split(records, &bounds, split);
     let parallel = records.len() > PARALLEL_CANDIDATES;
     let (left, right) = records.split_at_mut(mid);
     if parallel {
@@ -1093,6 +1194,87 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
         }
     }
     tree.close(at, false);
+}
+
+/// The box of the records' centres.
+fn centre_bounds(records: &[DualRecord]) -> DualBox {
+    let mut bounds = EMPTY_BOX;
+    for r in records {
+        let c = r.centre();
+        grow(&mut bounds, &[c, c]);
+    }
+    bounds
+}
+
+/// The bin of centre coordinate `c` on axis `a` of the centre box `bounds`.
+fn bin_of(bounds: &DualBox, c: f32, a: usize) -> usize {
+    let ext = bounds[1][a] - bounds[0][a];
+    // `as` saturates (NaN to 0): no bin index leaves the range.
+    (((c - bounds[0][a]) / ext * DUAL_BINS as f32) as usize).min(DUAL_BINS - 1)
+}
+
+/// Reorders `records` (centre box `bounds`) by the split byte `split` (see
+/// [`ConeBvhArrays::splits`]) and returns the size of the left side: the records in bins below
+/// `bin` on `axis`, or for [`MEDIAN_SPLIT`] the lower half by centre on the widest axis (ties by
+/// candidate). The one definition both the build and the replay use.
+fn apply_split(records: &mut [DualRecord], bounds: &DualBox, split: u8) -> usize {
+    if split != MEDIAN_SPLIT {
+        let (a, bin) = (usize::from(split >> 5), usize::from(split & 31));
+        let mut left = 0;
+        for j in 0..records.len() {
+            if bin_of(bounds, records[j].centre()[a], a) < bin {
+                records.swap(left, j);
+                left += 1;
+            }
+        }
+        return left;
+    }
+    // Median of the widest axis of centres (all equal: any halves).
+    let a =
+        (0..4).max_by(|&x, &y| (bounds[1][x] - bounds[0][x]).total_cmp(&(bounds[1][y] - bounds[0][y])).then(y.cmp(&x)));
+    let mid = records.len() / 2;
+    if let Some(a) = a {
+        records.select_nth_unstable_by(mid, |x, y| x.centre()[a].total_cmp(&y.centre()[a]).then(x.id.cmp(&y.id)));
+    }
+    mid
+}
+
+/// [`dual_node`] with the recorded split bytes `script` (read from `at`) instead of the
+/// heuristic's search: the same tree over the same records. Serial; a split byte that does not
+/// split (an empty side, an axis or bin out of range) or a script that ends early is refused.
+fn replay_dual_node(
+    tree: &mut Tree,
+    records: &mut [DualRecord],
+    leaf_size: u32,
+    script: &[u8],
+    at: &mut usize,
+) -> Result<(), ArraysError> {
+    let node = tree.open();
+    if records.len() <= leaf_size as usize || records.len() < 2 {
+        tree.order.extend(records.iter().map(|r| r.id));
+        tree.close(node, true);
+        return Ok(());
+    }
+    let bad = ArraysError::Value { array: "splits", index: *at, value: f64::NAN };
+    let split = *script.get(*at).ok_or(bad.clone())?;
+    *at += 1;
+    if split != MEDIAN_SPLIT && (split >> 5 > 3 || usize::from(split & 31) == 0) {
+        return Err(bad);
+    }
+    tree.splits.push(split);
+    let bounds = centre_bounds(records);
+    let mid = apply_split(records, &bounds, split);
+    if mid == 0 || mid == records.len() {
+        return Err(bad);
+    }
+    let (left, right) = records.split_at_mut(mid);
+    for part in [left, right] {
+        let child = tree.nodes.len() as u32;
+        replay_dual_node(tree, part, leaf_size, script, at)?;
+        tree.children[node].push(child);
+    }
+    tree.close(node, false);
+    Ok(())
 }
 
 /// Emits an obvhs BVH2 (PLOC) over the points of `ids`, cut at `leaf_size` ([`NormalSplit::Off`]).
@@ -1347,7 +1529,15 @@ mod tests {
             .map(|&[a, b]| [a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero()])
             .collect();
         for (leaf, level) in [(1u32, Some(1u8)), (4, Some(3)), (16, Some(2))] {
-            let tree = build_tree(&points, &unit, leaf, level);
+            let (tree, starts) = build_tree(&points, &unit, leaf, level, None).unwrap();
+            // Replaying the recorded splits gives the same tree, node for node.
+            let (again, starts_again) = build_tree(&points, &unit, leaf, level, Some((&tree.splits, &starts))).unwrap();
+            assert_eq!((&again.nodes, &again.order, &again.splits), (&tree.nodes, &tree.order, &tree.splits));
+            assert_eq!(starts_again, starts);
+            // A script cut short, or with a split that empties a side, is refused.
+            if let Some((_, short)) = tree.splits.split_last() {
+                assert!(build_tree(&points, &unit, leaf, level, Some((short, &starts))).is_err());
+            }
             let mut seen = tree.order.clone();
             seen.sort_unstable();
             assert_eq!(seen, (0..n as u32).collect::<Vec<_>>(), "not a permutation");
@@ -1373,7 +1563,7 @@ mod tests {
             points.push(Vec3::new(x, y, if i % 2 == 0 { 0.0 } else { 0.01 }));
         }
         let unit: Vec<[DVec3; 2]> = normals.iter().map(|&[a, b]| [a.as_dvec3(), b.as_dvec3()]).collect();
-        let tree = build_tree(&points, &unit, 8, Some(1));
+        let (tree, _) = build_tree(&points, &unit, 8, Some(1), None).unwrap();
         for &[start, end, _, is_leaf] in &tree.nodes {
             if is_leaf == 1 {
                 let leaf = &tree.order[start as usize..end as usize];

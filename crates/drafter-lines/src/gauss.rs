@@ -61,8 +61,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::{OrthoBlocks, unit_direction};
 use crate::tree::{
-    breadth_first, check_breadth_first, check_permutation, depths, for_each_in_subtrees, push_children, widest_level,
-    with_levels, with_ranges,
+    breadth_first, check_breadth_first, depths, for_each_in_subtrees, push_children, widest_level, with_levels,
+    with_ranges,
 };
 use crate::{ArraysError, CostModel, EdgeSet};
 
@@ -233,17 +233,23 @@ pub struct GaussMapArrays {
     pub max_depth: u32,
     /// 4 `f32` per node: cap centre x, y, z and the cull threshold `sin r + ε` (≥ 1: never culled).
     pub node_caps: Vec<f32>,
+    /// The overlapping-bin factor ([`Bins::Overlapping`]); 0 for [`Bins::Strict`].
+    pub overlap: f32,
     /// 4 `u32` per node, nodes breadth-first from the root (the whole sphere; depth 1 = level 0):
-    /// first child, child count, first own arc and end of own arcs (into `order`).
+    /// first child, child count, first own arc and end of own arcs, positions in the storage
+    /// order; own arcs of the nodes follow one another in node order.
+    ///
+    /// The storage order itself is not stored: which cell holds an arc is a function of its two
+    /// normals (the bin rule), so [`GaussMapHierarchy::from_arrays`] assigns the arcs again with
+    /// the builder's arithmetic and checks the result against these nodes.
     pub nodes: Vec<u32>,
-    /// Candidate index of each stored arc; own arcs of the nodes follow one another in node order.
-    pub order: Vec<u32>,
 }
 
 /// See the module docs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GaussMapHierarchy {
     base: BaseSolid,
+    bins: Bins,
     max_depth: u8,
     /// What a query reads about nodes, each with its cap, padded with 4 culled entries so that
     /// the up to 4 children of a node are tested in one SIMD pass.
@@ -752,13 +758,8 @@ fn round_up(x: f64) -> f32 {
 impl GaussMapHierarchy {
     /// Builds the hierarchy over candidates with `normals` (see [`crate::FeatureEdges`]).
     pub fn build(normals: &[[Vec3; 2]], options: &GaussMapOptions, cost: &CostModel) -> Self {
-        let mut arcs = arc_records(normals);
         let max_depth = options.max_depth.unwrap_or_else(|| depth_for_count(normals.len(), options.base)).min(12);
-        let builder = Builder { bins: options.bins, max_depth, base: base_cells(options.base) };
-        let mut nodes = Vec::new();
-        let mut scratch = vec![Arc::default(); arcs.len()];
-        builder.node(None, 0, &mut arcs, &mut scratch, 0, &mut nodes);
-        drop(scratch);
+        let (nodes, arcs) = assign(normals, options.base, options.bins, max_depth);
         let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
 
         // Caps over each subtree's endpoints (contiguous in the preorder arc order).
@@ -812,6 +813,7 @@ impl GaussMapHierarchy {
         let a = assemble(&flat, &flat_caps, &bfs_order, normals);
         let mut h = GaussMapHierarchy {
             base: options.base,
+            bins: options.bins,
             max_depth,
             nodes: a.nodes,
             widest: a.widest,
@@ -825,6 +827,11 @@ impl GaussMapHierarchy {
         };
         h.predicted_ns = h.estimate_ns(cost);
         h
+    }
+
+    /// The bins the hierarchy was built with.
+    pub fn bins(&self) -> Bins {
+        self.bins
     }
 
     /// Mean modelled cost of a query over 64 fixed directions.
@@ -984,14 +991,18 @@ impl GaussMapHierarchy {
             base: self.base.code(),
             max_depth: u32::from(self.max_depth),
             node_caps: self.caps.iter().flatten().copied().collect(),
+            overlap: match self.bins {
+                Bins::Strict => 0.0,
+                Bins::Overlapping { factor } => factor,
+            },
             nodes: self.flat.iter().flatten().copied().collect(),
-            order: self.order.clone(),
         }
     }
 
-    /// Rebuilds a hierarchy from its arrays and the candidates' normals, checking the structure and
-    /// that every cap really bounds the endpoints below it (so a corrupted file cannot make a query
-    /// drop a silhouette).
+    /// Rebuilds a hierarchy from its arrays and the candidates' normals: assigns every arc to its
+    /// cell with the builder's own arithmetic (the storage order is not stored), checks that the
+    /// result has exactly the stored nodes, and that every cap really bounds the endpoints below
+    /// it (so a corrupted file cannot make a query drop a silhouette).
     pub fn from_arrays(arrays: &GaussMapArrays, normals: &[[Vec3; 2]]) -> Result<Self, ArraysError> {
         let base = match arrays.base {
             0 => BaseSolid::Octahedron,
@@ -1003,7 +1014,11 @@ impl GaussMapHierarchy {
             index: 0,
             value: f64::from(arrays.max_depth),
         })?;
-        check_permutation(&arrays.order, normals.len())?;
+        let bins = match arrays.overlap {
+            0.0 => Bins::Strict,
+            f if (1.0..=8.0).contains(&f) => Bins::Overlapping { factor: f },
+            f => return Err(ArraysError::Value { array: "overlap", index: 0, value: f64::from(f) }),
+        };
         let count = arrays.nodes.len() / 4;
         if arrays.nodes.len() != count * 4 || count == 0 {
             return Err(ArraysError::Length { array: "nodes", expected: 4 * count.max(1), found: arrays.nodes.len() });
@@ -1025,8 +1040,9 @@ impl GaussMapHierarchy {
             }
             centers.push(c.normalize_or_zero());
         }
+        let order = derived_order(&flat, normals, base, bins, max_depth)?;
         let geo = arc_records(normals);
-        for_each_in_subtrees(&flat, &parent, &arrays.order, |node, a| {
+        for_each_in_subtrees(&flat, &parent, &order, |node, a| {
             let threshold = f64::from(caps[node][3]);
             if threshold >= 1.0 {
                 return Ok(());
@@ -1043,21 +1059,83 @@ impl GaussMapHierarchy {
             }
             Ok(())
         })?;
-        let a = assemble(&flat, &caps, &arrays.order, normals);
+        let a = assemble(&flat, &caps, &order, normals);
         Ok(GaussMapHierarchy {
             base,
+            bins,
             max_depth,
             nodes: a.nodes,
             widest: a.widest,
             blocks: a.blocks,
-            identity: is_identity(&arrays.order),
+            identity: is_identity(&order),
             flat,
             caps,
-            order: arrays.order.clone(),
+            order,
             assigned: None,
             predicted_ns: 0.0,
         })
     }
+}
+
+/// Every arc assigned to its cell by the bin rule: the builder's nodes in preorder and the arcs in
+/// preorder storage order (each node's own arcs, then its children's subtrees; input order within
+/// each). The one definition of where an arc goes, used by the build and by
+/// [`GaussMapHierarchy::from_arrays`], so that both find the same cells bit for bit.
+fn assign(normals: &[[Vec3; 2]], base: BaseSolid, bins: Bins, max_depth: u8) -> (Vec<BuildNode>, Vec<Arc>) {
+    let mut arcs = arc_records(normals);
+    let builder = Builder { bins, max_depth, base: base_cells(base) };
+    let mut nodes = Vec::new();
+    let mut scratch = vec![Arc::default(); arcs.len()];
+    builder.node(None, 0, &mut arcs, &mut scratch, 0, &mut nodes);
+    (nodes, arcs)
+}
+
+/// The storage order of a stored tree `flat` (breadth-first, pruned) over `normals`: the arcs are
+/// assigned again ([`assign`]), the stored tree is matched against the builder's from the root
+/// (a stored node without children over a built node with children is a collapsed subtree), and
+/// the breadth-first layout of the match must reproduce `flat` exactly.
+fn derived_order(
+    flat: &[[u32; 4]],
+    normals: &[[Vec3; 2]],
+    base: BaseSolid,
+    bins: Bins,
+    max_depth: u8,
+) -> Result<Vec<u32>, ArraysError> {
+    let (nodes, arcs) = assign(normals, base, bins, max_depth);
+    let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
+    drop(arcs);
+    let mut collapse = vec![false; nodes.len()];
+    let mut queue = vec![0usize];
+    let mut j = 0;
+    while j < queue.len() {
+        let i = queue[j];
+        let stored = flat.get(j).ok_or(ArraysError::Tree { node: j })?;
+        let children = &nodes[i].children;
+        if stored[1] == 0 && !children.is_empty() {
+            collapse[i] = true;
+        } else if stored[1] as usize != children.len() {
+            return Err(ArraysError::Tree { node: j });
+        } else {
+            queue.extend(children.iter().map(|&c| c as usize));
+        }
+        j += 1;
+    }
+    let no_children: &[u32] = &[];
+    let (derived, bfs_order, _) = breadth_first(
+        0,
+        |i| if collapse[i] { no_children } else { &nodes[i].children },
+        |i| {
+            let n = &nodes[i];
+            &order[n.own.0 as usize..if collapse[i] { n.sub_end } else { n.own.1 } as usize]
+        },
+    );
+    if let Some(node) = derived.iter().zip(flat).position(|(a, b)| a != b) {
+        return Err(ArraysError::Tree { node });
+    }
+    if derived.len() != flat.len() {
+        return Err(ArraysError::Tree { node: derived.len().min(flat.len()) });
+    }
+    Ok(bfs_order)
 }
 
 fn is_identity(order: &[u32]) -> bool {

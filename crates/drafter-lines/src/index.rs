@@ -256,29 +256,26 @@ impl SilhouetteIndex {
             candidate_normals: self.normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect(),
             candidate_points: self.points.iter().flat_map(|p| p.to_array()).collect(),
             gauss_map: self.gauss.as_ref().map(GaussMapHierarchy::to_arrays),
-            cone_bvh: self.bvh.as_ref().map(ConeBvh::to_arrays),
+            cone_bvh: self.bvh.as_ref().and_then(ConeBvh::to_arrays),
             orthographic: self.orthographic,
-            perspective: self.perspective,
+            // A tree that cannot be stored (no normal split) leaves brute force to the reader.
+            perspective: match self.bvh.as_ref().map(ConeBvh::normal_level) {
+                Some(None) => HierarchyChoice::BruteForce(BruteForceReason::Disabled),
+                _ => self.perspective,
+            },
         }
     }
 
     /// Loads an index from its arrays, validating every hierarchy against the candidates.
     ///
-    /// A file keeps its candidates in the Khronos encoding order, so a stored Gauss map's `order`
-    /// is a permutation. The candidates are then renumbered in its storage order (and the cone
-    /// BVH's order with them), as [`SilhouetteIndex::from_candidates`] does after a build: queries
-    /// run on the same memory layout either way, and answer in the renumbered order
+    /// The candidates may come in any order (a file keeps the Khronos encoding order): the
+    /// hierarchies store no permutation. The Gauss map assigns the arcs to its cells again,
+    /// which gives its storage order; the candidates are renumbered in it, as
+    /// [`SilhouetteIndex::from_candidates`] does after a build, and the cone BVH replays its
+    /// splits over the renumbered candidates, as it was built over them. Queries then run on the
+    /// same memory layout as after a build, and answer in the renumbered order
     /// ([`SilhouetteIndex::candidate_edges`] gives each answer's edge or corner).
     pub fn from_arrays(arrays: &SilhouetteArrays) -> Result<Self, ArraysError> {
-        match &arrays.gauss_map {
-            Some(g) if g.order.iter().enumerate().any(|(i, &k)| k as usize != i) => {
-                Self::from_arrays_in_order(&renumbered(arrays, &g.order)?)
-            }
-            _ => Self::from_arrays_in_order(arrays),
-        }
-    }
-
-    fn from_arrays_in_order(arrays: &SilhouetteArrays) -> Result<Self, ArraysError> {
         let n = arrays.candidate_edges.len();
         if arrays.candidate_normals.len() != 6 * n {
             return Err(ArraysError::Length {
@@ -297,16 +294,30 @@ impl SilhouetteIndex {
         if let Some(k) = arrays.candidate_normals.iter().chain(&arrays.candidate_points).position(|x| !x.is_finite()) {
             return Err(ArraysError::Value { array: "candidate_normals/points", index: k, value: f64::NAN });
         }
-        let normals: Vec<[Vec3; 2]> = arrays
+        let mut normals: Vec<[Vec3; 2]> = arrays
             .candidate_normals
             .chunks_exact(6)
             .map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])])
             .collect();
-        let points: Vec<Vec3> = arrays.candidate_points.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
-        let gauss = arrays.gauss_map.as_ref().map(|g| GaussMapHierarchy::from_arrays(g, &normals)).transpose()?;
+        let mut points: Vec<Vec3> =
+            arrays.candidate_points.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+        let mut candidate_edges = arrays.candidate_edges.clone();
+        let gauss = match &arrays.gauss_map {
+            Some(g) => {
+                let (g, permutation) = GaussMapHierarchy::from_arrays(g, &normals)?.into_storage_order();
+                let pick = |k: &u32| *k as usize;
+                candidate_edges = permutation.iter().map(|k| candidate_edges[pick(k)]).collect();
+                normals = permutation.iter().map(|k| normals[pick(k)]).collect();
+                if points.len() == n {
+                    points = permutation.iter().map(|k| points[pick(k)]).collect();
+                }
+                Some(g)
+            }
+            None => None,
+        };
         let bvh = arrays.cone_bvh.as_ref().map(|b| ConeBvh::from_arrays(b, &normals, &points)).transpose()?;
         Ok(Self {
-            candidate_edges: arrays.candidate_edges.clone(),
+            candidate_edges,
             brute: BruteForce::new(&normals, &points),
             normals,
             points,
@@ -316,36 +327,6 @@ impl SilhouetteIndex {
             perspective: arrays.perspective,
         })
     }
-}
-
-/// `arrays` with its candidates in the storage order `order` of its Gauss map (whose order becomes
-/// the identity) and its cone BVH's order mapped along.
-fn renumbered(arrays: &SilhouetteArrays, order: &[u32]) -> Result<SilhouetteArrays, ArraysError> {
-    let n = arrays.candidate_edges.len();
-    crate::tree::check_permutation(order, n)?;
-    let pick = |values: &[f32], width: usize| -> Vec<f32> {
-        if values.len() != width * n {
-            return values.to_vec();
-        }
-        order.iter().flat_map(|&k| values[width * k as usize..width * (k as usize + 1)].iter().copied()).collect()
-    };
-    let mut inverse = vec![0u32; n];
-    for (i, &k) in order.iter().enumerate() {
-        inverse[k as usize] = i as u32;
-    }
-    Ok(SilhouetteArrays {
-        candidate_edges: order.iter().map(|&k| arrays.candidate_edges[k as usize]).collect(),
-        candidate_normals: pick(&arrays.candidate_normals, 6),
-        candidate_points: pick(&arrays.candidate_points, 3),
-        gauss_map: arrays.gauss_map.clone().map(|g| GaussMapArrays { order: (0..n as u32).collect(), ..g }),
-        // An out-of-range entry stays out of range, so that the cone BVH's own check refuses it.
-        cone_bvh: arrays.cone_bvh.clone().map(|b| ConeBvhArrays {
-            order: b.order.iter().map(|&k| inverse.get(k as usize).copied().unwrap_or(u32::MAX)).collect(),
-            ..b
-        }),
-        orthographic: arrays.orthographic,
-        perspective: arrays.perspective,
-    })
 }
 
 fn speedup(brute_ns: f64, hierarchy_ns: f64) -> f32 {

@@ -166,21 +166,6 @@ pub(crate) fn depths(nodes: &[[u32; 4]]) -> Vec<u32> {
     depth
 }
 
-/// `order` must hold each of `0..len` exactly once.
-pub(crate) fn check_permutation(order: &[u32], len: usize) -> Result<(), ArraysError> {
-    if order.len() != len {
-        return Err(ArraysError::Length { array: "order", expected: len, found: order.len() });
-    }
-    let mut seen = vec![false; len];
-    for (k, &i) in order.iter().enumerate() {
-        match seen.get_mut(i as usize) {
-            Some(s) if !*s => *s = true,
-            _ => return Err(ArraysError::Value { array: "order", index: k, value: f64::from(i) }),
-        }
-    }
-    Ok(())
-}
-
 /// For every node, the candidates of its whole subtree (itself and all descendants), for checking
 /// that a bound holds everything below it: each candidate is listed under each of its ancestors.
 pub(crate) fn for_each_in_subtrees(
@@ -223,8 +208,6 @@ mod tests {
         let mut bad = nodes.clone();
         bad[2][3] = 2;
         assert!(check_breadth_first(&bad, 6).is_err());
-        assert!(check_permutation(&order, 6).is_ok());
-        assert!(check_permutation(&[0, 0, 1, 2, 3, 4], 6).is_err());
         let mut seen = vec![];
         for_each_in_subtrees(&nodes, &parent, &order, |node, c| {
             seen.push((node, c));

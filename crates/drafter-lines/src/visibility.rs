@@ -16,16 +16,17 @@
 //! requires those zeros and otherwise ignores such triangles.
 //! The encode-once rules hold per call: encode each primitive with its own triangles.
 //!
-//! `silhouetteNormals` is VEC3 SHORT normalized, one of the three types the merged draft allows (the
-//! earlier oct16 form is neither written nor read): `c = round(32767·x)` per component, read back
-//! as glTF defines normalized shorts, `max(c / 32767, −1)` (`drafter_core::snorm`). The draft
-//! recommends BYTE for size, but measured on the corpus BYTE changes 3–15 % of a view's silhouette
-//! edges and SHORT 0.01–0.16 % (`examples/normal_precision.rs`). Our own hierarchies are built on
-//! the decoded values, so that they answer exactly for the data every reader has.
+//! `silhouetteNormals` is written VEC3 BYTE normalized, the type the merged draft recommends (the
+//! earlier oct16 form is neither written nor read), each normal the lattice point whose direction
+//! is nearest it (`drafter_core::snorm8_encode_direction`), read back as glTF defines normalized
+//! bytes, `max(c / 127, −1)`. The decoder takes the decoded vectors, whatever type a file stored.
+//! Our own hierarchies are built on the decoded values, so that they answer exactly for the data
+//! every reader has; what 8 bits change against `f32` face normals is measured by
+//! `examples/normal_precision.rs` (docs/bench.md).
 
 use std::collections::HashMap;
 
-use drafter_core::{Topology, snorm16_decode, snorm16_encode};
+use drafter_core::{Topology, snorm8_encode_direction};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -66,7 +67,7 @@ pub struct EdgeVisibility {
     pub visibility: Vec<u8>,
     /// The `silhouetteNormals` accessor's values: two VEC3 BYTE normalized normals per 1-edge, in
     /// encoding order.
-    pub silhouette_normals: Vec<[i16; 3]>,
+    pub silhouette_normals: Vec<[i8; 3]>,
     /// Topology edge id of each 1-edge, in encoding order (links `silhouette_normals` to the
     /// full-precision normals of our own extension).
     pub silhouette_edges: Vec<u32>,
@@ -78,6 +79,11 @@ impl EdgeVisibility {
     /// The draft requires at least one non-zero value: write the extension only when this holds.
     pub fn has_visible_edges(&self) -> bool {
         !self.hard_edges.is_empty() || !self.silhouette_edges.is_empty()
+    }
+
+    /// `silhouette_normals` as a glTF reader decodes them (`drafter_core::snorm8_decode`).
+    pub fn decoded_normals(&self) -> Vec<Vec3> {
+        self.silhouette_normals.iter().map(|&c| drafter_core::snorm8_decode(c)).collect()
     }
 }
 
@@ -113,8 +119,8 @@ pub fn encode_edge_visibility(
                     .binary_search(&(e as u32))
                     .map_err(|_| VisibilityError::UnknownEdge { triangle: t, corner: k })?;
                 let [n1, n2] = lines.candidate_normals[c];
-                out.silhouette_normals.push(snorm16_encode(n1));
-                out.silhouette_normals.push(snorm16_encode(n2));
+                out.silhouette_normals.push(snorm8_encode_direction(n1));
+                out.silhouette_normals.push(snorm8_encode_direction(n2));
                 out.silhouette_edges.push(e as u32);
                 SILHOUETTE
             } else {
@@ -186,12 +192,13 @@ pub struct DecodedEdgeVisibility {
 
 /// Decodes one primitive's payload and checks the draft's rules by recounting every edge
 /// independently of [`Topology`]: edges are identified by welded vertex pairs (`welded_of_vertex`;
-/// pass the identity to identify them by index as a plain client would).
+/// pass the identity to identify them by index as a plain client would); `silhouette_normals` are
+/// the decoded vectors (`drafter_core::snorm8_decode` for the BYTE normals we write).
 pub fn decode_edge_visibility(
     triangles: &[[u32; 3]],
     welded_of_vertex: &[u32],
     visibility: &[u8],
-    silhouette_normals: &[[i16; 3]],
+    silhouette_normals: &[Vec3],
 ) -> Result<DecodedEdgeVisibility, VisibilityError> {
     let slots = 3 * triangles.len();
     let expected = (2 * slots).div_ceil(8);
@@ -223,7 +230,7 @@ pub fn decode_edge_visibility(
             entry.0[value as usize] += 1;
             if value == SILHOUETTE {
                 if let (Some(&x), Some(&y)) = (silhouette_normals.get(2 * ones), silhouette_normals.get(2 * ones + 1)) {
-                    entry.1 = Some([snorm16_decode(x), snorm16_decode(y)]);
+                    entry.1 = Some([x, y]);
                 }
                 ones += 1;
             }
@@ -276,13 +283,8 @@ mod tests {
         assert!(decode_edge_visibility(&tris, &ident, &pack([0, 0, 3, 3, 0, 0]), &[]).is_err());
         // Silhouette twice.
         assert!(
-            decode_edge_visibility(
-                &tris,
-                &ident,
-                &pack([0, 0, 1, 1, 0, 0]),
-                &[[1, 2, 3], [4, 5, 6], [7, 8, 9], [1, 1, 1]]
-            )
-            .is_err()
+            decode_edge_visibility(&tris, &ident, &pack([0, 0, 1, 1, 0, 0]), &[Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE])
+                .is_err()
         );
         // Missing normals.
         assert!(matches!(
@@ -295,8 +297,7 @@ mod tests {
         bytes[1] |= 0b1000_0000;
         assert_eq!(decode_edge_visibility(&tris, &ident, &bytes, &[]), Err(VisibilityError::TrailingBits));
         // A valid one.
-        let ok =
-            decode_edge_visibility(&tris, &ident, &pack([2, 2, 1, 0, 2, 2]), &[[0, 0, 32767], [32767, 0, 0]]).unwrap();
+        let ok = decode_edge_visibility(&tris, &ident, &pack([2, 2, 1, 0, 2, 2]), &[Vec3::Z, Vec3::X]).unwrap();
         assert_eq!(ok.hard.len(), 4);
         assert_eq!(ok.silhouettes.len(), 1);
         assert_eq!(ok.silhouettes[0].0, [0, 2]);

@@ -237,16 +237,29 @@ fn arrays_round_trip_and_validation() {
     let json = serde_json_like(&arrays);
     assert!(json > 0);
 
-    let gauss = arrays.gauss_map.clone().unwrap();
     // A cap shrunk below its arcs.
     let mut bad = arrays.clone();
     let g = bad.gauss_map.as_mut().unwrap();
     let k = (0..g.node_caps.len() / 4).find(|&i| g.node_caps[4 * i + 3] < 1.0).unwrap();
     g.node_caps[4 * k + 3] *= 0.5;
     assert!(matches!(SilhouetteIndex::from_arrays(&bad), Err(ArraysError::NotConservative { .. })));
-    // Not a permutation.
+    // Stored own ranges that are not where the bin rule puts the arcs: an arc moved from a
+    // node to the next one in storage order.
     let mut bad = arrays.clone();
-    bad.gauss_map.as_mut().unwrap().order[0] = gauss.order[1];
+    let g = bad.gauss_map.as_mut().unwrap();
+    let k = (0..g.nodes.len() / 4 - 1).find(|&i| g.nodes[4 * i + 3] > g.nodes[4 * i + 2]).unwrap();
+    g.nodes[4 * k + 3] -= 1;
+    g.nodes[4 * (k + 1) + 2] -= 1;
+    assert!(SilhouetteIndex::from_arrays(&bad).is_err());
+    // A BVH split byte changed: the replay finds another tree, which the stored nodes and bounds
+    // do not fit.
+    let mut bad = arrays.clone();
+    let b = bad.cone_bvh.as_mut().unwrap();
+    b.splits[0] = if b.splits[0] == 0x21 { 0x22 } else { 0x21 };
+    assert!(SilhouetteIndex::from_arrays(&bad).is_err());
+    // A script cut short.
+    let mut bad = arrays.clone();
+    bad.cone_bvh.as_mut().unwrap().splits.pop();
     assert!(SilhouetteIndex::from_arrays(&bad).is_err());
     // A broken child range.
     let mut bad = arrays.clone();
@@ -269,13 +282,48 @@ fn arrays_round_trip_and_validation() {
     assert!(matches!(SilhouetteIndex::from_arrays(&bad), Err(ArraysError::Length { .. })));
 }
 
+/// The hierarchies store no candidate order: an index built over candidates in some order (a
+/// file keeps the Khronos encoding order) loads from its hierarchies and the candidates in that
+/// same order to the same storage order, and the same answers, edge for edge.
+#[test]
+fn arrays_load_from_candidates_in_the_build_order() {
+    let options = forced(Default::default(), Default::default());
+    let x = index(noisy_sphere(48, 32, 0.01, 9), &options);
+    let n = x.lines.candidates.len();
+    // The build order: a fixed shuffle of the candidates.
+    let mut rng = Rng::new(5);
+    let mut perm: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        perm.swap(i, rng.below(i as u32 + 1) as usize);
+    }
+    let edges: Vec<u32> = perm.iter().map(|&k| x.lines.candidates[k]).collect();
+    let normals: Vec<[Vec3; 2]> = perm.iter().map(|&k| x.lines.candidate_normals[k]).collect();
+    let points: Vec<Vec3> = perm.iter().map(|&k| x.lines.candidate_points[k]).collect();
+    let built = SilhouetteIndex::from_candidates(edges.clone(), normals.clone(), points.clone(), &options);
+    let stored = built.to_arrays();
+    let file = SilhouetteArrays {
+        candidate_edges: edges,
+        candidate_normals: normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect(),
+        candidate_points: points.iter().flat_map(|p| p.to_array()).collect(),
+        ..stored
+    };
+    let loaded = SilhouetteIndex::from_arrays(&file).unwrap();
+    assert!(loaded.gauss_map().is_some() && loaded.cone_bvh().is_some());
+    assert_eq!(loaded.candidate_edges(), built.candidate_edges(), "the same storage order is derived");
+    let (mut a, mut b) = (EdgeSet::default(), EdgeSet::default());
+    for view in views(&x, &mut rng, 200, 200) {
+        built.query(view, &mut a);
+        loaded.query(view, &mut b);
+        assert_eq!(a, b);
+    }
+}
+
 /// The arrays are plain vectors: their total size in bytes (stand-in for a writer).
 fn serde_json_like(a: &SilhouetteArrays) -> usize {
-    let g = a.gauss_map.as_ref().map_or(0, |g| 4 * (g.node_caps.len() + g.nodes.len() + g.order.len()));
-    let b = a
-        .cone_bvh
-        .as_ref()
-        .map_or(0, |b| 4 * (b.node_boxes.len() + b.node_cones.len() + b.nodes.len() + b.order.len()));
+    let g = a.gauss_map.as_ref().map_or(0, |g| 4 * (g.node_caps.len() + g.nodes.len()));
+    let b = a.cone_bvh.as_ref().map_or(0, |b| {
+        4 * (b.node_boxes.len() + b.node_cones.len() + b.nodes.len() + b.split_starts.len()) + b.splits.len()
+    });
     4 * (a.candidate_edges.len() + a.candidate_normals.len() + a.candidate_points.len()) + g + b
 }
 
