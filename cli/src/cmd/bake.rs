@@ -215,6 +215,15 @@ pub fn run(args: Args) -> Result<()> {
         if let Some(c) = &r.compression {
             eprintln!("  compressed with {c}");
         }
+        if let Some(s) = &r.split {
+            eprintln!(
+                "  16-bit indices: {} primitive(s) over 65,535 vertices written as {} ({} of {} vertices repeated at seams)",
+                s.split_primitives,
+                s.chunks,
+                drafter_core::thousands(s.duplicated_vertices),
+                drafter_core::thousands(s.vertices)
+            );
+        }
         if let Some(t) = &r.textures {
             let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
             eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);

@@ -5,7 +5,9 @@
 //! 2. `bounds` — per part, an oriented box of its world-space vertices, the projector derived from
 //!    it and the gradient parameters, then per-part overrides from the config (drafter-bounds);
 //! 3. `normals` — per unique mesh, crease-aware vertex normals on a new vertex layout and the
-//!    Cignoni et al. 2005 enhanced normals (drafter-normals);
+//!    Cignoni et al. 2005 enhanced normals (drafter-normals); then every primitive that would write
+//!    more than 65,535 vertices is split into consecutive primitives that fit 16-bit indices
+//!    ([`split`]: it counts the layout's vertices, and the stages after it work per chunk);
 //! 4. `lines` — per unique mesh, edge classes on the welded topology (creases, boundaries, part
 //!    borders, silhouette candidates), their EXT_mesh_primitive_edge_visibility encoding per
 //!    primitive, and the silhouette hierarchies (drafter-lines);
@@ -18,8 +20,10 @@
 //! collected in part order).
 
 mod config;
+pub mod split;
 pub mod textures;
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
@@ -39,6 +43,7 @@ pub use config::{
     BakeConfig, Compression, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage,
     PartOverride, PartSelector, STYLES, TexturesStage,
 };
+pub use split::SplitSummary;
 pub use textures::{TextureReport, TexturesSummary};
 
 /// Why a bake failed.
@@ -86,6 +91,9 @@ pub struct BakeReport {
     /// What the line stage found, summed over unique meshes (absent when it was off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines: Option<LinesSummary>,
+    /// The primitives split for 16-bit indices (absent when none was).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub split: Option<SplitSummary>,
     /// The embedded textures and their PNG bytes (absent when none were baked).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub textures: Option<TexturesSummary>,
@@ -190,12 +198,27 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     } else {
         (vec![None; scene.meshes.len()], None)
     };
+    // Primitives within 16-bit indices: groups split by the vertices the writer will write, before
+    // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
+    // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
+    let (splits, split_summary) = split::split_scene(scene, &vertex_data);
+    let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) {
+        Cow::Borrowed(scene)
+    } else {
+        let mut copy = scene.clone();
+        for (mesh, split) in copy.meshes.iter_mut().zip(&splits) {
+            if let Some(split) = split {
+                mesh.groups = split.groups.clone();
+            }
+        }
+        Cow::Owned(copy)
+    };
     timed("normals", start);
 
     let start = begin("lines");
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
         let (edges, silhouettes, summary, line_diagnostics) =
-            compute_lines(scene, &topologies, &parts, &vertex_data, &config.lines);
+            compute_lines(&written_scene, &splits, &topologies, &parts, &vertex_data, &config.lines);
         diagnostics.extend(line_diagnostics);
         (edges, silhouettes, Some(summary))
     } else {
@@ -247,7 +270,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         None => (None, None),
     };
     let output = BakeOutput {
-        scene,
+        scene: &written_scene,
         root,
         instance_parts,
         mesh_labels,
@@ -297,6 +320,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         compression,
         normals: normals_summary,
         lines: lines_summary,
+        split: (split_summary.split_primitives > 0).then_some(split_summary),
         textures: textures_summary,
         diagnostics,
     };
@@ -362,9 +386,12 @@ fn compute_normals(
 type LinesResult = (Vec<Vec<Option<PrimitiveEdges>>>, Vec<Option<MeshSilhouettes>>, LinesSummary, Vec<Diagnostic>);
 
 /// Edges of every mesh used by an instance: classes (with part borders from the segmentation),
-/// the per-primitive encoding and the silhouette index.
+/// the per-primitive encoding and the silhouette index. `splits` gives, for meshes whose groups were
+/// split, the source group of each: a silhouette candidate is encoded once over the chunks of one
+/// source group (hard edges once per chunk, as the encode-once rules are per primitive).
 fn compute_lines(
     scene: &Scene,
+    splits: &[Option<split::SplitGroups>],
     topologies: &[Topology],
     parts: &Parts,
     vertex_data: &[Option<VertexData>],
@@ -401,12 +428,19 @@ fn compute_lines(
                 }
             };
             let mut diagnostics = feature.diagnostics();
+            let mut encoded = drafter_lines::SilhouettesEncoded::default();
             let edges: Vec<Option<PrimitiveEdges>> = mesh
                 .groups
                 .iter()
-                .map(|g| {
+                .enumerate()
+                .map(|(i, g)| {
+                    let source = |i: usize| splits[m].as_ref().map_or(i as u32, |s| s.source[i]);
+                    if i > 0 && source(i) != source(i - 1) {
+                        encoded = drafter_lines::SilhouettesEncoded::default();
+                    }
                     let triangles = &mesh.triangles[g.start as usize..(g.start + g.count) as usize];
-                    match drafter_lines::encode_edge_visibility(triangles, topology, &feature) {
+                    match drafter_lines::encode_edge_visibility_continuing(triangles, topology, &feature, &mut encoded)
+                    {
                         Ok(v) if v.has_visible_edges() => Some(PrimitiveEdges {
                             hard_edge_classes: v
                                 .hard_edges

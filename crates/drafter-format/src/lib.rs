@@ -36,7 +36,8 @@ pub use reader::{
 };
 pub use writer::{
     BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,
-    MeshSilhouettes, PrimitiveEdges, SamplerDesc, StoredNormals, TextureImage, VertexData, Written, write,
+    MAX_PRIMITIVE_VERTICES, MeshSilhouettes, PrimitiveEdges, SamplerDesc, StoredNormals, TextureImage, VertexData,
+    Written, write,
 };
 
 /// `drafter <version>`, written as the generator.

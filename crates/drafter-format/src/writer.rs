@@ -16,6 +16,12 @@ use crate::ext::{
     NodeExtension, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord, TexturesRecord,
 };
 
+/// The most vertices a primitive may have for 16-bit indices: glTF forbids the index 65535 (the
+/// primitive-restart value of UNSIGNED_SHORT), so indices run 0..=65534. The bake splits every
+/// triangle primitive that would write more into consecutive primitives of at most this many
+/// vertices; the writer renumbers such a group's vertices in order of first use.
+pub const MAX_PRIMITIVE_VERTICES: u32 = 65_535;
+
 /// Everything a bake produced, ready to write.
 #[derive(Clone, Debug)]
 pub struct BakeOutput<'a> {
@@ -286,8 +292,9 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     }
     let mut edge_material: Option<usize> = None;
     for (m, mesh) in scene.meshes.iter().enumerate() {
+        let primitive_of = arrange_primitives(&mut doc, mesh, m, from_source)?;
         for (g, group) in mesh.groups.iter().enumerate() {
-            let primitive = if from_source { group.primitive.map_or(g, |p| p as usize) } else { g };
+            let primitive = primitive_of[g];
             let mut enhanced_normal = None;
             let relaid = match &out.vertex_data[m] {
                 Some(vd) => match write_vertex_data(&mut doc, mesh, m, primitive, group, vd, from_source) {
@@ -303,10 +310,14 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
                 None => false,
             };
             if !relaid {
-                if from_source {
-                    rewrite_if_faces_dropped(&mut doc, mesh, m, primitive, group)?;
-                } else {
+                if !from_source {
                     write_mesh_vertices(&mut doc, mesh, m, primitive, group)?;
+                } else if group.vertex_count <= MAX_PRIMITIVE_VERTICES {
+                    rewrite_if_faces_dropped(&mut doc, mesh, m, primitive, group)?;
+                } else if let Err(reason) = gather_source_vertices(&mut doc, mesh, m, primitive, group) {
+                    // Still valid glTF: the whole source vertex range, 32-bit indices.
+                    notes.push(format!("mesh {m} primitive {primitive}: not written with 16-bit indices ({reason})"));
+                    rewrite_if_faces_dropped(&mut doc, mesh, m, primitive, group)?;
                 }
             }
             let part_labels = match &out.mesh_labels[m] {
@@ -501,28 +512,144 @@ fn write_mesh_vertices(
     primitive: usize,
     group: &TriangleGroup,
 ) -> Result<(), FormatError> {
-    let vertices = group.first_vertex as usize..(group.first_vertex + group.vertex_count) as usize;
-    let positions: Vec<[f32; 3]> = mesh.positions[vertices.clone()].iter().map(|p| p.to_array()).collect();
+    let range = group.start as usize..(group.start + group.count) as usize;
+    // The group's vertex range; over the 16-bit limit (a chunk of a split group), the vertices its
+    // triangles use, in order of first use.
+    let (vertices, local): (Vec<u32>, Vec<u32>) = if group.vertex_count <= MAX_PRIMITIVE_VERTICES {
+        let vertices = (group.first_vertex..group.first_vertex + group.vertex_count).collect();
+        (vertices, mesh.triangles[range].iter().flatten().map(|&v| v - group.first_vertex).collect())
+    } else {
+        first_use(&mesh.triangles[range], group.first_vertex, group.vertex_count)
+            .map(|(picks, local)| (picks.iter().map(|&l| l + group.first_vertex).collect(), local))
+            .ok_or_else(|| FormatError::Inconsistent(format!("mesh {m}: a triangle outside its group's vertices")))?
+    };
+    let positions: Vec<[f32; 3]> = vertices.iter().map(|&v| mesh.positions[v as usize].to_array()).collect();
     let mut attributes = json!({"POSITION": doc.push_vec3(&positions, true)});
     if let Some(normals) = &mesh.normals {
         // The spec requires unit normals; skip the attribute if any cannot be normalised.
         let unit: Option<Vec<[f32; 3]>> =
-            normals[vertices.clone()].iter().map(|n| n.try_normalize().map(|n| n.to_array())).collect();
+            vertices.iter().map(|&v| normals[v as usize].try_normalize().map(|n| n.to_array())).collect();
         if let Some(unit) = unit {
             attributes["NORMAL"] = doc.push_vec3(&unit, false).into();
         }
     }
     if let Some(uvs) = &mesh.uvs {
-        let uv: Vec<[f32; 2]> = uvs[vertices].iter().map(|t| t.to_array()).collect();
+        let uv: Vec<[f32; 2]> = vertices.iter().map(|&v| uvs[v as usize].to_array()).collect();
         attributes["TEXCOORD_0"] = doc.push_vec2(&uv).into();
     }
-    let range = group.start as usize..(group.start + group.count) as usize;
-    let local: Vec<u32> = mesh.triangles[range].iter().flatten().map(|&v| v - group.first_vertex).collect();
     let indices = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive)?;
     prim["attributes"] = attributes;
     prim["indices"] = indices.into();
     Ok(())
+}
+
+/// The vertices of `triangles` within the range of `count` vertices from `first` (source-local
+/// numbers, in order of first use) and the triangles' corners renumbered onto them; `None` when a
+/// corner is outside the range.
+fn first_use(triangles: &[[u32; 3]], first: u32, count: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+    let mut local_of = vec![u32::MAX; count as usize];
+    let mut picks = Vec::new();
+    let mut local = Vec::with_capacity(3 * triangles.len());
+    for &v in triangles.iter().flatten() {
+        let slot = local_of.get_mut(v.checked_sub(first)? as usize)?;
+        if *slot == u32::MAX {
+            *slot = picks.len() as u32;
+            picks.push(v - first);
+        }
+        local.push(*slot);
+    }
+    Some((picks, local))
+}
+
+/// Without a new layout, a glTF primitive's vertices restricted to what `group`'s triangles use,
+/// renumbered in order of first use: how each chunk of a primitive split for 16-bit indices gets its
+/// own vertices. `POSITION` is written from the scene (with the bounds the spec requires), every
+/// other attribute gathered from the source bytes; the indices become a triangle list. Fails,
+/// leaving the primitive as it was, for primitives with morph targets or sparse attributes (what it
+/// had appended is unreferenced, and compaction drops it).
+fn gather_source_vertices(
+    doc: &mut Doc,
+    mesh: &Mesh,
+    m: usize,
+    primitive: usize,
+    group: &TriangleGroup,
+) -> Result<(), String> {
+    let range = group.start as usize..(group.start + group.count) as usize;
+    let (picks, local) = first_use(&mesh.triangles[range], group.first_vertex, group.vertex_count)
+        .ok_or("a triangle outside the primitive's vertices")?;
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?.clone();
+    if prim.get("targets").is_some() {
+        return Err("the primitive has morph targets".into());
+    }
+    let source = prim.get("attributes").and_then(Value::as_object).cloned().unwrap_or_default();
+    let mut attributes = Map::new();
+    for (name, accessor) in &source {
+        if name == "POSITION" {
+            let positions: Vec<[f32; 3]> =
+                picks.iter().map(|&l| mesh.positions[(group.first_vertex + l) as usize].to_array()).collect();
+            attributes.insert(name.clone(), doc.push_vec3(&positions, true).into());
+            continue;
+        }
+        let accessor = accessor.as_u64().ok_or("attribute is not an accessor index")? as usize;
+        let gathered = doc.gather_attribute(accessor, &picks).map_err(|e| e.to_string())?;
+        attributes.insert(name.clone(), gathered.into());
+    }
+    let indices = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
+    prim["attributes"] = Value::Object(attributes);
+    prim["indices"] = indices.into();
+    if let Value::Object(map) = prim {
+        map.remove("mode");
+    }
+    Ok(())
+}
+
+/// The glTF primitive each of `mesh`'s groups is written to. A group is its source primitive (glTF
+/// input) or the synthesized primitive of its own; when several groups come from one source
+/// primitive (the bake split it so that every primitive fits 16-bit indices), the mesh's
+/// `primitives` array is rebuilt with one copy of that primitive's JSON per group, consecutive and
+/// in group order, the other primitives (those of no group too) kept in their order. So the file's
+/// triangle primitives are the groups in order, and a mesh triangle's number counted through the
+/// primitives is its index in `mesh.triangles`.
+fn arrange_primitives(doc: &mut Doc, mesh: &Mesh, m: usize, from_source: bool) -> Result<Vec<usize>, FormatError> {
+    let sources: Vec<usize> = mesh
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(g, group)| if from_source { group.primitive.map_or(g, |p| p as usize) } else { g })
+        .collect();
+    let mut distinct = sources.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
+    if distinct.len() == sources.len() {
+        return Ok(sources);
+    }
+    if sources.windows(2).any(|w| w[0] > w[1]) {
+        return Err(FormatError::Inconsistent(format!("mesh {m}: split groups are not in primitive order")));
+    }
+    let mesh_json =
+        doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
+    let old = mesh_json.get("primitives").and_then(Value::as_array).cloned().unwrap_or_default();
+    let mut primitives = Vec::with_capacity(old.len() + sources.len());
+    let mut primitive_of = Vec::with_capacity(sources.len());
+    let mut g = 0;
+    for (p, primitive) in old.into_iter().enumerate() {
+        let first = g;
+        while sources.get(g) == Some(&p) {
+            primitive_of.push(primitives.len());
+            primitives.push(primitive.clone());
+            g += 1;
+        }
+        if g == first {
+            primitives.push(primitive);
+        }
+    }
+    if g != sources.len() {
+        return Err(FormatError::Inconsistent(format!("mesh {m} has no primitive {}", sources[g])));
+    }
+    mesh_json["primitives"] = Value::Array(primitives);
+    Ok(primitive_of)
 }
 
 /// The material `EXT_mesh_primitive_edge_visibility.material` names on every primitive: black and

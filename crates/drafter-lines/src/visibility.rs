@@ -14,7 +14,11 @@
 //! Coplanar and degenerate-neighbour edges are 0, and so are all three edges of a triangle that
 //! collapsed in the weld (a repeated welded vertex: the topology gives it no edges); the decoder
 //! requires those zeros and otherwise ignores such triangles.
-//! The encode-once rules hold per call: encode each primitive with its own triangles.
+//! The encode-once rules hold per call: encode each primitive with its own triangles. A primitive
+//! that the bake split into several (16-bit indices) is encoded chunk by chunk with
+//! [`encode_edge_visibility_continuing`]: hard edges again per chunk (a chunk is a primitive of its
+//! own, and a primitive's client needs its 2), silhouette candidates once across the chunks, as
+//! before the split (the 1 carries both face normals, so a candidate on a chunk seam needs no copy).
 //!
 //! `silhouetteNormals` is written VEC3 BYTE normalized, the type the merged draft recommends (the
 //! earlier oct16 form is neither written nor read), each normal the lattice point whose direction
@@ -94,9 +98,30 @@ pub fn encode_edge_visibility(
     topology: &Topology,
     lines: &FeatureEdges,
 ) -> Result<EdgeVisibility, VisibilityError> {
+    encode_edge_visibility_continuing(triangles, topology, lines, &mut SilhouettesEncoded::default())
+}
+
+/// The silhouette candidates that earlier chunks of a split primitive encoded as 1, by topology
+/// edge id (see [`encode_edge_visibility_continuing`]). Start each source primitive afresh.
+#[derive(Clone, Debug, Default)]
+pub struct SilhouettesEncoded(Vec<bool>);
+
+/// [`encode_edge_visibility`] for one chunk of a primitive split into consecutive primitives: hard
+/// edges follow the encode-once rules within these `triangles` (2 here, even when an earlier chunk
+/// has the edge too), while a silhouette candidate that `encoded` records as written by an earlier
+/// chunk is 0 here, so that each candidate is encoded 1 exactly once over the chunks, with both
+/// face normals, as in the unsplit primitive. Records this chunk's 1s in `encoded`.
+pub fn encode_edge_visibility_continuing(
+    triangles: &[[u32; 3]],
+    topology: &Topology,
+    lines: &FeatureEdges,
+    encoded: &mut SilhouettesEncoded,
+) -> Result<EdgeVisibility, VisibilityError> {
     let lookup = EdgeLookup::new(topology);
     let mut out = EdgeVisibility { visibility: vec![0; (6 * triangles.len()).div_ceil(8)], ..Default::default() };
     let mut written = vec![false; topology.edges.len()];
+    let silhouette_written = &mut encoded.0;
+    silhouette_written.resize(topology.edges.len(), false);
     for (t, tri) in triangles.iter().enumerate() {
         let welded = welded_triangle(tri, t, &topology.welded_of_vertex)?;
         if collapsed(&welded) {
@@ -113,7 +138,7 @@ pub fn encode_edge_visibility(
                     out.hard_edges.push(e as u32);
                     HARD
                 }
-            } else if class == EdgeClass::SilhouetteCandidate && !written[e] {
+            } else if class == EdgeClass::SilhouetteCandidate && !std::mem::replace(&mut silhouette_written[e], true) {
                 let c = lines
                     .candidates
                     .binary_search(&(e as u32))

@@ -106,3 +106,52 @@ fn per_primitive_encoding_holds_the_rules() {
         Err(VisibilityError::VertexOutOfRange { .. })
     ));
 }
+
+#[test]
+fn chunks_of_a_split_primitive_encode_hard_edges_each_and_silhouettes_once() {
+    // A primitive split into consecutive chunks (the bake's 16-bit index split): every chunk holds
+    // the rules on its own (a hard edge on a seam is 2 in each chunk that has it), and each
+    // silhouette candidate is 1 exactly once over the chunks, in the first chunk that meets it.
+    let mesh = uv_sphere(32, 20);
+    let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+    let lines = classify_edges(&topology, None, &LineOptions { crease_angle_deg: 10.0, ..Default::default() }).unwrap();
+    assert!(lines.counts.hard() > 0 && lines.counts.silhouette_candidate > 0);
+    let whole = encode_edge_visibility(&mesh.triangles, &topology, &lines).unwrap();
+    let n = mesh.triangles.len();
+    let chunks = [&mesh.triangles[..n / 3], &mesh.triangles[n / 3..2 * n / 3], &mesh.triangles[2 * n / 3..]];
+    let mut encoded = SilhouettesEncoded::default();
+    let mut silhouettes = Vec::new();
+    let (mut hard_repeats, mut candidate_meets) = (0, 0);
+    for chunk in chunks {
+        let e = encode_edge_visibility_continuing(chunk, &topology, &lines, &mut encoded).unwrap();
+        let decoded =
+            decode_edge_visibility(chunk, &topology.welded_of_vertex, &e.visibility, &e.decoded_normals()).unwrap();
+        // The edges of this chunk's own triangles, by class.
+        let mut edges: Vec<usize> = chunk
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| [t[k], t[(k + 1) % 3]]))
+            .map(|[a, b]| [topology.welded_of_vertex[a as usize], topology.welded_of_vertex[b as usize]])
+            .filter_map(|[a, b]| topology.edges.binary_search(&[a.min(b), a.max(b)]).ok())
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let hard: Vec<[u32; 2]> =
+            edges.iter().filter(|&&e| lines.classes[e].is_hard()).map(|&e| topology.edges[e]).collect();
+        assert_eq!(decoded.hard, hard, "exactly the hard edges of the chunk's triangles");
+        hard_repeats += hard.len();
+        candidate_meets += edges.iter().filter(|&&e| lines.classes[e] == EdgeClass::SilhouetteCandidate).count();
+        silhouettes.extend(decoded.silhouettes.iter().map(|s| s.0));
+        assert_eq!(e.silhouette_edges.len(), decoded.silhouettes.len());
+    }
+    // Seams exist for both kinds: hard edges are counted again per chunk, candidates are not.
+    assert!(hard_repeats > lines.counts.hard() && candidate_meets > lines.counts.silhouette_candidate);
+    silhouettes.sort_unstable();
+    let expected: Vec<[u32; 2]> = lines.candidates.iter().map(|&e| topology.edges[e as usize]).collect();
+    assert_eq!(silhouettes, expected, "every candidate exactly once over the chunks");
+    assert_eq!(whole.silhouette_edges.len(), expected.len());
+    // A fresh state per call is the one-primitive encoder.
+    let again =
+        encode_edge_visibility_continuing(&mesh.triangles, &topology, &lines, &mut SilhouettesEncoded::default())
+            .unwrap();
+    assert_eq!(again, whole);
+}
