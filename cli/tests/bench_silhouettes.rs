@@ -80,6 +80,28 @@ fn instanced_assembly_counts_match_the_world() {
     assert!(counts.iter().all(|&c| c > 0));
 }
 
+/// A baked file is measured as a reader loads it: its stored candidates and hierarchies (both
+/// orders derived at load), which answer as brute force over the same decoded data.
+#[test]
+fn a_baked_file_is_measured_with_its_stored_hierarchies() {
+    let dir = common::scratch("bench-silhouettes-stored");
+    let baked = dir.join("fandisk.glb");
+    common::bake(&common::shared_models().join("obj/common-3d-test-models/fandisk.obj"), &baked, &[]);
+    let file = baked.to_str().unwrap();
+    for mode in [&[][..], &["--perspective"][..]] {
+        let mut args = vec!["bench", "silhouettes", file, "--views", "300", "--json"];
+        args.extend_from_slice(mode);
+        let r = bench_json(&args);
+        assert_eq!(r["hierarchies"], "stored");
+        assert_eq!(r["mismatches"], 0);
+        let kind = if mode.is_empty() { "gauss_map" } else { "cone_bvh" };
+        assert_eq!(r["meshes"][0]["choice"]["kind"], kind, "{mode:?}");
+    }
+    let r = bench_json(&["bench", "silhouettes", file, "--views", "50", "--rebuild", "--json"]);
+    assert_eq!(r["hierarchies"], "built");
+    assert_eq!(r["mismatches"], 0);
+}
+
 #[test]
 fn perspective_agrees_with_brute_force() {
     let path = common::shared_models().join("obj/v-hacd/crank.off");

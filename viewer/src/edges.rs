@@ -248,9 +248,11 @@ impl ModelLines {
     }
 }
 
-/// The index of one mesh's stored candidates and hierarchies; `None` (with a notice) when the
-/// candidates do not match the mesh.
-fn load_silhouettes(
+/// The index of one mesh's stored candidates and hierarchies, as every reader of the file loads it
+/// (`position(t, k)`: the position of corner k of mesh triangle t); `None` (with a notice) when the
+/// candidates do not match the mesh. A stored hierarchy that does not validate is dropped, with a
+/// notice, and brute force answers its views.
+pub fn load_silhouettes(
     m: usize,
     s: &MeshSilhouettes,
     position: &dyn Fn(usize, usize) -> Option<Vec3>,

@@ -39,7 +39,7 @@ pub enum What {
     /// Frame time of the same triangles (1000 synthetic spheres) in 10 and in 1000 parts, as parts of
     /// one mesh (per-triangle labels) and as separate meshes.
     Parts(PartsArgs),
-    /// Silhouettes per view: brute force against the stored hierarchies, speedup, counts and
+    /// Silhouettes per view: brute force against the hierarchies (a baked file's stored ones, as loaded; else built), speedup, counts and
     /// mismatches (`--views N|icosa`, `--perspective`).
     Silhouettes(super::bench_silhouettes::Args),
 }

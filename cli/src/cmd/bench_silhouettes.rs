@@ -1,7 +1,10 @@
 //! `drafter bench silhouettes FILE [--views N|icosa] [--perspective] [--json]`: brute force
 //! against the silhouette hierarchies, per view, in the same process.
 //!
-//! Every unique mesh of the scene gets what the bake would store for it: its welded topology
+//! A baked file is measured as a reader loads it: each mesh's stored candidates (the Khronos edges
+//! encoded 1, with their decoded normals) and stored hierarchies, through the viewer's loader
+//! (`drafter_viewer::edges::load_silhouettes`); `build_ms` is then the load time. `--rebuild`, or
+//! any other file, gives every unique mesh what the bake would store for it: its welded topology
 //! (default weld), its edge classes at the default crease angle (part borders are not separated
 //! here: the bench measures the mesh's own edges) and the [`SilhouetteIndex`] with default
 //! options, which keeps a hierarchy only where its cost model predicts a gain. A view is given in
@@ -49,6 +52,9 @@ pub struct Args {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Build the hierarchies from the geometry even when the file stores them.
+    #[arg(long)]
+    pub rebuild: bool,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -89,6 +95,8 @@ pub struct Report {
     pub mismatches: usize,
     /// Silhouette edges per view (every instance), in view order.
     pub counts: Vec<usize>,
+    /// `stored` (the file's candidates and hierarchies, as loaded) or `built` (from the geometry).
+    pub hierarchies: &'static str,
     pub meshes: Vec<MeshRow>,
 }
 
@@ -107,6 +115,7 @@ pub struct MeshRow {
     pub candidates: usize,
     /// What answers this mode's queries, and why.
     pub choice: HierarchyChoice,
+    /// Build time, or load time for stored hierarchies.
     pub build_ms: f64,
 }
 
@@ -126,12 +135,14 @@ pub fn run(args: Args) -> Result<()> {
     if args.perspective && matches!(args.views, Views::Icosa) {
         bail!(BadInput("--views icosa gives orthographic directions; leave out --perspective".into()));
     }
-    let prepared = prepare(&scene);
+    let stored = if args.rebuild { None } else { stored(&scene, &bytes) };
+    let hierarchies = if stored.is_some() { "stored" } else { "built" };
+    let prepared = stored.unwrap_or_else(|| prepare(&scene));
     if prepared.iter().all(|p| p.index.is_empty()) {
         bail!(BadInput(format!("{}: no silhouette candidates (no closed, curved surface to outline)", path.display())));
     }
     let views = make_views(&scene, &args);
-    let report = measure(&args, &prepared, &views);
+    let report = measure(&args, &prepared, &views, hierarchies);
     let text = if args.json { serde_json::to_string_pretty(&report)? + "\n" } else { table(&report) };
     // A reader that stops early (`| head`) is not an error.
     match std::io::stdout().lock().write_all(text.as_bytes()) {
@@ -140,8 +151,8 @@ pub fn run(args: Args) -> Result<()> {
     }
 }
 
-/// Topology, edge classes and index of every mesh an instance uses, in parallel.
-fn prepare(scene: &Scene) -> Vec<Prepared> {
+/// `object_from_world` of every mesh's instances (those with an invertible transform).
+fn mesh_instances(scene: &Scene) -> Vec<Vec<DMat4>> {
     let mut instances: Vec<Vec<DMat4>> = vec![Vec::new(); scene.meshes.len()];
     for inst in &scene.instances {
         let m = inst.world_from_object;
@@ -149,6 +160,50 @@ fn prepare(scene: &Scene) -> Vec<Prepared> {
             instances[inst.mesh.index()].push(m.inverse());
         }
     }
+    instances
+}
+
+/// The stored candidates and hierarchies of a baked file, as the viewer loads them; `None` when
+/// the file stores none (not baked, or baked without lines). A stored hierarchy that does not
+/// validate is reported on stderr and answered by brute force, as in the viewer.
+fn stored(scene: &Scene, bytes: &[u8]) -> Option<Vec<Prepared>> {
+    let baked = drafter_format::read(bytes, &|_| None).ok()?;
+    if baked.mesh_silhouettes.is_empty() {
+        return None;
+    }
+    let instances = mesh_instances(scene);
+    let mut notices = Vec::new();
+    let mut prepared = Vec::new();
+    for (m, s) in &baked.mesh_silhouettes {
+        let m = *m as usize;
+        let (Some(mesh), Some(inst)) = (scene.meshes.get(m), instances.get(m)) else { continue };
+        if inst.is_empty() {
+            continue;
+        }
+        let position = |t: usize, k: usize| -> Option<Vec3> {
+            let tri = mesh.triangles.get(t)?;
+            mesh.positions.get(tri[k % 3] as usize).copied()
+        };
+        let start = std::time::Instant::now();
+        let Some(lines) = drafter_viewer::edges::load_silhouettes(m, s, &position, &mut notices) else { continue };
+        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        prepared.push(Prepared {
+            mesh: m,
+            index: lines.index,
+            instances: inst.clone(),
+            edges: Topology::build(mesh, Weld::default()).edges.len(),
+            build_ms,
+        });
+    }
+    for n in notices {
+        eprintln!("note: {n}");
+    }
+    (!prepared.is_empty()).then_some(prepared)
+}
+
+/// Topology, edge classes and index of every mesh an instance uses, in parallel.
+fn prepare(scene: &Scene) -> Vec<Prepared> {
+    let instances = mesh_instances(scene);
     scene
         .meshes
         .par_iter()
@@ -212,7 +267,7 @@ fn local(view: View, object_from_world: &DMat4) -> View {
     }
 }
 
-fn measure(args: &Args, prepared: &[Prepared], views: &[View]) -> Report {
+fn measure(args: &Args, prepared: &[Prepared], views: &[View], hierarchies: &'static str) -> Report {
     // Every (mesh, instance) pair with its view per world view, computed once.
     let pairs: Vec<(usize, &DMat4)> =
         prepared.iter().enumerate().flat_map(|(k, p)| p.instances.iter().map(move |m| (k, m))).collect();
@@ -267,6 +322,7 @@ fn measure(args: &Args, prepared: &[Prepared], views: &[View]) -> Report {
         },
         mismatches,
         counts,
+        hierarchies,
         meshes: prepared
             .iter()
             .map(|p| MeshRow {
@@ -284,7 +340,7 @@ fn measure(args: &Args, prepared: &[Prepared], views: &[View]) -> Report {
 fn table(r: &Report) -> String {
     let mut out = String::new();
     let mean = r.counts.iter().sum::<usize>() as f64 / r.counts.len().max(1) as f64;
-    let _ = writeln!(out, "{} — {} views, {}", r.file, r.views, r.mode);
+    let _ = writeln!(out, "{} — {} views, {}, {} hierarchies", r.file, r.views, r.mode, r.hierarchies);
     let _ = writeln!(
         out,
         "  {} edges, {} candidates; mean {:.1} silhouettes per view; {} mismatching views",
@@ -306,8 +362,13 @@ fn table(r: &Report) -> String {
     for m in &r.meshes {
         let _ = writeln!(
             out,
-            "  mesh {:>4}: {:>3} instance(s), {:>9} candidates, built in {:.0} ms, {:?}",
-            m.mesh, m.instances, m.candidates, m.build_ms, m.choice
+            "  mesh {:>4}: {:>3} instance(s), {:>9} candidates, {} in {:.0} ms, {:?}",
+            m.mesh,
+            m.instances,
+            m.candidates,
+            if r.hierarchies == "stored" { "loaded" } else { "built" },
+            m.build_ms,
+            m.choice
         );
     }
     out

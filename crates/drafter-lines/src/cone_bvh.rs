@@ -87,7 +87,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
 use crate::gauss::{BaseSolid, QueryCounts, arc_paths, base_cells};
-use crate::tree::{breadth_first, check_breadth_first, for_each_in_subtrees, push_children, widest_level, with_levels};
+use crate::tree::{breadth_first, check_breadth_first, push_children, widest_level, with_levels};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cone's half-angle.
@@ -755,7 +755,7 @@ impl ConeBvh {
         )?;
         drop(unit);
         let (flat, order) = query_layout(&stored, &tree.order)?;
-        let parent = check_breadth_first(&flat, normals.len())?;
+        check_breadth_first(&flat, normals.len())?;
         let mut axes = Vec::with_capacity(count);
         for (i, c) in cones.iter().enumerate() {
             if c.iter().any(|x| !x.is_finite()) {
@@ -767,27 +767,33 @@ impl ConeBvh {
             }
             axes.push(axis.normalize_or_zero());
         }
-        for_each_in_subtrees(&flat, &parent, &order, |node, k| {
-            let b = boxes[node];
-            let p = points[k as usize];
-            let inside = b[0] <= p.x && p.x <= b[3] && b[1] <= p.y && p.y <= b[4] && b[2] <= p.z && p.z <= b[5];
-            let s = f64::from(cones[node][3]);
-            let in_cone = s >= 1.0
-                || normals[k as usize].iter().all(|nrm| {
+        // Every stored node's candidates are a range of the replayed preorder: each node checks its
+        // range against its box and cone and gathers its plane offsets (not stored: they follow
+        // from the boxes and the candidates), all nodes in parallel over contiguous memory.
+        let (pre_points, pre_unit): (Vec<Vec3>, Vec<[DVec3; 2]>) =
+            tree.order.par_iter().map(|&k| (points[k as usize], unit_pair(normals[k as usize]))).unzip();
+        let planes: Vec<PlaneBound> = stored
+            .par_iter()
+            .enumerate()
+            .map(|(node, &[_, _, start, end])| {
+                let r = start as usize..end as usize;
+                let (b, s, a) = (boxes[node], f64::from(cones[node][3]), axes[node]);
+                let mut acc = PlaneAcc::new(&b);
+                for (i, (&p, &unit)) in pre_points[r.clone()].iter().zip(&pre_unit[r.clone()]).enumerate() {
+                    let inside = b[0] <= p.x && p.x <= b[3] && b[1] <= p.y && p.y <= b[4] && b[2] <= p.z && p.z <= b[5];
                     // Angle below π/2 iff axis·n > 0, and then its sine is |axis × n| (unit vectors).
-                    let nrm = nrm.as_dvec3().normalize_or_zero();
-                    let a = axes[node];
-                    nrm != DVec3::ZERO && a.dot(nrm) > 0.0 && a.cross(nrm).length() + CONE_MARGIN * 0.5 <= s
-                });
-            if inside && in_cone { Ok(()) } else { Err(ArraysError::NotConservative { node, candidate: k }) }
-        })?;
-        // The plane offsets are not stored: they follow from the boxes and the candidates.
-        let mut acc: Vec<PlaneAcc> = boxes.iter().map(PlaneAcc::new).collect();
-        for_each_in_subtrees(&flat, &parent, &order, |node, k| {
-            acc[node].add(unit_pair(normals[k as usize]), points[k as usize]);
-            Ok(())
-        })?;
-        let planes: Vec<PlaneBound> = acc.iter().zip(&cones).map(|(a, c)| a.finish(c)).collect();
+                    let in_cone = s >= 1.0
+                        || unit.iter().all(|&n| {
+                            n != DVec3::ZERO && a.dot(n) > 0.0 && a.cross(n).length() + CONE_MARGIN * 0.5 <= s
+                        });
+                    if !(inside && in_cone) {
+                        return Err(ArraysError::NotConservative { node, candidate: tree.order[r.start + i] });
+                    }
+                    acc.add(unit, p);
+                }
+                Ok(acc.finish(&cones[node]))
+            })
+            .collect::<Result<_, _>>()?;
         let a = assemble(&flat, &boxes, &cones, &planes, &order, normals, points);
         Ok(ConeBvh {
             nodes: a.nodes,

@@ -60,10 +60,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::brute::{OrthoBlocks, unit_direction};
-use crate::tree::{
-    breadth_first, check_breadth_first, depths, for_each_in_subtrees, push_children, widest_level, with_levels,
-    with_ranges,
-};
+use crate::tree::{breadth_first, check_breadth_first, depths, push_children, widest_level, with_levels, with_ranges};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cap radius (see the module docs).
@@ -1028,7 +1025,7 @@ impl GaussMapHierarchy {
         }
         let flat: Vec<[u32; 4]> = arrays.nodes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let caps: Vec<[f32; 4]> = arrays.node_caps.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-        let parent = check_breadth_first(&flat, normals.len())?;
+        check_breadth_first(&flat, normals.len())?;
         let mut centers = Vec::with_capacity(count);
         for (i, cap) in caps.iter().enumerate() {
             if cap.iter().any(|x| !x.is_finite()) {
@@ -1040,25 +1037,28 @@ impl GaussMapHierarchy {
             }
             centers.push(c.normalize_or_zero());
         }
-        let order = derived_order(&flat, normals, base, bins, max_depth)?;
-        let geo = arc_records(normals);
-        for_each_in_subtrees(&flat, &parent, &order, |node, a| {
+        let (order, arcs, ranges) = derived_order(&flat, normals, base, bins, max_depth)?;
+        // Every stored node's arcs (its whole subtree) are a range of the builder's preorder: each
+        // node checks its range against its cap, all nodes in parallel over contiguous memory.
+        ranges.par_iter().enumerate().try_for_each(|(node, &(lo, hi))| {
             let threshold = f64::from(caps[node][3]);
             if threshold >= 1.0 {
                 return Ok(());
             }
             let c = centers[node];
-            let g = &geo[a as usize];
-            // For unit vectors the angle r is below π/2 iff c·p > 0, and then sin r = |c × p| (no
-            // atan2 per point and ancestor: this check is most of a large file's load time). A
-            // zero normal (degenerate face) is inside every cap, as the builder counts it.
-            for p in [g.n1, g.n2].into_iter().filter(|p| *p != DVec3::ZERO) {
-                if c.dot(p) <= 0.0 || c.cross(p).length() + CULL_MARGIN * 0.5 > threshold {
-                    return Err(ArraysError::NotConservative { node, candidate: a });
+            for g in &arcs[lo..hi] {
+                // For unit vectors the angle r is below π/2 iff c·p > 0, and then sin r = |c × p|
+                // (no atan2 per point and ancestor). A zero normal (degenerate face) is inside
+                // every cap, as the builder counts it.
+                for p in [g.n1, g.n2].into_iter().filter(|p| *p != DVec3::ZERO) {
+                    if c.dot(p) <= 0.0 || c.cross(p).length() + CULL_MARGIN * 0.5 > threshold {
+                        return Err(ArraysError::NotConservative { node, candidate: g.id });
+                    }
                 }
             }
             Ok(())
         })?;
+        drop(arcs);
         let a = assemble(&flat, &caps, &order, normals);
         Ok(GaussMapHierarchy {
             base,
@@ -1093,17 +1093,19 @@ fn assign(normals: &[[Vec3; 2]], base: BaseSolid, bins: Bins, max_depth: u8) -> 
 /// The storage order of a stored tree `flat` (breadth-first, pruned) over `normals`: the arcs are
 /// assigned again ([`assign`]), the stored tree is matched against the builder's from the root
 /// (a stored node without children over a built node with children is a collapsed subtree), and
-/// the breadth-first layout of the match must reproduce `flat` exactly.
+/// the breadth-first layout of the match must reproduce `flat` exactly. Also returns the arcs in
+/// the builder's preorder and each stored node's range of them (its whole subtree).
+type Derived = (Vec<u32>, Vec<Arc>, Vec<(usize, usize)>);
+
 fn derived_order(
     flat: &[[u32; 4]],
     normals: &[[Vec3; 2]],
     base: BaseSolid,
     bins: Bins,
     max_depth: u8,
-) -> Result<Vec<u32>, ArraysError> {
+) -> Result<Derived, ArraysError> {
     let (nodes, arcs) = assign(normals, base, bins, max_depth);
     let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
-    drop(arcs);
     let mut collapse = vec![false; nodes.len()];
     let mut queue = vec![0usize];
     let mut j = 0;
@@ -1121,7 +1123,7 @@ fn derived_order(
         j += 1;
     }
     let no_children: &[u32] = &[];
-    let (derived, bfs_order, _) = breadth_first(
+    let (derived, bfs_order, source) = breadth_first(
         0,
         |i| if collapse[i] { no_children } else { &nodes[i].children },
         |i| {
@@ -1135,7 +1137,8 @@ fn derived_order(
     if derived.len() != flat.len() {
         return Err(ArraysError::Tree { node: derived.len().min(flat.len()) });
     }
-    Ok(bfs_order)
+    let ranges = source.iter().map(|&i| (nodes[i].own.0 as usize, nodes[i].sub_end as usize)).collect();
+    Ok((bfs_order, arcs, ranges))
 }
 
 fn is_identity(order: &[u32]) -> bool {

@@ -166,26 +166,6 @@ pub(crate) fn depths(nodes: &[[u32; 4]]) -> Vec<u32> {
     depth
 }
 
-/// For every node, the candidates of its whole subtree (itself and all descendants), for checking
-/// that a bound holds everything below it: each candidate is listed under each of its ancestors.
-pub(crate) fn for_each_in_subtrees(
-    nodes: &[[u32; 4]],
-    parent: &[u32],
-    order: &[u32],
-    mut visit: impl FnMut(usize, u32) -> Result<(), ArraysError>,
-) -> Result<(), ArraysError> {
-    for (j, &[_, _, start, end]) in nodes.iter().enumerate() {
-        for &c in &order[start as usize..end as usize] {
-            let mut k = j as u32;
-            while k != u32::MAX {
-                visit(k as usize, c)?;
-                k = parent[k as usize];
-            }
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,12 +188,5 @@ mod tests {
         let mut bad = nodes.clone();
         bad[2][3] = 2;
         assert!(check_breadth_first(&bad, 6).is_err());
-        let mut seen = vec![];
-        for_each_in_subtrees(&nodes, &parent, &order, |node, c| {
-            seen.push((node, c));
-            Ok(())
-        })
-        .unwrap();
-        assert!(seen.contains(&(0, 4)) && seen.contains(&(1, 4)) && !seen.contains(&(2, 4)));
     }
 }
