@@ -140,20 +140,11 @@ mod tests {
             assert!(b <= a + 1e-9, "{n}: {b}° against {a}°");
             plain += a;
             direction += b;
-        }
-        assert!(direction < 0.9 * plain, "mean error {direction} against {plain}");
-        // Never longer or shorter than rounding makes a vector.
-        for _ in 0..20000 {
-            let mut r = || {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-            };
-            let Some(n) = Vec3::new(r(), r(), r()).try_normalize() else { continue };
+            // Never longer or shorter than rounding makes a vector.
             let length = snorm8_decode(snorm8_encode_direction(n)).length();
             assert!((length - 1.0).abs() < 0.0069, "{n}: decoded length {length}");
         }
+        assert!(direction < 0.9 * plain, "mean error {direction} against {plain}");
         assert_eq!(snorm8_encode_direction(Vec3::Z), [0, 0, 127]);
         assert_eq!(snorm8_encode_direction(Vec3::ZERO), [0, 0, 0]);
     }

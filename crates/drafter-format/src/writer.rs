@@ -494,8 +494,20 @@ fn write_vertex_data(
     // Normalized bytes (stride 4): a quarter of FLOAT, within 0.4° (what gltfpack gives NORMAL).
     let enhanced: Vec<[i8; 3]> = enhanced.iter().map(|&n| drafter_core::snorm8_encode(n.into())).collect();
     attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_attribute(&enhanced).into());
-    let indices = doc.push_scalars(&triangles, Some(ELEMENT_ARRAY_BUFFER));
-    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
+    set_triangle_list(doc, m, primitive, attributes, &triangles).map_err(|e| e.to_string())
+}
+
+/// Gives a primitive new attributes and a triangle list (indices in the smallest type that fits;
+/// any `mode` removed: the default is triangles).
+fn set_triangle_list(
+    doc: &mut Doc,
+    m: usize,
+    primitive: usize,
+    attributes: Map<String, Value>,
+    triangles: &[u32],
+) -> Result<(), FormatError> {
+    let indices = doc.push_scalars(triangles, Some(ELEMENT_ARRAY_BUFFER));
+    let prim = primitive_mut(doc, m, primitive)?;
     prim["attributes"] = Value::Object(attributes);
     prim["indices"] = indices.into();
     if let Value::Object(map) = prim {
@@ -595,14 +607,7 @@ fn gather_source_vertices(
         let gathered = doc.gather_attribute(accessor, &picks).map_err(|e| e.to_string())?;
         attributes.insert(name.clone(), gathered.into());
     }
-    let indices = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
-    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
-    prim["attributes"] = Value::Object(attributes);
-    prim["indices"] = indices.into();
-    if let Value::Object(map) = prim {
-        map.remove("mode");
-    }
-    Ok(())
+    set_triangle_list(doc, m, primitive, attributes, &local).map_err(|e| e.to_string())
 }
 
 /// The glTF primitive each of `mesh`'s groups is written to. A group is its source primitive (glTF
