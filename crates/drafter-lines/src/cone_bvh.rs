@@ -86,7 +86,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
-use crate::gauss::{BaseSolid, QueryCounts, arc_paths, base_cells};
+use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
 use crate::tree::{breadth_first, check_breadth_first, push_children, widest_level, with_levels};
 use crate::{ArraysError, CostModel, EdgeSet};
 
@@ -469,6 +469,18 @@ const PARALLEL_CANDIDATES: usize = 32 * 1024;
 impl ConeBvh {
     /// Builds the hierarchy over candidates with `normals` and points `points` (one each).
     pub fn build(normals: &[[Vec3; 2]], points: &[Vec3], options: &ConeBvhOptions, cost: &CostModel) -> Self {
+        Self::build_with_cells(normals, points, options, cost, None)
+    }
+
+    /// [`ConeBvh::build`] over candidates in a Gauss map's storage order, whose arc cells the
+    /// normal split reads (`cells`) instead of assigning the arcs again.
+    pub(crate) fn build_with_cells(
+        normals: &[[Vec3; 2]],
+        points: &[Vec3],
+        options: &ConeBvhOptions,
+        cost: &CostModel,
+        cells: Option<&ArcCells>,
+    ) -> Self {
         let n = normals.len().min(points.len());
         let (normals, points) = (&normals[..n], &points[..n]);
         let leaf_size = options.leaf_size.clamp(1, 4096);
@@ -478,7 +490,7 @@ impl ConeBvh {
             NormalSplit::Level(l) => Some(l.min(6)),
             NormalSplit::Auto => Some(normal_level_for_count(n)),
         };
-        let (tree, split_starts) = match build_tree(points, &unit, leaf_size, normal_level, None) {
+        let (tree, split_starts) = match build_tree(points, &unit, leaf_size, normal_level, None, cells) {
             Ok(built) => built,
             Err(_) => unreachable!("a build without a replay script does not fail"),
         };
@@ -712,6 +724,17 @@ impl ConeBvh {
     /// nodes must tile that order, and every box and cone must really bound the candidates below
     /// it, so a corrupted file cannot make a query drop a silhouette.
     pub fn from_arrays(arrays: &ConeBvhArrays, normals: &[[Vec3; 2]], points: &[Vec3]) -> Result<Self, ArraysError> {
+        Self::from_arrays_with_cells(arrays, normals, points, None)
+    }
+
+    /// [`ConeBvh::from_arrays`] over candidates in a Gauss map's storage order, whose arc cells
+    /// the normal split reads (`cells`) instead of assigning the arcs again.
+    pub(crate) fn from_arrays_with_cells(
+        arrays: &ConeBvhArrays,
+        normals: &[[Vec3; 2]],
+        points: &[Vec3],
+        cells: Option<&ArcCells>,
+    ) -> Result<Self, ArraysError> {
         if points.len() != normals.len() {
             return Err(ArraysError::Length { array: "points", expected: normals.len(), found: points.len() });
         }
@@ -752,6 +775,7 @@ impl ConeBvh {
             arrays.leaf_size,
             Some(normal_level),
             Some((&arrays.splits, &arrays.split_starts)),
+            cells,
         )?;
         drop(unit);
         let (flat, order) = query_layout(&stored, &tree.order)?;
@@ -931,6 +955,7 @@ fn build_tree(
     leaf_size: u32,
     normal_level: Option<u8>,
     replay: Option<(&[u8], &[u32])>,
+    cells: Option<&ArcCells>,
 ) -> Result<(Tree, Vec<u32>), ArraysError> {
     let mut tree = Tree::default();
     let ids: Vec<u32> = (0..points.len() as u32).collect();
@@ -941,26 +966,36 @@ fn build_tree(
         spatial(&mut tree, &ids, points, leaf_size);
         return Ok((tree, Vec::new()));
     };
-    let base = base_cells(BaseSolid::Icosahedron);
-    let paths = arc_paths(unit, &base, level, f64::from(crate::gauss::DEFAULT_OVERLAP));
-    let dual = dual_points(points, unit);
+    let factor = f64::from(crate::gauss::DEFAULT_OVERLAP);
+    let paths = match cells.and_then(|c| c.paths(unit, level, factor)) {
+        Some(paths) => paths,
+        None => arc_paths(unit, &base_cells(BaseSolid::Icosahedron), level, factor),
+    };
     let split = NormalSplitter { paths: &paths, level };
     // Three passes: the normal split lists its dual-space trees, they are built (or replayed) on
     // the thread pool, and the normal split runs again, splicing them in where it asks for them.
     let mut jobs: Vec<Vec<u32>> = Vec::new();
     split.node(&mut Tree::default(), ids.clone(), 0, leaf_size, &mut |_, ids| jobs.push(ids));
-    let records =
-        |ids: &[u32]| -> Vec<DualRecord> { ids.iter().map(|&id| DualRecord { b: dual[id as usize], id }).collect() };
     let built: Vec<Tree> = match replay {
-        None => jobs
-            .par_iter()
-            .map(|ids| {
-                let mut sub = Tree::default();
-                dual_node(&mut sub, &mut records(ids), leaf_size, 0);
-                sub
-            })
-            .collect(),
+        None => {
+            let dual = dual_points(points, unit);
+            let records = |ids: &[u32]| -> Vec<DualRecord> {
+                ids.iter().map(|&id| DualRecord { b: dual[id as usize], id }).collect()
+            };
+            jobs.par_iter()
+                .map(|ids| {
+                    let mut sub = Tree::default();
+                    dual_node(&mut sub, &mut records(ids), leaf_size, 0);
+                    sub
+                })
+                .collect()
+        }
         Some((splits, starts)) => {
+            // The replay needs only the boxes' centres: records of 20 bytes instead of 36.
+            let centres = dual_centres(points, unit);
+            let records = |ids: &[u32]| -> Vec<CentreRecord> {
+                ids.iter().map(|&id| CentreRecord { c: centres[id as usize], id }).collect()
+            };
             if starts.len() != jobs.len() {
                 return Err(ArraysError::Length { array: "split_starts", expected: jobs.len(), found: starts.len() });
             }
@@ -973,7 +1008,9 @@ fn build_tree(
                     let script = splits.get(from..to).ok_or_else(|| bad(j))?;
                     let mut sub = Tree::default();
                     let mut at = 0;
-                    replay_dual_node(&mut sub, &mut records(ids), leaf_size, script, &mut at)?;
+                    let mut records = records(ids);
+                    let bounds = centre_bounds(&records);
+                    replay_dual_node(&mut sub, &mut records, bounds, leaf_size, script, &mut at)?;
                     if at != script.len() { Err(bad(j)) } else { Ok(sub) }
                 })
                 .collect::<Result<_, _>>()?
@@ -1052,24 +1089,39 @@ impl NormalSplitter<'_> {
 /// points `(k·n̂, n̂·(v − c))` (see the module docs).
 type DualBox = [[f32; 4]; 2];
 
-/// Every candidate's [`DualBox`].
-fn dual_points(points: &[Vec3], unit: &[[DVec3; 2]]) -> Vec<DualBox> {
+/// The frame of the dual space over `points`: the centre `c` of their bounding box and the normal
+/// weight `k` (see the module docs).
+fn dual_frame(points: &[Vec3]) -> (Vec3, f32) {
     let b = bounding_box(points.iter().copied());
     let (lo, hi) = (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5]));
-    let c = anchor(&b);
-    let k = DUAL_NORMAL_WEIGHT * ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE);
-    unit.par_iter()
-        .zip(points)
-        .map(|(&[n1, n2], &v)| {
-            let d = v - c;
-            let plane = |n: DVec3| {
-                let n = n.as_vec3();
-                [k * n.x, k * n.y, k * n.z, n.dot(d)]
-            };
-            let (a, b) = (plane(n1), plane(n2));
-            [std::array::from_fn(|i| a[i].min(b[i])), std::array::from_fn(|i| a[i].max(b[i]))]
-        })
-        .collect()
+    (anchor(&b), DUAL_NORMAL_WEIGHT * ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE))
+}
+
+/// A candidate's [`DualBox`] in the frame `(c, k)` of [`dual_frame`].
+fn dual_box((c, k): (Vec3, f32), [n1, n2]: [DVec3; 2], v: Vec3) -> DualBox {
+    let d = v - c;
+    let plane = |n: DVec3| {
+        let n = n.as_vec3();
+        [k * n.x, k * n.y, k * n.z, n.dot(d)]
+    };
+    let (a, b) = (plane(n1), plane(n2));
+    [std::array::from_fn(|i| a[i].min(b[i])), std::array::from_fn(|i| a[i].max(b[i]))]
+}
+
+/// Every candidate's [`DualBox`].
+fn dual_points(points: &[Vec3], unit: &[[DVec3; 2]]) -> Vec<DualBox> {
+    let frame = dual_frame(points);
+    unit.par_iter().zip(points).map(|(&n, &v)| dual_box(frame, n, v)).collect()
+}
+
+/// Every candidate's [`DualBox`] centre, as [`DualRecord::centre`] computes it.
+fn dual_centres(points: &[Vec3], unit: &[[DVec3; 2]]) -> Vec<[f32; 4]> {
+    let frame = dual_frame(points);
+    unit.par_iter().zip(points).map(|(&n, &v)| box_centre(&dual_box(frame, n, v))).collect()
+}
+
+fn box_centre(b: &DualBox) -> [f32; 4] {
+    std::array::from_fn(|a| (b[0][a] + b[1][a]) * 0.5)
 }
 
 /// Mean-width measure of a 4D box: the sum of its extents.
@@ -1095,9 +1147,35 @@ struct DualRecord {
     id: u32,
 }
 
-impl DualRecord {
+/// What [`apply_split`] needs of a record: its dual-space box centre and its candidate.
+trait Centred {
+    fn centre(&self) -> [f32; 4];
+    fn id(&self) -> u32;
+}
+
+impl Centred for DualRecord {
     fn centre(&self) -> [f32; 4] {
-        std::array::from_fn(|a| (self.b[0][a] + self.b[1][a]) * 0.5)
+        box_centre(&self.b)
+    }
+    fn id(&self) -> u32 {
+        self.id
+    }
+}
+
+/// A candidate as the replay moves it: the centre of its [`DualBox`] and its index (the replay
+/// never needs the box itself).
+#[derive(Clone, Copy)]
+struct CentreRecord {
+    c: [f32; 4],
+    id: u32,
+}
+
+impl Centred for CentreRecord {
+    fn centre(&self) -> [f32; 4] {
+        self.c
+    }
+    fn id(&self) -> u32 {
+        self.id
     }
 }
 
@@ -1180,7 +1258,7 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
         None => MEDIAN_SPLIT,
     };
     tree.splits.push(split);
-    let mid = apply_split(records, &bounds, split);
+    let (mid, _) = apply_split(records, &bounds, split);
     let parallel = records.len() > PARALLEL_CANDIDATES;
     let (left, right) = records.split_at_mut(mid);
     if parallel {
@@ -1203,7 +1281,7 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
 }
 
 /// The box of the records' centres.
-fn centre_bounds(records: &[DualRecord]) -> DualBox {
+fn centre_bounds(records: &[impl Centred]) -> DualBox {
     let mut bounds = EMPTY_BOX;
     for r in records {
         let c = r.centre();
@@ -1220,37 +1298,63 @@ fn bin_of(bounds: &DualBox, c: f32, a: usize) -> usize {
 }
 
 /// Reorders `records` (centre box `bounds`) by the split byte `split` (see
-/// [`ConeBvhArrays::splits`]) and returns the size of the left side: the records in bins below
-/// `bin` on `axis`, or for [`MEDIAN_SPLIT`] the lower half by centre on the widest axis (ties by
-/// candidate). The one definition both the build and the replay use.
-fn apply_split(records: &mut [DualRecord], bounds: &DualBox, split: u8) -> usize {
+/// [`ConeBvhArrays::splits`]) and returns the size of the left side and the centre boxes of both
+/// sides: the records in bins below `bin` on `axis`, or for [`MEDIAN_SPLIT`] the lower half by
+/// centre on the widest axis (ties by candidate). The one definition both the build and the
+/// replay use; the order it leaves depends only on the records' centres and candidates, not on
+/// the record type.
+fn apply_split(records: &mut [impl Centred], bounds: &DualBox, split: u8) -> (usize, [DualBox; 2]) {
+    let mut sides = [EMPTY_BOX; 2];
     if split != MEDIAN_SPLIT {
         let (a, bin) = (usize::from(split >> 5), usize::from(split & 31));
         let mut left = 0;
         for j in 0..records.len() {
-            if bin_of(bounds, records[j].centre()[a], a) < bin {
+            let c = records[j].centre();
+            if bin_of(bounds, c[a], a) < bin {
+                grow(&mut sides[0], &[c, c]);
                 records.swap(left, j);
                 left += 1;
+            } else {
+                grow(&mut sides[1], &[c, c]);
             }
         }
-        return left;
+        return (left, sides);
     }
-    // Median of the widest axis of centres (all equal: any halves).
+    // Median of the widest axis of centres (all equal: any halves): the key of rank `mid` is
+    // found on a copy of the keys, then the records are partitioned against it in one pass.
     let a =
         (0..4).max_by(|&x, &y| (bounds[1][x] - bounds[0][x]).total_cmp(&(bounds[1][y] - bounds[0][y])).then(y.cmp(&x)));
     let mid = records.len() / 2;
-    if let Some(a) = a {
-        records.select_nth_unstable_by(mid, |x, y| x.centre()[a].total_cmp(&y.centre()[a]).then(x.id.cmp(&y.id)));
+    let key = |r: &dyn Centred| (r.centre()[a.unwrap_or(0)], r.id());
+    let before = |x: (f32, u32), y: (f32, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+    let mut keys: Vec<(f32, u32)> = records.iter().map(|r| key(r)).collect();
+    if keys.is_empty() {
+        return (0, sides);
     }
-    mid
+    let (_, &mut pivot, _) = keys.select_nth_unstable_by(mid, |&x, &y| before(x, y));
+    drop(keys);
+    let mut left = 0;
+    for j in 0..records.len() {
+        let c = records[j].centre();
+        if before(key(&records[j]), pivot).is_lt() {
+            grow(&mut sides[0], &[c, c]);
+            records.swap(left, j);
+            left += 1;
+        } else {
+            grow(&mut sides[1], &[c, c]);
+        }
+    }
+    (left, sides)
 }
 
 /// [`dual_node`] with the recorded split bytes `script` (read from `at`) instead of the
-/// heuristic's search: the same tree over the same records. Serial; a split byte that does not
-/// split (an empty side, an axis or bin out of range) or a script that ends early is refused.
+/// heuristic's search: the same tree over the same records, whose centre box is `bounds`. Serial;
+/// a split byte that does not split (an empty side, an axis or bin out of range) or a script that
+/// ends early is refused.
 fn replay_dual_node(
     tree: &mut Tree,
-    records: &mut [DualRecord],
+    records: &mut [CentreRecord],
+    bounds: DualBox,
     leaf_size: u32,
     script: &[u8],
     at: &mut usize,
@@ -1268,15 +1372,14 @@ fn replay_dual_node(
         return Err(bad);
     }
     tree.splits.push(split);
-    let bounds = centre_bounds(records);
-    let mid = apply_split(records, &bounds, split);
+    let (mid, sides) = apply_split(records, &bounds, split);
     if mid == 0 || mid == records.len() {
         return Err(bad);
     }
     let (left, right) = records.split_at_mut(mid);
-    for part in [left, right] {
+    for (part, b) in [(left, sides[0]), (right, sides[1])] {
         let child = tree.nodes.len() as u32;
-        replay_dual_node(tree, part, leaf_size, script, at)?;
+        replay_dual_node(tree, part, b, leaf_size, script, at)?;
         tree.children[node].push(child);
     }
     tree.close(node, false);
@@ -1535,14 +1638,15 @@ mod tests {
             .map(|&[a, b]| [a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero()])
             .collect();
         for (leaf, level) in [(1u32, Some(1u8)), (4, Some(3)), (16, Some(2))] {
-            let (tree, starts) = build_tree(&points, &unit, leaf, level, None).unwrap();
+            let (tree, starts) = build_tree(&points, &unit, leaf, level, None, None).unwrap();
             // Replaying the recorded splits gives the same tree, node for node.
-            let (again, starts_again) = build_tree(&points, &unit, leaf, level, Some((&tree.splits, &starts))).unwrap();
+            let (again, starts_again) =
+                build_tree(&points, &unit, leaf, level, Some((&tree.splits, &starts)), None).unwrap();
             assert_eq!((&again.nodes, &again.order, &again.splits), (&tree.nodes, &tree.order, &tree.splits));
             assert_eq!(starts_again, starts);
             // A script cut short, or with a split that empties a side, is refused.
             if let Some((_, short)) = tree.splits.split_last() {
-                assert!(build_tree(&points, &unit, leaf, level, Some((short, &starts))).is_err());
+                assert!(build_tree(&points, &unit, leaf, level, Some((short, &starts)), None).is_err());
             }
             let mut seen = tree.order.clone();
             seen.sort_unstable();
@@ -1569,7 +1673,7 @@ mod tests {
             points.push(Vec3::new(x, y, if i % 2 == 0 { 0.0 } else { 0.01 }));
         }
         let unit: Vec<[DVec3; 2]> = normals.iter().map(|&[a, b]| [a.as_dvec3(), b.as_dvec3()]).collect();
-        let (tree, _) = build_tree(&points, &unit, 8, Some(1), None).unwrap();
+        let (tree, _) = build_tree(&points, &unit, 8, Some(1), None, None).unwrap();
         for &[start, end, _, is_leaf] in &tree.nodes {
             if is_leaf == 1 {
                 let leaf = &tree.order[start as usize..end as usize];

@@ -431,13 +431,7 @@ pub(crate) fn arc_path(n1: DVec3, n2: DVec3, base: &[Cell], level: u8, factor: f
 /// each visited cell's children (and their bins) are built once for all the arcs that reach it,
 /// rather than once per arc and level. Equal to `arc_path` on every arc (tested).
 pub(crate) fn arc_paths(unit: &[[DVec3; 2]], base: &[Cell], level: u8, factor: f64) -> Vec<(u32, u8)> {
-    let mids: Vec<Option<DVec3>> = unit
-        .par_iter()
-        .map(|&[n1, n2]| {
-            let sum = n1 + n2;
-            (n1 != DVec3::ZERO && n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
-        })
-        .collect();
+    let mids: Vec<Option<DVec3>> = unit.par_iter().map(|&u| arc_mid(u)).collect();
     let bins: Vec<f64> = base.iter().map(|c| bin_cos(c, factor)).collect();
     let mut groups: Vec<Vec<u32>> = vec![Vec::new(); base.len()];
     for (i, mid) in mids.iter().enumerate() {
@@ -448,7 +442,7 @@ pub(crate) fn arc_paths(unit: &[[DVec3; 2]], base: &[Cell], level: u8, factor: f
             }
         }
     }
-    let descend = PathDescent { unit, mids: &mids, level, factor };
+    let descend = PathDescent { unit, level, factor };
     let found: Vec<Vec<(u32, (u32, u8))>> = groups
         .into_par_iter()
         .enumerate()
@@ -484,9 +478,24 @@ fn most_inside(cells: &[Cell], p: DVec3) -> usize {
         .0
 }
 
+/// The midpoint of the arc between unit normals `n1`, `n2`; `None` for a zero or antipodal arc.
+fn arc_mid([n1, n2]: [DVec3; 2]) -> Option<DVec3> {
+    let sum = n1 + n2;
+    (n1 != DVec3::ZERO && n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
+}
+
+/// The cell with digits `key` ([`BuildNode::key`]) `cells` cells down from `base`.
+fn cell_of(base: &[Cell], key: u32, cells: u8) -> Cell {
+    let digit = |i: u8| (key >> (2 * u32::from(i))) as usize;
+    let mut cell = base[digit(cells - 1)];
+    for i in (0..cells - 1).rev() {
+        cell = cell.children()[digit(i) & 3];
+    }
+    cell
+}
+
 struct PathDescent<'a> {
     unit: &'a [[DVec3; 2]],
-    mids: &'a [Option<DVec3>],
     level: u8,
     factor: f64,
 }
@@ -503,7 +512,7 @@ impl PathDescent<'_> {
         let bins = children.each_ref().map(|c| bin_cos(c, self.factor));
         let mut groups: [Vec<u32>; 4] = Default::default();
         for i in ids {
-            let Some(m) = self.mids[i as usize] else { continue };
+            let Some(m) = arc_mid(self.unit[i as usize]) else { continue };
             let k = most_inside(&children, m);
             if fits_bin(&children[k], bins[k], self.unit[i as usize]) {
                 groups[k].push(i);
@@ -534,8 +543,87 @@ struct Arc {
 impl Arc {
     /// The arc's midpoint; `None` for a zero or antipodal arc.
     fn mid(&self) -> Option<DVec3> {
-        let sum = self.n1 + self.n2;
-        (self.n1 != DVec3::ZERO && self.n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
+        arc_mid([self.n1, self.n2])
+    }
+}
+
+/// Where the bin rule left each arc as far as a Gauss map followed it, in the map's storage
+/// order. The cone BVH splits its candidates by the same rule (icosahedron, default overlap) to
+/// a shallower level, and reads the cells from here instead of assigning every arc again.
+#[derive(Debug)]
+pub(crate) struct ArcCells {
+    base: BaseSolid,
+    bins: Bins,
+    /// Per arc: its cell's digits ([`BuildNode::key`]), how many cells it went down (0: the
+    /// root), and whether the map stopped before offering it to that cell's children.
+    cells: Vec<(u32, u8, bool)>,
+}
+
+impl ArcCells {
+    /// Each arc's cell, by candidate, from the builder's `nodes` and preorder `arcs`.
+    fn by_candidate(nodes: &[BuildNode], arcs: &[Arc]) -> Vec<(u32, u8, bool)> {
+        let mut by_id = vec![(0u32, 0u8, false); arcs.len()];
+        for n in nodes {
+            for a in &arcs[n.own.0 as usize..n.own.1 as usize] {
+                by_id[a.id as usize] = (n.key, n.depth, !n.tried);
+            }
+        }
+        by_id
+    }
+
+    /// The cells `by_id` ([`ArcCells::by_candidate`]) in storage order `order`.
+    fn new(base: BaseSolid, bins: Bins, by_id: &[(u32, u8, bool)], order: &[u32]) -> Self {
+        ArcCells { base, bins, cells: order.par_iter().map(|&i| by_id[i as usize]).collect() }
+    }
+
+    /// The paths [`arc_paths`] gives for `unit` (the arcs in this order) at `level` and bin radius
+    /// `factor`: each arc's cell cut to `level`, and where the map stopped above `level` (a
+    /// collapsed subtree, its `max_depth`) the descent goes on from there. `None` where the map
+    /// used another rule.
+    pub(crate) fn paths(&self, unit: &[[DVec3; 2]], level: u8, factor: f64) -> Option<Vec<(u32, u8)>> {
+        let same_rule = self.base == BaseSolid::Icosahedron
+            && matches!(self.bins, Bins::Overlapping { factor: f } if f64::from(f) == factor);
+        if !same_rule || self.cells.len() != unit.len() || self.cells.iter().any(|&(_, c, open)| c == 0 && open) {
+            return None;
+        }
+        let full = level + 1;
+        let mut paths: Vec<(u32, u8)> = self
+            .cells
+            .par_iter()
+            .map(|&(key, cells, _)| match cells {
+                c if c >= full => (key >> (2 * u32::from(c - full)), full),
+                c => (key * 4u32.pow(u32::from(full - c)), c),
+            })
+            .collect();
+        // Runs of arcs that may go further (a node's arcs are contiguous in storage order).
+        let mut runs = Vec::new();
+        let mut i = 0;
+        while i < self.cells.len() {
+            let (key, cells, open) = self.cells[i];
+            let mut j = i + 1;
+            while j < self.cells.len() && self.cells[j] == (key, cells, open) {
+                j += 1;
+            }
+            if open && cells < full {
+                runs.push((i, j));
+            }
+            i = j;
+        }
+        let base = base_cells(BaseSolid::Icosahedron);
+        let descend = PathDescent { unit, level, factor };
+        let found: Vec<Vec<(u32, (u32, u8))>> = runs
+            .into_par_iter()
+            .map(|(lo, hi)| {
+                let (key, cells, _) = self.cells[lo];
+                let mut out = Vec::with_capacity(hi - lo);
+                descend.cell(cell_of(&base, key, cells), key, cells, (lo as u32..hi as u32).collect(), &mut out);
+                out
+            })
+            .collect();
+        for (i, path) in found.into_iter().flatten() {
+            paths[i as usize] = path;
+        }
+        Some(paths)
     }
 }
 
@@ -559,6 +647,11 @@ struct BuildNode {
     sub_end: u32,
     children: Vec<u32>,
     cell_center: Option<DVec3>,
+    /// The cell's digits: base face, then one digit per 4:1 split (unpadded; 0 for the root).
+    key: u32,
+    /// Whether the arcs were offered to the children (false at `max_depth` and at a stored leaf,
+    /// where the bin rule might have taken them further).
+    tried: bool,
 }
 
 /// Subtrees holding more arcs than this are built on the thread pool (one task per child cell)
@@ -580,6 +673,9 @@ struct Builder {
     base: Vec<Cell>,
 }
 
+/// A stored breadth-first tree and a node's index in it, which a reader's assignment follows.
+type Guide<'a> = Option<(&'a [[u32; 4]], usize)>;
+
 /// Where an arc goes at a node: it stays there.
 const STAY: u8 = u8::MAX;
 
@@ -600,18 +696,29 @@ impl Builder {
     }
 
     /// Appends to `out` the subtree, in preorder, for `cell` (`None`: the root) holding `arcs`,
-    /// which start at position `offset` of the final order. Reorders `arcs` into that order: the
-    /// node's own arcs, then each child's subtree (stable: input order within each). `scratch`
-    /// is as long as `arcs`.
+    /// which start at position `offset` of the final order, and leaves the arcs in that order: the
+    /// node's own arcs, then each child's subtree (stable: input order within each).
+    ///
+    /// The arcs move between two buffers, one scatter per level (ping-pong): `arcs` holds them on
+    /// entry and `spare` is free, as long as `arcs`. `flipped` says that `arcs` is the caller's
+    /// scratch buffer and `spare` its arc buffer, where the final order must end up.
+    ///
+    /// With `guide` (a stored breadth-first tree and this node's index in it) the descent follows
+    /// the stored tree instead of going to `max_depth`: a stored leaf keeps all its arcs (in input
+    /// order, as the build stores a collapsed subtree), and a stored inner node must split into
+    /// exactly its stored children. Returns false where the arcs do not split as stored.
+    #[allow(clippy::too_many_arguments)]
     fn node(
         &self,
         cell: Option<Cell>,
         depth: u8,
         arcs: &mut [Arc],
-        scratch: &mut [Arc],
+        spare: &mut [Arc],
+        flipped: bool,
         offset: u32,
         out: &mut Vec<BuildNode>,
-    ) {
+        (key, guide): (u32, Guide<'_>),
+    ) -> bool {
         let index = out.len();
         out.push(BuildNode {
             depth,
@@ -619,8 +726,12 @@ impl Builder {
             sub_end: offset + arcs.len() as u32,
             children: Vec::new(),
             cell_center: cell.map(|c| c.center),
+            key,
+            tried: false,
         });
+        let stored_children = guide.map(|(tree, at)| tree[at][1]);
         let children: Vec<BinCell> = match cell {
+            _ if stored_children == Some(0) => Vec::new(),
             None => self.base.iter().map(|&c| self.bin_cell(c)).collect(),
             // Depth 1 is level 0; a cell at level `depth - 1` splits while that is below max_depth.
             Some(c) if depth <= self.max_depth => c.children().iter().map(|&c| self.bin_cell(c)).collect(),
@@ -628,8 +739,12 @@ impl Builder {
         };
         if children.is_empty() {
             out[index].own.1 = offset + arcs.len() as u32;
-            return;
+            if flipped {
+                spare.copy_from_slice(arcs);
+            }
+            return stored_children.is_none_or(|c| c == 0);
         }
+        out[index].tried = true;
         // Where each arc goes, then a stable counting scatter: own arcs first, then by child.
         let target = |g: &Arc| {
             g.mid()
@@ -659,35 +774,53 @@ impl Builder {
         let mut next = starts.clone();
         for (g, &t) in arcs.iter().zip(&targets) {
             let b = bucket(t);
-            scratch[next[b]] = *g;
+            spare[next[b]] = *g;
             next[b] += 1;
         }
-        arcs.copy_from_slice(scratch);
+        drop(targets);
+        // The arcs are now in `spare`; the own ones stay there if that is the final buffer.
+        if !flipped {
+            arcs[..starts[1]].copy_from_slice(&spare[..starts[1]]);
+        }
         out[index].own.1 = offset + starts[1] as u32;
+        let filled = (0..children.len()).filter(|&k| starts[k + 2] > starts[k + 1]).count();
+        if stored_children.is_some_and(|c| c as usize != filled) {
+            return false;
+        }
 
-        // The children's ranges, split off the two buffers in order.
+        // The children's ranges, split off the two buffers in order; the roles swap below.
         let parallel = arcs.len() > PARALLEL_ARCS;
         let mut work = Vec::new();
-        let (mut rest, mut rest_scratch) = (&mut arcs[starts[1]..], &mut scratch[starts[1]..]);
+        let (mut rest, mut rest_spare) = (&mut spare[starts[1]..], &mut arcs[starts[1]..]);
         for k in 0..children.len() {
             let len = starts[k + 2] - starts[k + 1];
             let (these, tail) = rest.split_at_mut(len);
-            let (these_scratch, tail_scratch) = rest_scratch.split_at_mut(len);
-            (rest, rest_scratch) = (tail, tail_scratch);
+            let (these_spare, tail_spare) = rest_spare.split_at_mut(len);
+            (rest, rest_spare) = (tail, tail_spare);
             if len > 0 {
-                work.push((children[k].cell, these, these_scratch, offset + starts[k + 1] as u32));
+                let child_guide = guide.map(|(tree, at)| (tree, tree[at][0] as usize + work.len()));
+                let child_key = if cell.is_none() { k as u32 } else { key * 4 + k as u32 };
+                work.push((
+                    children[k].cell,
+                    these,
+                    these_spare,
+                    offset + starts[k + 1] as u32,
+                    (child_key, child_guide),
+                ));
             }
         }
         if parallel {
-            let subtrees: Vec<Vec<BuildNode>> = work
+            let subtrees: Vec<(Vec<BuildNode>, bool)> = work
                 .into_par_iter()
-                .map(|(cell, these, these_scratch, at)| {
+                .map(|(cell, these, these_spare, at, g)| {
                     let mut sub = Vec::new();
-                    self.node(Some(cell), depth + 1, these, these_scratch, at, &mut sub);
-                    sub
+                    let ok = self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, &mut sub, g);
+                    (sub, ok)
                 })
                 .collect();
-            for sub in subtrees {
+            let mut ok = true;
+            for (sub, fine) in subtrees {
+                ok &= fine;
                 let node_offset = out.len() as u32;
                 out[index].children.push(node_offset);
                 out.extend(sub.into_iter().map(|mut n| {
@@ -695,12 +828,16 @@ impl Builder {
                     n
                 }));
             }
+            ok
         } else {
-            for (cell, these, these_scratch, at) in work {
+            for (cell, these, these_spare, at, g) in work {
                 let child = out.len() as u32;
-                self.node(Some(cell), depth + 1, these, these_scratch, at, out);
+                if !self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, out, g) {
+                    return false;
+                }
                 out[index].children.push(child);
             }
+            true
         }
     }
 }
@@ -755,9 +892,20 @@ fn round_up(x: f64) -> f32 {
 impl GaussMapHierarchy {
     /// Builds the hierarchy over candidates with `normals` (see [`crate::FeatureEdges`]).
     pub fn build(normals: &[[Vec3; 2]], options: &GaussMapOptions, cost: &CostModel) -> Self {
+        Self::build_with_cells(normals, options, cost).0
+    }
+
+    /// [`GaussMapHierarchy::build`], also giving where each arc went (in storage order).
+    pub(crate) fn build_with_cells(
+        normals: &[[Vec3; 2]],
+        options: &GaussMapOptions,
+        cost: &CostModel,
+    ) -> (Self, ArcCells) {
         let max_depth = options.max_depth.unwrap_or_else(|| depth_for_count(normals.len(), options.base)).min(12);
-        let (nodes, arcs) = assign(normals, options.base, options.bins, max_depth);
-        let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
+        let Some((nodes, arcs)) = assign(normals, options.base, options.bins, max_depth, None) else {
+            unreachable!("an unguided assignment always succeeds")
+        };
+        let mut order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
 
         // Caps over each subtree's endpoints (contiguous in the preorder arc order).
         let caps: Vec<[f32; 4]> = nodes
@@ -767,6 +915,7 @@ impl GaussMapHierarchy {
                 bounding_cap(range.iter().flat_map(|a| [a.n1, a.n2]), n.cell_center)
             })
             .collect();
+        let by_id = ArcCells::by_candidate(&nodes, &arcs);
         drop(arcs);
         let assigned =
             LevelHistogram::from_nodes(nodes.iter().map(|n| (u32::from(n.depth), (n.own.1 - n.own.0) as usize)));
@@ -796,7 +945,21 @@ impl GaussMapHierarchy {
             }
         }
 
-        // Collapsed nodes own their whole subtree (contiguous in the preorder `order`).
+        // Collapsed nodes own their whole subtree (contiguous in the preorder `order`), in input
+        // order: the order in which the arcs reached the node, so that a reader's assignment can
+        // stop there (see `assign`). The scatter is stable, so that is ascending candidate order.
+        let mut inside_collapsed = vec![false; nodes.len()];
+        for i in 0..nodes.len() {
+            if collapse[i] && !inside_collapsed[i] {
+                let n = &nodes[i];
+                order[n.own.0 as usize..n.sub_end as usize].sort_unstable();
+            }
+            if collapse[i] || inside_collapsed[i] {
+                for &c in &nodes[i].children {
+                    inside_collapsed[c as usize] = true;
+                }
+            }
+        }
         let no_children: &[u32] = &[];
         let (flat, bfs_order, source) = breadth_first(
             0,
@@ -808,6 +971,7 @@ impl GaussMapHierarchy {
         );
         let flat_caps: Vec<[f32; 4]> = source.iter().map(|&i| caps[i]).collect();
         let a = assemble(&flat, &flat_caps, &bfs_order, normals);
+        let cells = ArcCells::new(options.base, options.bins, &by_id, &bfs_order);
         let mut h = GaussMapHierarchy {
             base: options.base,
             bins: options.bins,
@@ -823,7 +987,7 @@ impl GaussMapHierarchy {
             predicted_ns: 0.0,
         };
         h.predicted_ns = h.estimate_ns(cost);
-        h
+        (h, cells)
     }
 
     /// The bins the hierarchy was built with.
@@ -1001,6 +1165,14 @@ impl GaussMapHierarchy {
     /// result has exactly the stored nodes, and that every cap really bounds the endpoints below
     /// it (so a corrupted file cannot make a query drop a silhouette).
     pub fn from_arrays(arrays: &GaussMapArrays, normals: &[[Vec3; 2]]) -> Result<Self, ArraysError> {
+        Ok(Self::from_arrays_with_cells(arrays, normals)?.0)
+    }
+
+    /// [`GaussMapHierarchy::from_arrays`], also giving where each arc went (in storage order).
+    pub(crate) fn from_arrays_with_cells(
+        arrays: &GaussMapArrays,
+        normals: &[[Vec3; 2]],
+    ) -> Result<(Self, ArcCells), ArraysError> {
         let base = match arrays.base {
             0 => BaseSolid::Octahedron,
             1 => BaseSolid::Icosahedron,
@@ -1025,7 +1197,7 @@ impl GaussMapHierarchy {
         }
         let flat: Vec<[u32; 4]> = arrays.nodes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let caps: Vec<[f32; 4]> = arrays.node_caps.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-        check_breadth_first(&flat, normals.len())?;
+        let parents = check_breadth_first(&flat, normals.len())?;
         let mut centers = Vec::with_capacity(count);
         for (i, cap) in caps.iter().enumerate() {
             if cap.iter().any(|x| !x.is_finite()) {
@@ -1037,22 +1209,31 @@ impl GaussMapHierarchy {
             }
             centers.push(c.normalize_or_zero());
         }
-        let (order, arcs, ranges) = derived_order(&flat, normals, base, bins, max_depth)?;
-        // Every stored node's arcs (its whole subtree) are a range of the builder's preorder: each
-        // node checks its range against its cap, all nodes in parallel over contiguous memory.
+        let (order, arcs, ranges, by_id) = derived_order(&flat, normals, base, bins, max_depth)?;
+        // Every arc lies in the cap of the node that owns it and in each of that node's ancestors'.
+        // Each node checks its own arcs (a range of the builder's preorder) against its chain of
+        // caps: all nodes in parallel, every arc read once.
         ranges.par_iter().enumerate().try_for_each(|(node, &(lo, hi))| {
-            let threshold = f64::from(caps[node][3]);
-            if threshold >= 1.0 {
+            let mut chain = Vec::new();
+            let mut at = node as u32;
+            while at != u32::MAX {
+                if caps[at as usize][3] < 1.0 {
+                    chain.push((at as usize, centers[at as usize], f64::from(caps[at as usize][3])));
+                }
+                at = parents[at as usize];
+            }
+            if chain.is_empty() {
                 return Ok(());
             }
-            let c = centers[node];
             for g in &arcs[lo..hi] {
                 // For unit vectors the angle r is below π/2 iff c·p > 0, and then sin r = |c × p|
                 // (no atan2 per point and ancestor). A zero normal (degenerate face) is inside
                 // every cap, as the builder counts it.
                 for p in [g.n1, g.n2].into_iter().filter(|p| *p != DVec3::ZERO) {
-                    if c.dot(p) <= 0.0 || c.cross(p).length() + CULL_MARGIN * 0.5 > threshold {
-                        return Err(ArraysError::NotConservative { node, candidate: g.id });
+                    for &(owner, c, threshold) in &chain {
+                        if c.dot(p) <= 0.0 || c.cross(p).length() + CULL_MARGIN * 0.5 > threshold {
+                            return Err(ArraysError::NotConservative { node: owner, candidate: g.id });
+                        }
                     }
                 }
             }
@@ -1060,7 +1241,8 @@ impl GaussMapHierarchy {
         })?;
         drop(arcs);
         let a = assemble(&flat, &caps, &order, normals);
-        Ok(GaussMapHierarchy {
+        let cells = ArcCells::new(base, bins, &by_id, &order);
+        let h = GaussMapHierarchy {
             base,
             bins,
             max_depth,
@@ -1073,29 +1255,38 @@ impl GaussMapHierarchy {
             order,
             assigned: None,
             predicted_ns: 0.0,
-        })
+        };
+        Ok((h, cells))
     }
 }
 
 /// Every arc assigned to its cell by the bin rule: the builder's nodes in preorder and the arcs in
 /// preorder storage order (each node's own arcs, then its children's subtrees; input order within
 /// each). The one definition of where an arc goes, used by the build and by
-/// [`GaussMapHierarchy::from_arrays`], so that both find the same cells bit for bit.
-fn assign(normals: &[[Vec3; 2]], base: BaseSolid, bins: Bins, max_depth: u8) -> (Vec<BuildNode>, Vec<Arc>) {
+/// [`GaussMapHierarchy::from_arrays`], so that both find the same cells bit for bit. With `guide`
+/// (a stored breadth-first tree, already checked by [`check_breadth_first`]) the descent stops at
+/// the stored leaves, whose arcs stay in input order; `None` where the arcs do not split as stored.
+fn assign(
+    normals: &[[Vec3; 2]],
+    base: BaseSolid,
+    bins: Bins,
+    max_depth: u8,
+    guide: Option<&[[u32; 4]]>,
+) -> Option<(Vec<BuildNode>, Vec<Arc>)> {
     let mut arcs = arc_records(normals);
     let builder = Builder { bins, max_depth, base: base_cells(base) };
     let mut nodes = Vec::new();
     let mut scratch = vec![Arc::default(); arcs.len()];
-    builder.node(None, 0, &mut arcs, &mut scratch, 0, &mut nodes);
-    (nodes, arcs)
+    let ok = builder.node(None, 0, &mut arcs, &mut scratch, false, 0, &mut nodes, (0, guide.map(|g| (g, 0))));
+    ok.then_some((nodes, arcs))
 }
 
-/// The storage order of a stored tree `flat` (breadth-first, pruned) over `normals`: the arcs are
-/// assigned again ([`assign`]), the stored tree is matched against the builder's from the root
-/// (a stored node without children over a built node with children is a collapsed subtree), and
-/// the breadth-first layout of the match must reproduce `flat` exactly. Also returns the arcs in
-/// the builder's preorder and each stored node's range of them (its whole subtree).
-type Derived = (Vec<u32>, Vec<Arc>, Vec<(usize, usize)>);
+/// The storage order of a stored tree `flat` (breadth-first, pruned, checked by
+/// [`check_breadth_first`]) over `normals`: the arcs are assigned again down the stored tree
+/// ([`assign`]), and the breadth-first layout of the result must reproduce `flat` exactly. Also
+/// returns the arcs in the builder's preorder, each stored node's range of them (its own arcs) and
+/// each arc's cell by candidate ([`ArcCells::by_candidate`]).
+type Derived = (Vec<u32>, Vec<Arc>, Vec<(usize, usize)>, Vec<(u32, u8, bool)>);
 
 fn derived_order(
     flat: &[[u32; 4]],
@@ -1104,31 +1295,14 @@ fn derived_order(
     bins: Bins,
     max_depth: u8,
 ) -> Result<Derived, ArraysError> {
-    let (nodes, arcs) = assign(normals, base, bins, max_depth);
+    let (nodes, arcs) = assign(normals, base, bins, max_depth, Some(flat)).ok_or(ArraysError::Tree { node: 0 })?;
     let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
-    let mut collapse = vec![false; nodes.len()];
-    let mut queue = vec![0usize];
-    let mut j = 0;
-    while j < queue.len() {
-        let i = queue[j];
-        let stored = flat.get(j).ok_or(ArraysError::Tree { node: j })?;
-        let children = &nodes[i].children;
-        if stored[1] == 0 && !children.is_empty() {
-            collapse[i] = true;
-        } else if stored[1] as usize != children.len() {
-            return Err(ArraysError::Tree { node: j });
-        } else {
-            queue.extend(children.iter().map(|&c| c as usize));
-        }
-        j += 1;
-    }
-    let no_children: &[u32] = &[];
     let (derived, bfs_order, source) = breadth_first(
         0,
-        |i| if collapse[i] { no_children } else { &nodes[i].children },
+        |i| &nodes[i].children,
         |i| {
             let n = &nodes[i];
-            &order[n.own.0 as usize..if collapse[i] { n.sub_end } else { n.own.1 } as usize]
+            &order[n.own.0 as usize..n.own.1 as usize]
         },
     );
     if let Some(node) = derived.iter().zip(flat).position(|(a, b)| a != b) {
@@ -1137,8 +1311,9 @@ fn derived_order(
     if derived.len() != flat.len() {
         return Err(ArraysError::Tree { node: derived.len().min(flat.len()) });
     }
-    let ranges = source.iter().map(|&i| (nodes[i].own.0 as usize, nodes[i].sub_end as usize)).collect();
-    Ok((bfs_order, arcs, ranges))
+    let ranges = source.iter().map(|&i| (nodes[i].own.0 as usize, nodes[i].own.1 as usize)).collect();
+    let by_id = ArcCells::by_candidate(&nodes, &arcs);
+    Ok((bfs_order, arcs, ranges, by_id))
 }
 
 fn is_identity(order: &[u32]) -> bool {
@@ -1189,6 +1364,50 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_gauss_maps_arc_cells_give_the_bvh_paths() {
+        let mut rng = crate::measure::ViewRng::new(3);
+        let normals: Vec<[Vec3; 2]> = (0..30_000)
+            .map(|k| {
+                let a = rng.direction();
+                let spread = [1e-4, 1e-2, 0.1, 0.5][k % 4];
+                [a, (a + rng.direction() * spread).normalize_or_zero()]
+            })
+            .collect();
+        let cost = CostModel::default();
+        let factor = f64::from(DEFAULT_OVERLAP);
+        let base = base_cells(BaseSolid::Icosahedron);
+        // Shallow maps stop above the BVH's level (max_depth; collapsed subtrees, where a reader
+        // stops), so the descent goes on from their cells.
+        for max_depth in [1u8, 3, 8] {
+            let options = GaussMapOptions { max_depth: Some(max_depth), ..Default::default() };
+            let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &options, &cost);
+            let (loaded, loaded_cells) =
+                GaussMapHierarchy::from_arrays_with_cells(&built.to_arrays(), &normals).unwrap();
+            assert_eq!(loaded.order, built.order);
+            let assigned = built.assigned_histogram().unwrap();
+            let assigned_nodes = assigned.root.nodes + assigned.levels.iter().map(|l| l.nodes).sum::<usize>();
+            assert!(max_depth < 8 || built.node_count() < assigned_nodes, "some subtree is collapsed");
+            let unit: Vec<[DVec3; 2]> =
+                built.order.iter().map(|&i| normals[i as usize].map(|n| n.as_dvec3().normalize_or_zero())).collect();
+            for level in [0u8, 2, 4, 6] {
+                let expected = arc_paths(&unit, &base, level, factor);
+                assert_eq!(
+                    cells.paths(&unit, level, factor).unwrap(),
+                    expected,
+                    "built, depth {max_depth}, level {level}"
+                );
+                assert_eq!(loaded_cells.paths(&unit, level, factor).unwrap(), expected, "loaded, depth {max_depth}");
+            }
+        }
+        // Another rule: no paths.
+        let octahedron = GaussMapOptions { base: BaseSolid::Octahedron, ..Default::default() };
+        let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &octahedron, &cost);
+        let unit: Vec<[DVec3; 2]> =
+            built.order.iter().map(|&i| normals[i as usize].map(|n| n.as_dvec3().normalize_or_zero())).collect();
+        assert!(cells.paths(&unit, 3, factor).is_none());
     }
 
     #[test]

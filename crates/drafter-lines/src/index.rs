@@ -131,7 +131,7 @@ impl SilhouetteIndex {
         } else if n < options.min_candidates {
             (None, HierarchyChoice::BruteForce(too_few))
         } else {
-            let g = GaussMapHierarchy::build(&normals, &options.gauss, cost);
+            let (g, cells) = GaussMapHierarchy::build_with_cells(&normals, &options.gauss, cost);
             let speedup = speedup(n as f64 * f64::from(cost.brute_ortho_ns), g.predicted_ns_per_query());
             if speedup >= options.min_speedup {
                 let choice = HierarchyChoice::GaussMap {
@@ -148,11 +148,13 @@ impl SilhouetteIndex {
                 if points.len() == n {
                     points = permutation.iter().map(|k| points[pick(k)]).collect();
                 }
-                (Some(g), choice)
+                (Some((g, cells)), choice)
             } else {
                 (None, HierarchyChoice::BruteForce(BruteForceReason::NotFaster { predicted_speedup: speedup }))
             }
         };
+        // The BVH's normal split reads the Gauss map's cells (the candidates are in its order).
+        let (gauss, cells) = gauss.unzip();
         let brute = BruteForce::new(&normals, &points);
 
         let (bvh, perspective) = if !options.perspective || points.len() != n {
@@ -160,7 +162,7 @@ impl SilhouetteIndex {
         } else if n < options.min_candidates {
             (None, HierarchyChoice::BruteForce(too_few))
         } else {
-            let b = ConeBvh::build(&normals, &points, &options.bvh, cost);
+            let b = ConeBvh::build_with_cells(&normals, &points, &options.bvh, cost, cells.as_ref());
             let speedup = speedup(n as f64 * f64::from(cost.brute_perspective_ns), b.predicted_ns_per_query());
             if speedup >= options.min_speedup {
                 let choice = HierarchyChoice::ConeBvh {
@@ -304,18 +306,24 @@ impl SilhouetteIndex {
         let mut candidate_edges = arrays.candidate_edges.clone();
         let gauss = match &arrays.gauss_map {
             Some(g) => {
-                let (g, permutation) = GaussMapHierarchy::from_arrays(g, &normals)?.into_storage_order();
+                let (g, cells) = GaussMapHierarchy::from_arrays_with_cells(g, &normals)?;
+                let (g, permutation) = g.into_storage_order();
                 let pick = |k: &u32| *k as usize;
                 candidate_edges = permutation.iter().map(|k| candidate_edges[pick(k)]).collect();
                 normals = permutation.iter().map(|k| normals[pick(k)]).collect();
                 if points.len() == n {
                     points = permutation.iter().map(|k| points[pick(k)]).collect();
                 }
-                Some(g)
+                Some((g, cells))
             }
             None => None,
         };
-        let bvh = arrays.cone_bvh.as_ref().map(|b| ConeBvh::from_arrays(b, &normals, &points)).transpose()?;
+        let (gauss, cells) = gauss.unzip();
+        let bvh = arrays
+            .cone_bvh
+            .as_ref()
+            .map(|b| ConeBvh::from_arrays_with_cells(b, &normals, &points, cells.as_ref()))
+            .transpose()?;
         Ok(Self {
             candidate_edges,
             brute: BruteForce::new(&normals, &points),

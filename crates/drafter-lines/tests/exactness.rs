@@ -300,6 +300,12 @@ fn arrays_load_from_candidates_in_the_build_order() {
     let normals: Vec<[Vec3; 2]> = perm.iter().map(|&k| x.lines.candidate_normals[k]).collect();
     let points: Vec<Vec3> = perm.iter().map(|&k| x.lines.candidate_points[k]).collect();
     let built = SilhouetteIndex::from_candidates(edges.clone(), normals.clone(), points.clone(), &options);
+    // The cost model collapsed subtrees: their arcs are stored in input order, and the reader's
+    // assignment stops at them.
+    let g = built.gauss_map().unwrap();
+    let assigned = g.assigned_histogram().unwrap();
+    let assigned_nodes = assigned.root.nodes + assigned.levels.iter().map(|l| l.nodes).sum::<usize>();
+    assert!(g.node_count() < assigned_nodes, "{} stored of {assigned_nodes} nodes", g.node_count());
     let stored = built.to_arrays();
     let file = SilhouetteArrays {
         candidate_edges: edges,
