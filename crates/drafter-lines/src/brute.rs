@@ -273,17 +273,21 @@ pub(crate) struct OrthoBlocks {
 impl OrthoBlocks {
     /// Candidates `order[k]` at storage position `k`.
     pub fn new(order: &[u32], normals: &[[Vec3; 2]]) -> Self {
-        let mut quads = Vec::with_capacity(order.len().div_ceil(4) * 6);
-        for chunk in order.chunks(4) {
-            let mut rows = [[0f32; 4]; 6];
-            for (lane, &i) in chunk.iter().enumerate() {
-                let [n1, n2] = normals[i as usize];
-                for (r, x) in [n1.x, n1.y, n1.z, n2.x, n2.y, n2.z].into_iter().enumerate() {
-                    rows[r][lane] = x;
+        // Blocks are independent: built on the thread pool (a million-candidate map at load).
+        let blocks: Vec<[[f32; 4]; 6]> = order
+            .par_chunks(4)
+            .map(|chunk| {
+                let mut rows = [[0f32; 4]; 6];
+                for (lane, &i) in chunk.iter().enumerate() {
+                    let [n1, n2] = normals[i as usize];
+                    for (r, x) in [n1.x, n1.y, n1.z, n2.x, n2.y, n2.z].into_iter().enumerate() {
+                        rows[r][lane] = x;
+                    }
                 }
-            }
-            quads.extend_from_slice(&rows);
-        }
+                rows
+            })
+            .collect();
+        let quads: Vec<[f32; 4]> = blocks.into_iter().flatten().collect();
         Self {
             #[cfg(target_arch = "x86_64")]
             quantized: Quantized::new(&quads),
@@ -415,19 +419,23 @@ impl Quantized {
 
     /// From the `f32` blocks (6 quads per block).
     fn new(quads: &[[f32; 4]]) -> Self {
-        let mut blocks = Vec::with_capacity(quads.len() / 2);
-        for r in quads.chunks_exact(6) {
-            let lane = |l: usize| {
-                let n1 = Self::quantize(Vec3::new(r[0][l], r[1][l], r[2][l]));
-                let n2 = Self::quantize(Vec3::new(r[3][l], r[4][l], r[5][l]));
-                (n1, n2)
-            };
-            let [(a0, b0), (a1, b1), (a2, b2), (a3, b3)] = [lane(0), lane(1), lane(2), lane(3)];
-            blocks.push(Lanes([a0[0], a0[1], a1[0], a1[1], a2[0], a2[1], a3[0], a3[1]]));
-            blocks.push(Lanes([b0[0], b0[1], b1[0], b1[1], b2[0], b2[1], b3[0], b3[1]]));
-            blocks.push(Lanes([a0[2], b0[2], a1[2], b1[2], a2[2], b2[2], a3[2], b3[2]]));
-        }
-        Self { blocks }
+        let triples: Vec<[Lanes; 3]> = quads
+            .par_chunks_exact(6)
+            .map(|r| {
+                let lane = |l: usize| {
+                    let n1 = Self::quantize(Vec3::new(r[0][l], r[1][l], r[2][l]));
+                    let n2 = Self::quantize(Vec3::new(r[3][l], r[4][l], r[5][l]));
+                    (n1, n2)
+                };
+                let [(a0, b0), (a1, b1), (a2, b2), (a3, b3)] = [lane(0), lane(1), lane(2), lane(3)];
+                [
+                    Lanes([a0[0], a0[1], a1[0], a1[1], a2[0], a2[1], a3[0], a3[1]]),
+                    Lanes([b0[0], b0[1], b1[0], b1[1], b2[0], b2[1], b3[0], b3[1]]),
+                    Lanes([a0[2], b0[2], a1[2], b1[2], a2[2], b2[2], a3[2], b3[2]]),
+                ]
+            })
+            .collect();
+        Self { blocks: triples.into_iter().flatten().collect() }
     }
 
     #[allow(unsafe_code)]
@@ -550,8 +558,40 @@ impl Stream {
     }
 
     /// Length in quads.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.quads.len()
+    }
+
+    /// The blocks of each of `ranges` of `ids`, one range after the other (what
+    /// [`Stream::push_blocks`] gives range by range), built on the thread pool; also each
+    /// range's first quad and block count.
+    pub fn from_ranges(
+        ranges: &[(usize, usize)],
+        ids: &[u32],
+        normals: &[[Vec3; 2]],
+        points: &[Vec3],
+    ) -> (Self, Vec<(u32, u32)>) {
+        let mut at = Vec::with_capacity(ranges.len());
+        let mut quads = 0usize;
+        for &(start, end) in ranges {
+            let blocks = (end - start).div_ceil(4);
+            at.push((quads as u32, blocks as u32));
+            quads += 10 * blocks;
+        }
+        let parts: Vec<Stream> = ranges
+            .par_iter()
+            .map(|&(start, end)| {
+                let mut part = Stream::new();
+                part.push_blocks(&ids[start..end], normals, points);
+                part
+            })
+            .collect();
+        let mut stream = Stream { quads: Vec::with_capacity(quads) };
+        for part in parts {
+            stream.quads.extend_from_slice(&part.quads);
+        }
+        (stream, at)
     }
 
     /// Appends candidates `ids` as whole blocks; returns the number of blocks.

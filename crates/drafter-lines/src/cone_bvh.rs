@@ -243,13 +243,13 @@ fn assemble(
     normals: &[[Vec3; 2]],
     points: &[Vec3],
 ) -> Assembled {
-    let mut stream = Stream::new();
+    let ranges: Vec<(usize, usize)> = flat.iter().map(|&[_, _, start, end]| (start as usize, end as usize)).collect();
+    let (stream, at) = Stream::from_ranges(&ranges, order, normals, points);
     let mut nodes: Vec<BvhNode> = flat
         .iter()
         .enumerate()
-        .map(|(i, &[first_child, child_count, start, end])| {
-            let quad = stream.len() as u32;
-            let blocks = stream.push_blocks(&order[start as usize..end as usize], normals, points);
+        .map(|(i, &[first_child, child_count, _, _])| {
+            let (quad, blocks) = at[i];
             let (p0, c, [cos, lo, hi, reach]) = (anchor(&boxes[i]), cones[i], planes[i].0);
             BvhNode {
                 anchor_sin: p0.extend(c[3]),
