@@ -32,6 +32,7 @@ use std::collections::HashMap;
 
 use drafter_core::{Topology, snorm8_encode_direction};
 use glam::Vec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::{EdgeClass, FeatureEdges};
@@ -122,6 +123,8 @@ pub fn encode_edge_visibility_continuing(
     let mut written = vec![false; topology.edges.len()];
     let silhouette_written = &mut encoded.0;
     silhouette_written.resize(topology.edges.len(), false);
+    // Candidates in encoding order; their normals are rounded afterwards, on the thread pool.
+    let mut candidates = Vec::new();
     for (t, tri) in triangles.iter().enumerate() {
         let welded = welded_triangle(tri, t, &topology.welded_of_vertex)?;
         if collapsed(&welded) {
@@ -143,9 +146,7 @@ pub fn encode_edge_visibility_continuing(
                     .candidates
                     .binary_search(&(e as u32))
                     .map_err(|_| VisibilityError::UnknownEdge { triangle: t, corner: k })?;
-                let [n1, n2] = lines.candidate_normals[c];
-                out.silhouette_normals.push(snorm8_encode_direction(n1));
-                out.silhouette_normals.push(snorm8_encode_direction(n2));
+                candidates.push(c);
                 out.silhouette_edges.push(e as u32);
                 SILHOUETTE
             } else {
@@ -156,6 +157,8 @@ pub fn encode_edge_visibility_continuing(
             out.visibility[slot / 4] |= value << (2 * (slot % 4));
         }
     }
+    out.silhouette_normals =
+        candidates.par_iter().flat_map_iter(|&c| lines.candidate_normals[c].map(snorm8_encode_direction)).collect();
     Ok(out)
 }
 
