@@ -985,7 +985,9 @@ fn build_tree(
             jobs.par_iter()
                 .map(|ids| {
                     let mut sub = Tree::default();
-                    dual_node(&mut sub, &mut records(ids), leaf_size, 0);
+                    let mut records = records(ids);
+                    let bounds = centre_bounds(&records);
+                    dual_node(&mut sub, &mut records, bounds, leaf_size, 0);
                     sub
                 })
                 .collect()
@@ -1185,15 +1187,15 @@ impl Centred for CentreRecord {
 /// surface-area heuristic of ray tracing, with the mean width that measures how often a random
 /// hyperplane crosses a box). Deterministic: in place, ties to the first axis and bin; subtrees
 /// of more than [`PARALLEL_CANDIDATES`] are built on the thread pool, which gives the same tree.
-/// Candidates whose centres coincide on every axis are split in halves.
-fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth: u32) {
+/// Candidates whose centres coincide on every axis are split in halves. `bounds` is the box of the
+/// records' centres.
+fn dual_node(tree: &mut Tree, records: &mut [DualRecord], bounds: DualBox, leaf_size: u32, depth: u32) {
     let at = tree.open();
     if records.len() <= leaf_size as usize || records.len() < 2 {
         tree.order.extend(records.iter().map(|r| r.id));
         tree.close(at, true);
         return;
     }
-    let bounds = centre_bounds(records);
     let bin_of = |c: f32, a: usize| bin_of(&bounds, c, a);
     // Axes whose centres all coincide (or are not finite) offer no split.
     let splittable: [bool; 4] =
@@ -1258,22 +1260,23 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], leaf_size: u32, depth:
         None => MEDIAN_SPLIT,
     };
     tree.splits.push(split);
-    let (mid, _) = apply_split(records, &bounds, split);
+    // The partition pass also gives each side's centre box.
+    let (mid, sides) = apply_split(records, &bounds, split);
     let parallel = records.len() > PARALLEL_CANDIDATES;
     let (left, right) = records.split_at_mut(mid);
     if parallel {
-        let build = |part: &mut [DualRecord]| {
+        let build = |part: &mut [DualRecord], b: DualBox| {
             let mut sub = Tree::default();
-            dual_node(&mut sub, part, leaf_size, depth + 1);
+            dual_node(&mut sub, part, b, leaf_size, depth + 1);
             sub
         };
-        let (l, r) = rayon::join(|| build(left), || build(right));
+        let (l, r) = rayon::join(|| build(left, sides[0]), || build(right, sides[1]));
         tree.append_child(at, l);
         tree.append_child(at, r);
     } else {
-        for part in [left, right] {
+        for (part, b) in [(left, sides[0]), (right, sides[1])] {
             let child = tree.nodes.len() as u32;
-            dual_node(tree, part, leaf_size, depth + 1);
+            dual_node(tree, part, b, leaf_size, depth + 1);
             tree.children[at].push(child);
         }
     }
