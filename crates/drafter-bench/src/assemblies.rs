@@ -20,8 +20,8 @@
 
 use std::f64::consts::{FRAC_PI_4, TAU};
 
-use drafter_core::{Mesh, PartId, Scene, SourceFormat};
-use drafter_segment::Parts;
+use drafter_core::{EDGE_NONE, InstanceId, Mesh, PartId, Scene, SourceFormat, Topology, Weld};
+use drafter_segment::{FanPairing, Parts, SegmentMode, SegmentOptions, segment};
 use glam::DVec3;
 
 /// A solid part in world space: positions (f64) and outward triangles.
@@ -408,6 +408,109 @@ pub fn flatten(scene: &Scene) -> (Scene, Vec<u32>) {
         }
     }
     (single_mesh_scene(mesh, "merged"), truth)
+}
+
+/// The solids of every instance of `scene`, as the true part of each triangle of [`flatten`]'s
+/// mesh: what "the parts" of a merged assembly can mean when some of its meshes hold several
+/// separate bodies (a bearing and its balls, four bolts written as one mesh), which no method can
+/// tell from one part by geometry alone.
+///
+/// Each unique mesh on its own is cut into edge-connected pieces (welded, with the faces around
+/// non-manifold edges paired as [`SegmentMode::Components`] pairs them), and a piece is a *solid*
+/// when it is closed: every welded edge it uses is used by at least two of its faces (checked
+/// here, not taken from the segmentation). A mesh with fewer than two solids is one part, open
+/// pieces and all (faces that do not weld are still one part). A mesh with several solids is that
+/// many parts; each open piece goes with the solid that shares the most welded vertices with it,
+/// else with the largest solid. Returns the truth and the number of instances that hold several
+/// solids.
+pub fn flatten_solids(scene: &Scene) -> (Vec<u32>, usize) {
+    let mut of_mesh: Vec<Option<(Vec<u32>, u32)>> = vec![None; scene.meshes.len()];
+    let mut truth = Vec::new();
+    let (mut next, mut split) = (0u32, 0usize);
+    for inst in &scene.instances {
+        let entry = of_mesh[inst.mesh.index()].get_or_insert_with(|| mesh_solids(scene.mesh(inst.mesh)));
+        let (labels, count) = (&entry.0, entry.1);
+        truth.extend(labels.iter().map(|&l| next + l));
+        next += count;
+        split += usize::from(count > 1);
+    }
+    (truth, split)
+}
+
+/// The solid of each face of `mesh` (see [`flatten_solids`]) and their number.
+fn mesh_solids(mesh: &Mesh) -> (Vec<u32>, u32) {
+    let faces = mesh.triangles.len();
+    let one = (vec![0; faces], u32::from(faces > 0));
+    if faces == 0 {
+        return one;
+    }
+    let scene = Scene::single_mesh(SourceFormat::Stl, mesh.clone(), "solids");
+    let options =
+        SegmentOptions { mode: SegmentMode::Components, fan_pairing: FanPairing::Partial, ..SegmentOptions::default() };
+    let (parts, _) = segment(&scene, &options);
+    let piece: Vec<u32> = (0..faces as u32).map(|f| parts.part_of(InstanceId(0), f).0).collect();
+    let pieces = parts.len();
+    // Closed: every welded edge a piece uses is used by two of its faces or more.
+    let topo = Topology::build(mesh, Weld::default());
+    let mut uses: Vec<(u32, u32)> = Vec::new();
+    for (f, edges) in topo.face_edges.iter().enumerate() {
+        uses.extend(edges.iter().filter(|&&e| e != EDGE_NONE).map(|&e| (e, piece[f])));
+    }
+    uses.sort_unstable();
+    let mut closed = vec![true; pieces];
+    for run in uses.chunk_by(|a, b| a == b) {
+        if run.len() == 1 {
+            closed[run[0].1 as usize] = false;
+        }
+    }
+    let solids: Vec<usize> = (0..pieces).filter(|&p| closed[p]).collect();
+    if solids.len() < 2 {
+        return one;
+    }
+    let mut size = vec![0usize; pieces];
+    for &p in &piece {
+        size[p as usize] += 1;
+    }
+    let largest = *solids.iter().max_by_key(|&&p| (size[p], std::cmp::Reverse(p))).unwrap_or(&solids[0]);
+    // Welded vertices shared between each open piece and each solid.
+    let mut at_vertex: Vec<(u32, u32)> = Vec::new();
+    for (f, tri) in topo.faces.iter().enumerate() {
+        at_vertex.extend(tri.iter().map(|&v| (v, piece[f])));
+    }
+    at_vertex.sort_unstable();
+    at_vertex.dedup();
+    let mut shared: Vec<(u32, u32)> = Vec::new();
+    for run in at_vertex.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, o) in run.iter().filter(|x| !closed[x.1 as usize]) {
+            shared.extend(run.iter().filter(|x| closed[x.1 as usize]).map(|&(_, s)| (o, s)));
+        }
+    }
+    shared.sort_unstable();
+    let mut solid_of = vec![u32::MAX; pieces];
+    for (k, &p) in solids.iter().enumerate() {
+        solid_of[p] = k as u32;
+    }
+    let mut best: Vec<(usize, u32)> = vec![(0, u32::MAX); pieces];
+    for run in shared.chunk_by(|a, b| a == b) {
+        let (o, s) = run[0];
+        if run.len() > best[o as usize].0 {
+            best[o as usize] = (run.len(), s);
+        }
+    }
+    let labels = piece
+        .iter()
+        .map(|&p| {
+            let p = p as usize;
+            if closed[p] {
+                solid_of[p]
+            } else if best[p].1 != u32::MAX {
+                solid_of[best[p].1 as usize]
+            } else {
+                solid_of[largest]
+            }
+        })
+        .collect();
+    (labels, solids.len() as u32)
 }
 
 fn single_mesh_scene(mesh: Mesh, name: &str) -> Scene {

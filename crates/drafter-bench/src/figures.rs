@@ -325,8 +325,9 @@ pub fn segmentation(report: &SweepReport) -> Figure {
     }
 }
 
-/// Issue 17: `auto` on the generated contact family, fans paired whole only (before) and in part
-/// (now): triangles in a matching part, and parts found against the true count.
+/// Issue 17: `auto` on the generated contact family, fans paired whole only (before), in part, and
+/// in part with cracks glued (now): triangles in a matching part, and parts found against the true
+/// count.
 pub fn segmentation_contacts(report: &SweepReport) -> Figure {
     let c = &report.segmentation.contacts;
     // Numbers on the axis (the names do not fit); the kinds repeat in each variant, in order.
@@ -353,15 +354,16 @@ pub fn segmentation_contacts(report: &SweepReport) -> Figure {
     let passing = |f: &dyn Fn(&crate::sweep::ContactPoint) -> (f64, usize)| {
         c.iter().filter(|p| f(p).0 >= 0.99 && f(p).1 == p.truth_parts).count()
     };
-    let (before, after) = (passing(&|p| p.whole), passing(&|p| p.partial));
+    let (before, between, after) = (passing(&|p| p.whole), passing(&|p| p.partial), passing(&|p| p.stitched));
     let matched = Panel {
         title: "triangles in a part that matches one original part (bar: 99%)".into(),
         x_label: x_label.clone(),
         y_label: "% of triangles".into(),
         categories: categories.clone(),
         series: vec![
-            Series::new("fans paired whole only (before)", Kind::BigPoints, 1, at(-0.15, &|p| 100.0 * p.whole.0)),
-            Series::new("fans paired in part (now)", Kind::BigPoints, 0, at(0.15, &|p| 100.0 * p.partial.0)),
+            Series::new("fans paired whole only (before)", Kind::BigPoints, 1, at(-0.2, &|p| 100.0 * p.whole.0)),
+            Series::new("fans paired in part", Kind::BigPoints, 2, at(0.0, &|p| 100.0 * p.partial.0)),
+            Series::new("in part, cracks glued (now)", Kind::BigPoints, 0, at(0.2, &|p| 100.0 * p.stitched.0)),
         ],
         headroom: 0.25,
         y_from_zero: true,
@@ -378,13 +380,19 @@ pub fn segmentation_contacts(report: &SweepReport) -> Figure {
                 "fans paired whole only (before)",
                 Kind::BigPoints,
                 1,
-                at(-0.15, &|p| p.whole.1 as f64 - p.truth_parts as f64),
+                at(-0.2, &|p| p.whole.1 as f64 - p.truth_parts as f64),
             ),
             Series::new(
-                "fans paired in part (now)",
+                "fans paired in part",
+                Kind::BigPoints,
+                2,
+                at(0.0, &|p| p.partial.1 as f64 - p.truth_parts as f64),
+            ),
+            Series::new(
+                "in part, cracks glued (now)",
                 Kind::BigPoints,
                 0,
-                at(0.15, &|p| p.partial.1 as f64 - p.truth_parts as f64),
+                at(0.2, &|p| p.stitched.1 as f64 - p.truth_parts as f64),
             ),
         ],
         headroom: 0.25,
@@ -393,7 +401,7 @@ pub fn segmentation_contacts(report: &SweepReport) -> Figure {
     };
     Figure {
         title: format!(
-            "Segmentation of touching parts (generated, merged into one unwelded mesh): {before} of {} at the bar before, {after} now",
+            "Segmentation of touching parts (generated, merged into one unwelded mesh): {before} of {} at the bar before, {between} with fans paired in part, {after} now",
             c.len()
         ),
         columns: 1,

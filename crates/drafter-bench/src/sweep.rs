@@ -595,7 +595,8 @@ pub struct SegmentSweep {
     /// `auto` mode on each unique mesh alone over [`MERGE_FRACTIONS`] (parts summed).
     pub by_merge_fraction: Vec<SegmentPoint>,
     /// `auto` mode on the generated contact family ([`crate::assemblies::contact_assemblies`]),
-    /// with fans paired whole only (before issue 17) and in part (the default).
+    /// with fans paired whole only (before issue 17), in part, and in part with cracks glued (the
+    /// defaults).
     #[serde(default)]
     pub contacts: Vec<ContactPoint>,
 }
@@ -608,8 +609,11 @@ pub struct ContactPoint {
     pub truth_parts: usize,
     /// [`FanPairing::Whole`]: fraction of triangles in a matching part, and parts found.
     pub whole: (f64, usize),
-    /// [`FanPairing::Partial`] (the default): the same.
+    /// [`FanPairing::Partial`], without gluing cracks (before the second step of issue 17).
     pub partial: (f64, usize),
+    /// The defaults: fans paired in part and open pieces glued across cracks.
+    #[serde(default)]
+    pub stitched: (f64, usize),
 }
 
 /// [`ContactPoint`]s of the generated contact family.
@@ -618,14 +622,23 @@ pub fn contact_accuracy() -> Vec<ContactPoint> {
         .iter()
         .map(|a| {
             let (scene, truth) = a.merged();
-            let measure = |fan_pairing| {
-                let (parts, _) = segment(&scene, &SegmentOptions { fan_pairing, ..SegmentOptions::default() });
+            let measure = |fan_pairing, stitch_fraction| {
+                let options = SegmentOptions { fan_pairing, stitch_fraction, ..SegmentOptions::default() };
+                let (parts, _) = segment(&scene, &options);
                 let acc = crate::assemblies::accuracy(&parts, &truth);
                 (acc, (acc.matched, acc.parts))
             };
-            let (acc, whole) = measure(FanPairing::Whole);
-            let (_, partial) = measure(FanPairing::Partial);
-            ContactPoint { name: a.name.clone(), triangles: truth.len(), truth_parts: acc.truth_parts, whole, partial }
+            let (acc, whole) = measure(FanPairing::Whole, 0.0);
+            let (_, partial) = measure(FanPairing::Partial, 0.0);
+            let (_, stitched) = measure(FanPairing::Partial, drafter_segment::DEFAULT_STITCH_FRACTION);
+            ContactPoint {
+                name: a.name.clone(),
+                triangles: truth.len(),
+                truth_parts: acc.truth_parts,
+                whole,
+                partial,
+                stitched,
+            }
         })
         .collect()
 }

@@ -49,6 +49,8 @@ pub enum DiagnosticKind {
     /// Non-manifold edges whose faces could be paired into solids only in part; the faces left
     /// over are free edges of their parts.
     PartlyPairedNonManifoldEdge,
+    /// Open pieces glued by segmentation to the pieces their free edges lie on (cracks).
+    GluedCrack,
     /// Small components merged into a touching neighbour by segmentation.
     MergedSliver,
     /// A mesh whose line stage failed; it has no edges in the output.
@@ -84,6 +86,7 @@ impl DiagnosticKind {
             Self::InconsistentWinding => "edges between faces of inconsistent winding",
             Self::UnpairedNonManifoldEdge => "unpaired non-manifold edges",
             Self::PartlyPairedNonManifoldEdge => "partly paired non-manifold edges",
+            Self::GluedCrack => "open pieces glued across cracks",
             Self::MergedSliver => "small components merged",
             Self::LinesSkipped => "meshes without lines",
             Self::EdgesNotWritten => "primitives without edges",

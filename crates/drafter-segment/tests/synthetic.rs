@@ -427,3 +427,73 @@ fn modes_parse_and_print() {
     assert!("blobs".parse::<SegmentMode>().is_err());
     assert_eq!(SegmentMode::default(), SegmentMode::Auto);
 }
+
+/// A box whose faces are patches of `n[face]`×`n[face]` quads (faces in the order of `add_box`:
+/// -x, +x, -y, +y, -z, +z), each with its own vertices; faces with different `n` meet at a crack
+/// (T-junctions: they share the corners but no edge). `lift` moves the +z face up.
+fn cracked_box(n: [u32; 6], lift: f32) -> Mesh {
+    let mut mesh = Mesh::default();
+    let mut face = Mesh::default();
+    for (k, &nk) in n.iter().enumerate() {
+        face.positions.clear();
+        face.triangles.clear();
+        add_box(&mut face, Vec3::ZERO, Vec3::ONE, nk);
+        // add_box writes six faces of 2·nk² triangles and (nk + 1)² vertices each, in order.
+        let (v, t) = (((nk + 1) * (nk + 1)) as usize, (2 * nk * nk) as usize);
+        let base = mesh.positions.len() as u32;
+        let offset = (k * v) as u32;
+        let up = if k == 5 { Vec3::Z * lift } else { Vec3::ZERO };
+        mesh.positions.extend(face.positions[k * v..(k + 1) * v].iter().map(|&p| p + up));
+        mesh.triangles.extend(face.triangles[k * t..(k + 1) * t].iter().map(|tri| tri.map(|i| i - offset + base)));
+    }
+    mesh
+}
+
+#[test]
+fn a_face_cracked_off_its_solid_is_glued_back() {
+    // The top is a 2×2 patch on 1×1 sides: its edges' midpoints lie on the sides' edges.
+    let scene = single(cracked_box([1, 1, 1, 1, 1, 2], 0.0));
+    assert_eq!(sizes(&run(&scene, SegmentMode::Components)), vec![10, 8]);
+    let (parts, diagnostics) = segment(&scene, &SegmentOptions::default());
+    assert_eq!(sizes(&parts), vec![18]);
+    let glued = diagnostics.iter().find(|d| d.kind == drafter_core::DiagnosticKind::GluedCrack);
+    assert_eq!(glued.map(|d| d.count), Some(1), "{diagnostics:?}");
+    // Off, or with the face lifted beyond the tolerance, the crack stays a cut.
+    let off = SegmentOptions { stitch_fraction: 0.0, ..SegmentOptions::default() };
+    assert_eq!(sizes(&segment(&scene, &off).0), vec![10, 8]);
+    let lifted = single(cracked_box([1, 1, 1, 1, 1, 2], 1e-4));
+    assert_eq!(sizes(&segment(&lifted, &SegmentOptions::default()).0), vec![10, 8]);
+}
+
+#[test]
+fn every_face_cracked_apart_is_glued_into_one_part() {
+    // Six patches, no two with the same tessellation along a shared edge: six open pieces.
+    let scene = single(cracked_box([1, 2, 3, 4, 5, 6], 0.0));
+    assert_eq!(run(&scene, SegmentMode::Components).len(), 6);
+    assert_eq!(run(&scene, SegmentMode::Auto).len(), 1);
+}
+
+#[test]
+fn open_pieces_that_only_touch_are_not_glued() {
+    // Two squares side by side along half an edge: neither is sealed by the other.
+    let mut mesh = Mesh::default();
+    add_polygon(&mut mesh, &[Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]);
+    add_polygon(
+        &mut mesh,
+        &[Vec3::new(1.0, 0.5, 0.0), Vec3::new(2.0, 0.5, 0.0), Vec3::new(2.0, 1.5, 0.0), Vec3::new(1.0, 1.5, 0.0)],
+    );
+    assert_eq!(run(&single(mesh), SegmentMode::Auto).len(), 2);
+    // A sheet lying on a closed cube's face: the cube has no free edge to seal it.
+    let mut mesh = Mesh::default();
+    add_box(&mut mesh, Vec3::ZERO, Vec3::ONE, 1);
+    add_polygon(
+        &mut mesh,
+        &[
+            Vec3::new(0.25, 0.25, 1.0),
+            Vec3::new(0.75, 0.25, 1.0),
+            Vec3::new(0.75, 0.75, 1.0),
+            Vec3::new(0.25, 0.75, 1.0),
+        ],
+    );
+    assert_eq!(sizes(&run(&single(mesh), SegmentMode::Auto)), vec![12, 2]);
+}
