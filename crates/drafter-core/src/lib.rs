@@ -32,4 +32,4 @@ pub use obb_method::ObbMethod;
 pub use param::ParamError;
 pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceDocument, SourceFormat, TriangleGroup};
 pub use snorm::{snorm8_decode, snorm8_encode, snorm8_encode_direction, snorm16_decode, snorm16_encode};
-pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld};
+pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld, robust_diagonal};

@@ -274,6 +274,13 @@ const SNAP_SAMPLE: usize = 4096;
 /// point, and every later stage would pay for that collapse (issue 21, class 3). For a model
 /// without such outliers the core spans more than 1/64 of the box and nothing changes.
 fn snap_scale(positions: &[Vec3]) -> f64 {
+    robust_diagonal(positions)
+}
+
+/// The bounding diagonal of `positions`, unless a few lie far outside the rest: then 64 times the
+/// diagonal of their core (see [`snap_scale`], which is this). Tolerances that are a fraction of a
+/// mesh's size should use it, so that one stray vertex cannot make them huge.
+pub fn robust_diagonal(positions: &[Vec3]) -> f64 {
     if positions.is_empty() {
         return 0.0;
     }

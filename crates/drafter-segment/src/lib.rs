@@ -433,7 +433,8 @@ fn segment_mesh(
     let mut glued = 0;
     if merge && options.stitch_fraction > 0.0 && labelling.count > 1 {
         let limits = stitch::StitchLimits {
-            tolerance: options.stitch_fraction * diagonal,
+            // Of the robust diagonal: one stray vertex must not make every free edge "near".
+            tolerance: options.stitch_fraction * drafter_core::robust_diagonal(&mesh.positions),
             sealed_fraction: STITCH_SEALED_FRACTION,
             share_fraction: STITCH_SHARE_FRACTION,
         };

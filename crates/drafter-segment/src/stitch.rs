@@ -53,6 +53,11 @@ struct Segment {
 /// many cells is registered coarsely, in boxes of several cells).
 const MAX_PIECES: f64 = 1024.0;
 
+/// Cells holding more segments than this are not searched: many free edges through one small
+/// region (a fan of thousands of open slivers around a point) would make the search quadratic.
+/// Their points count as uncovered, so what meets there is not glued.
+const MAX_CELL_ENTRIES: usize = 256;
+
 /// Glues the open labels of `labelling` across cracks; `None` when nothing could be glued (fewer
 /// than two open labels, or no sealed one).
 pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &StitchLimits) -> Option<StitchOutcome> {
@@ -80,9 +85,16 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
     if region.is_empty() {
         return None;
     }
-    region.min -= tol + 1.0;
-    region.max += tol + 1.0;
-    let cell = (2.0 * median).max(4.0 * tol).max(region.diagonal() * 1e-6).max(f64::MIN_POSITIVE);
+    region.min -= tol;
+    region.max += tol;
+    // A segment is registered piece by piece; the cells double until the pieces stay within a
+    // budget linear in the number of segments (a few very long edges among short ones would
+    // otherwise be cut into millions of pieces).
+    let mut cell = (2.0 * median).max(4.0 * tol).max(f64::MIN_POSITIVE);
+    let budget = (8 * segments.len() + (1 << 20)) as f64;
+    while cell.is_finite() && lengths.iter().map(|&l| (l / cell).ceil().clamp(1.0, MAX_PIECES)).sum::<f64>() > budget {
+        cell *= 2.0;
+    }
     let max_coord = f64::from(u32::MAX - 1);
     let cell_of = |p: DVec3| {
         let c = ((p - region.min) / cell).floor().clamp(DVec3::ZERO, DVec3::splat(max_coord));
@@ -122,10 +134,11 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
         out.clear();
         let key = cell_of(p);
         let start = entries.partition_point(|e| e.0 < key);
-        for &(k, i) in &entries[start..] {
-            if k != key {
-                break;
-            }
+        let end = start + entries[start..].partition_point(|e| e.0 == key);
+        if end - start > MAX_CELL_ENTRIES {
+            return; // a crowded cell (many free edges through one point) is not searched
+        }
+        for &(_, i) in &entries[start..end] {
             let s = segments[i as usize];
             if s.label != own && point_segment_distance_squared(p, point(s.a), point(s.b)) <= tol2 {
                 out.push(s.label);

@@ -497,3 +497,23 @@ fn open_pieces_that_only_touch_are_not_glued() {
     );
     assert_eq!(sizes(&run(&single(mesh), SegmentMode::Auto)), vec![12, 2]);
 }
+
+#[test]
+fn thousands_of_open_slivers_through_one_point_are_not_searched_pairwise() {
+    // 20,000 separate triangles that share only their apex: 40,000 free edges through one point.
+    // Crowded cells are skipped, so this is linear; nothing seals anything.
+    let mut mesh = Mesh::default();
+    for i in 0..20_000u32 {
+        let a = i as f32 * 0.000_314;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend([
+            Vec3::ZERO,
+            Vec3::new(a.cos(), a.sin(), 0.1),
+            Vec3::new((a + 0.0002).cos(), (a + 0.0002).sin(), 0.1),
+        ]);
+        mesh.triangles.push([base, base + 1, base + 2]);
+    }
+    let (parts, diagnostics) = segment(&single(mesh), &SegmentOptions::default());
+    assert!(!parts.is_empty());
+    assert!(diagnostics.iter().all(|d| d.kind != drafter_core::DiagnosticKind::GluedCrack), "{diagnostics:?}");
+}
