@@ -12,6 +12,10 @@
 //! that a long segment touches a number of cells proportional to its length, not to its box's
 //! volume. A point is then tested only against the segments of its own cell. Nothing iterates a
 //! hash map and every list is sorted, so the result does not depend on the thread count.
+//!
+//! Hostile input stays linear: the tolerance is a fraction of the mesh's robust diagonal (a stray
+//! vertex far away does not count), the cells double until all pieces fit a budget of 8 per
+//! segment plus 2^20, and a cell with more than [`MAX_CELL_ENTRIES`] segments is not searched.
 
 use drafter_core::{Aabb, EDGE_NONE, Topology};
 use glam::DVec3;
