@@ -53,9 +53,10 @@ pub struct Args {
     /// Oriented-box method (overrides the config file).
     #[arg(long, value_enum)]
     pub obb: Option<ObbArg>,
-    /// Compress the file with EXT_meshopt_compression (lossless; .glb only; readers need the
-    /// extension: three.js with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress =
-    /// "meshopt"` in the config.
+    /// Compress the file with EXT_meshopt_compression (triangles reordered for the codecs, shading
+    /// normals rounded to 2^-10, positions exact; .glb only; readers need the extension: three.js
+    /// with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress = "meshopt"` in the
+    /// config.
     #[arg(long)]
     pub compress: bool,
     /// Skip the normal stage (keep the input's normals and vertex layout).

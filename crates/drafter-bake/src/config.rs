@@ -41,7 +41,7 @@
 //! specular = true
 //!
 //! [output]
-//! compress = "meshopt"       # "none" (default) or "meshopt": EXT_meshopt_compression, lossless, .glb only
+//! compress = "meshopt"       # "none" (default) or "meshopt": EXT_meshopt_compression, .glb only
 //!
 //! [[part]]                   # any number; `name` or `id` selects the part(s)
 //! name = "gear"
@@ -98,8 +98,9 @@ pub enum Compression {
     /// Plain buffers (the default): any glTF reader opens the file.
     #[default]
     None,
-    /// `EXT_meshopt_compression` on the buffer views where it pays, lossless (see
-    /// `drafter_core::meshopt`); readers need the extension (three.js with its MeshoptDecoder,
+    /// `EXT_meshopt_compression` on the buffer views where it pays (lossless codecs, see
+    /// `drafter_core::meshopt`), on a scene reordered for them with shading normals rounded
+    /// (`reorder.rs` in this crate); readers need the extension (three.js with its MeshoptDecoder,
     /// CesiumJS, gltfpack, our own). GLB output only.
     Meshopt,
 }

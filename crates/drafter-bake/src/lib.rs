@@ -20,6 +20,7 @@
 //! collected in part order).
 
 mod config;
+mod reorder;
 pub mod split;
 pub mod textures;
 
@@ -169,6 +170,15 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     if scene.instanced_triangle_count() == 0 {
         return Err(BakeError::Input("the scene has no triangles to bake".into()));
     }
+    // Compressed output: triangles and vertices in the orders the codecs compress best, before
+    // any stage, so that everything is computed on what the file holds (`reorder.rs`).
+    let reordered;
+    let scene = if config.compress == Compression::Meshopt && config.container == Container::Glb {
+        reordered = reorder::for_compression(scene);
+        &reordered
+    } else {
+        scene
+    };
     let mut stages = Vec::new();
     let mut timed =
         |name: &'static str, start: Instant| stages.push(StageTiming { name, ms: start.elapsed().as_secs_f64() * 1e3 });
@@ -179,7 +189,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
 
     // Welded topology of every mesh used by an instance, built once and shared by the stages.
     let start = begin("topology");
-    let topologies = build_topologies(scene, config.segment.weld);
+    let mut topologies = build_topologies(scene, config.segment.weld);
     timed("topology", start);
 
     let start = begin("segment");
@@ -202,13 +212,27 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
     // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
     let (splits, split_summary) = split::split_scene(scene, &vertex_data);
-    let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) {
+    let compressing = config.compress == Compression::Meshopt && config.container == Container::Glb;
+    let mut vertex_data = vertex_data;
+    let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) && !compressing {
         Cow::Borrowed(scene)
     } else {
         let mut copy = scene.clone();
         for (mesh, split) in copy.meshes.iter_mut().zip(&splits) {
             if let Some(split) = split {
                 mesh.groups = split.groups.clone();
+            }
+        }
+        if compressing {
+            for layout in vertex_data.iter_mut().flatten() {
+                reorder::round_normals(&mut layout.normals);
+            }
+            // Each triangle starts at the corner the index codec keeps (`reorder.rs`).
+            for ((mesh, layout), topology) in copy.meshes.iter_mut().zip(&mut vertex_data).zip(&mut topologies) {
+                if let Some(layout) = layout {
+                    let groups = mesh.groups.clone();
+                    reorder::settle_rotations(mesh, layout, topology, &groups);
+                }
             }
         }
         Cow::Owned(copy)

@@ -130,9 +130,12 @@ fn stored_hierarchies_answer_as_brute_force_over_the_decoded_file() {
     assert!(total >= 3);
 }
 
-/// `--compress` is lossless: the compressed file reads back to the same illustration data and
-/// the same imported scene as the plain one, and its hierarchies answer as brute force over what
-/// a reader decodes from it.
+/// `--compress` bakes the same triangles in the codecs' preferred order (vertex cache, first use,
+/// each triangle starting at the corner the index codec keeps) with `NORMAL` rounded to 2^-10: the
+/// compressed file holds the input's triangles (as position triples, up to order and rotation),
+/// the same parts, and the same numbers of silhouette, hard and hidden edges as a plain bake; its
+/// hierarchies answer as brute force over what a reader decodes from it. (That the codecs decode
+/// every view back exactly is checked view by view as the file is written.)
 #[test]
 fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
     let path = model("obj/common-3d-test-models/fandisk.obj");
@@ -146,13 +149,51 @@ fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
     assert!(stats.encoded_views > 0 && stats.encoded_bytes_after < stats.encoded_bytes_before, "{stats:?}");
     assert!(packed.written.main.len() < plain.written.main.len());
     assert_eq!(stats.file_bytes_after, packed.written.main.len() as u64);
+
     let read = |bytes: &[u8]| drafter_format::read(bytes, &|_| None).expect("reads");
-    assert_eq!(read(&packed.written.main), read(&plain.written.main));
+    let (a, b) = (read(&packed.written.main), read(&plain.written.main));
+    let parts = |f: &drafter_format::BakedFile| -> Vec<(String, u32)> {
+        f.parts().iter().map(|p| (p.name.clone(), p.triangles)).collect()
+    };
+    assert_eq!(parts(&a), parts(&b));
+    // Edge values 0..=3 counted over every written triangle edge.
+    let values = |f: &drafter_format::BakedFile| {
+        let mut count = [0usize; 4];
+        for (_, _, e) in &f.primitive_edges {
+            for byte in &e.visibility {
+                for k in 0..4 {
+                    count[usize::from(byte >> (2 * k) & 3)] += 1;
+                }
+            }
+        }
+        count
+    };
+    let (va, vb) = (values(&a), values(&b));
+    assert_eq!(va[1..], vb[1..], "silhouette, hard and repeated hard edges");
+
     let scene = |bytes: &[u8]| drafter_io::import_bytes(Path::new("baked.glb"), bytes).expect("imports").scene;
-    let (a, b) = (scene(&packed.written.main), scene(&plain.written.main));
-    assert_eq!(a.meshes.len(), b.meshes.len());
-    for (x, y) in a.meshes.iter().zip(&b.meshes) {
-        assert_eq!((&x.positions, &x.triangles, &x.normals), (&y.positions, &y.triangles, &y.normals));
+    let (sa, sb) = (scene(&packed.written.main), scene(&plain.written.main));
+    // The same triangles as the input (position triples, up to order and rotation).
+    let triangles = |scene: &drafter_core::Scene| {
+        let mut out: Vec<[[u32; 3]; 3]> = Vec::new();
+        for mesh in &scene.meshes {
+            out.extend(mesh.triangles.iter().map(|t| {
+                let p = t.map(|v| mesh.positions[v as usize].to_array().map(f32::to_bits));
+                let first = (0..3).min_by_key(|&k| p[k]).unwrap_or(0);
+                [p[first], p[(first + 1) % 3], p[(first + 2) % 3]]
+            }));
+        }
+        out.sort_unstable();
+        out
+    };
+    let input = triangles(&imported.scene);
+    assert!(input == triangles(&sa) && input == triangles(&sb), "the baked triangles are the input's");
+    // NORMAL is rounded to 2^-10 in the compressed file, and stays a unit vector.
+    for mesh in &sa.meshes {
+        for n in mesh.normals.iter().flatten() {
+            assert!(n.to_array().iter().all(|c| (c * 1024.0).fract() == 0.0), "{n}");
+            assert!((n.length() - 1.0).abs() < 2e-3, "{n}");
+        }
     }
     assert!(check(&path, drafter_bake::Compression::Meshopt) > 0);
 }
