@@ -26,7 +26,7 @@ pub(crate) fn for_compression(scene: &Scene) -> Scene {
 /// Triangle ranges of `mesh`'s groups (one range of all triangles when it has none).
 fn triangle_ranges(mesh: &Mesh) -> Vec<std::ops::Range<usize>> {
     if mesh.groups.is_empty() {
-        return vec![0..mesh.triangles.len()];
+        return std::iter::once(0..mesh.triangles.len()).collect();
     }
     mesh.groups
         .iter()
