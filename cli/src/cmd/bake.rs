@@ -54,8 +54,8 @@ pub struct Args {
     #[arg(long, value_enum)]
     pub obb: Option<ObbArg>,
     /// Compress the file with EXT_meshopt_compression (triangles reordered for the codecs, shading
-    /// normals rounded to 2^-10, positions exact; .glb only; readers need the extension: three.js
-    /// with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress = "meshopt"` in the
+    /// normals as bytes with KHR_mesh_quantization, positions exact; .glb only; readers need the
+    /// extensions: three.js with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress = "meshopt"` in the
     /// config.
     #[arg(long)]
     pub compress: bool,

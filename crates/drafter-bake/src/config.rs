@@ -99,8 +99,8 @@ pub enum Compression {
     #[default]
     None,
     /// `EXT_meshopt_compression` on the buffer views where it pays (lossless codecs, see
-    /// `drafter_core::meshopt`), on a scene reordered for them with shading normals rounded
-    /// (`reorder.rs` in this crate); readers need the extension (three.js with its MeshoptDecoder,
+    /// `drafter_core::meshopt`), on a scene reordered for them (`reorder.rs` in this crate), with
+    /// shading normals as bytes (`KHR_mesh_quantization`); readers need the extension (three.js with its MeshoptDecoder,
     /// CesiumJS, gltfpack, our own). GLB output only.
     Meshopt,
 }

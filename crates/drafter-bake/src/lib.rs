@@ -224,9 +224,6 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
             }
         }
         if compressing {
-            for layout in vertex_data.iter_mut().flatten() {
-                reorder::round_normals(&mut layout.normals);
-            }
             // Each triangle starts at the corner the index codec keeps (`reorder.rs`).
             for ((mesh, layout), topology) in copy.meshes.iter_mut().zip(&mut vertex_data).zip(&mut topologies) {
                 if let Some(layout) = layout {
@@ -302,6 +299,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         primitive_edges,
         mesh_silhouettes,
         textures: embedded,
+        quantized_normals: compressing,
     };
     let written = drafter_format::write(&output, &config.container).map_err(|e| match e {
         // The input's own JSON that cannot be carried over (a number beyond f64, nesting deeper

@@ -200,18 +200,3 @@ fn first_use_stream(triangles: &[[u32; 3]]) -> Vec<u32> {
         })
         .collect()
 }
-
-/// Spacing of the grid `NORMAL` components are rounded to in a compressed file: 2^-10, so that a
-/// float component keeps at most 10 bits below its leading one and its low mantissa bytes are
-/// zero, which the vertex codec stores in almost nothing. A component moves by at most 2^-11
-/// (under 0.06° of direction, against gltfpack's 8-bit normals at 0.4°); the length stays within
-/// 0.1% of 1, inside the validator's tolerance for unit vectors (0.674%).
-const NORMAL_STEP: f32 = 1.0 / 1024.0;
-
-/// Rounds `NORMAL` components for compression (see [`NORMAL_STEP`]). Only the shading normals a
-/// plain client reads are rounded; nothing the bake computes depends on them.
-pub(crate) fn round_normals(normals: &mut [[f32; 3]]) {
-    for n in normals {
-        *n = n.map(|c| (c / NORMAL_STEP).round() * NORMAL_STEP);
-    }
-}

@@ -31,5 +31,8 @@ pub use ids::{EdgeId, InstanceId, MaterialId, MeshId, NodeId, PartId};
 pub use obb_method::ObbMethod;
 pub use param::ParamError;
 pub use scene::{Aabb, Instance, Material, Mesh, Node, Scene, SourceDocument, SourceFormat, TriangleGroup};
-pub use snorm::{snorm8_decode, snorm8_encode, snorm8_encode_direction, snorm16_decode, snorm16_encode};
+pub use snorm::{
+    VALIDATOR_UNIT_TOLERANCE, snorm8_decode, snorm8_encode, snorm8_encode_direction, snorm8_encode_unit,
+    snorm16_decode, snorm16_encode,
+};
 pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld, robust_diagonal};

@@ -57,6 +57,44 @@ pub fn snorm8_encode_direction(n: Vec3) -> [i8; 3] {
     best.1
 }
 
+/// The glTF validator's tolerance for unit vectors (`ACCESSOR_VECTOR3_NON_UNIT`): the decoded
+/// length may differ from 1 by at most this much.
+pub const VALIDATOR_UNIT_TOLERANCE: f32 = 0.00674;
+
+/// A unit vector as normalized signed bytes that a validator accepts as unit length, for a
+/// quantized `NORMAL` (`KHR_mesh_quantization`): of the 27 lattice points around `127·n` whose
+/// length is within 0.84 of 127 (decoded: within 0.0066 of 1, inside
+/// [`VALIDATOR_UNIT_TOLERANCE`]; per-component rounding and [`snorm8_encode_direction`] can land
+/// up to 0.0068 away), the one with the largest cosine to `n` (ties: the first in x-slowest,
+/// low-before-high order). If no such point exists, which the tests have not found for any
+/// direction, [`snorm8_encode_direction`]. A non-finite or zero `n` encodes as [`snorm8_encode`].
+pub fn snorm8_encode_unit(n: Vec3) -> [i8; 3] {
+    const LENGTH_TOLERANCE: f64 = 0.84;
+    if !n.is_finite() || n == Vec3::ZERO {
+        return snorm8_encode(n);
+    }
+    let n = n.as_dvec3().normalize();
+    let centre = (n * 127.0).round();
+    let mut best: Option<(f64, [i8; 3])> = None;
+    for dx in -1..=1 {
+        for dy in -1..=1 {
+            for dz in -1..=1 {
+                let c = (centre + glam::DVec3::new(f64::from(dx), f64::from(dy), f64::from(dz)))
+                    .clamp(glam::DVec3::splat(-127.0), glam::DVec3::splat(127.0));
+                let length = c.length();
+                if length == 0.0 || (length - 127.0).abs() > LENGTH_TOLERANCE {
+                    continue;
+                }
+                let cos = c.dot(n) / length;
+                if best.is_none_or(|(b, _)| cos > b) {
+                    best = Some((cos, [c.x as i8, c.y as i8, c.z as i8]));
+                }
+            }
+        }
+    }
+    best.map_or_else(|| snorm8_encode_direction(n.as_vec3()), |b| b.1)
+}
+
 /// What a glTF reader decodes from normalized signed bytes: `max(c / 127, −1)` per component
 /// (glTF 2.0 §3.11). Not renormalised.
 pub fn snorm8_decode(c: [i8; 3]) -> Vec3 {
@@ -147,5 +185,34 @@ mod tests {
         assert!(direction < 0.9 * plain, "mean error {direction} against {plain}");
         assert_eq!(snorm8_encode_direction(Vec3::Z), [0, 0, 127]);
         assert_eq!(snorm8_encode_direction(Vec3::ZERO), [0, 0, 0]);
+    }
+
+    #[test]
+    fn unit_bytes_pass_the_validator_and_point_the_right_way() {
+        let mut s = 11u64;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut worst = 0.0f32;
+        for k in 0..200_000 {
+            let n = match k {
+                0..6 => [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z][k],
+                6..14 => Vec3::new(
+                    if k & 1 == 0 { 1.0 } else { -1.0 },
+                    if k & 2 == 0 { 1.0 } else { -1.0 },
+                    if k & 4 == 0 { 1.0 } else { -1.0 },
+                )
+                .normalize(),
+                _ => Vec3::new(r(), r(), r()).normalize_or(Vec3::X),
+            };
+            let d = snorm8_decode(snorm8_encode_unit(n));
+            assert!((d.length() - 1.0).abs() <= VALIDATOR_UNIT_TOLERANCE, "{n}: {d} has length {}", d.length());
+            worst = worst.max(n.angle_between(d).to_degrees());
+        }
+        // Within a lattice step of the best direction: below 0.7°.
+        assert!(worst < 0.7, "worst angle {worst}°");
     }
 }

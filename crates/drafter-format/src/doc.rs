@@ -499,6 +499,15 @@ impl Doc {
         }
     }
 
+    /// Adds `name` to `extensionsUsed` and `extensionsRequired`, once each.
+    pub fn require_extension(&mut self, name: &str) {
+        self.use_extension(name);
+        let required = self.array_mut("extensionsRequired");
+        if !required.iter().any(|v| v.as_str() == Some(name)) {
+            required.push(Value::String(name.to_owned()));
+        }
+    }
+
     /// Adds `name` to `extensionsUsed` once.
     pub fn use_extension(&mut self, name: &str) {
         let used = self.array_mut("extensionsUsed");

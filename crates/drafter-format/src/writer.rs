@@ -39,7 +39,15 @@ pub struct BakeOutput<'a> {
     pub mesh_silhouettes: Vec<Option<MeshSilhouettes>>,
     /// The NPR lookup textures to embed (`None`: none).
     pub textures: Option<EmbeddedTextures>,
+    /// Write the new layouts' `NORMAL` as normalized bytes (`KHR_mesh_quantization`, then listed
+    /// as required), each within the validator's unit tolerance
+    /// (`drafter_core::snorm8_encode_unit`); for compressed files, whose readers need an
+    /// extension anyway. `false`: FLOAT.
+    pub quantized_normals: bool,
 }
+
+/// The extension that allows normalized-integer `NORMAL`s.
+pub const MESH_QUANTIZATION_EXTENSION: &str = "KHR_mesh_quantization";
 
 /// PNG images to embed and the extension's record of them. The record's indices are positions in
 /// `images`; the writer appends the images after the input's own `images`/`textures` and rewrites
@@ -297,16 +305,28 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             let primitive = primitive_of[g];
             let mut enhanced_normal = None;
             let relaid = match &out.vertex_data[m] {
-                Some(vd) => match write_vertex_data(&mut doc, mesh, m, primitive, group, vd, from_source) {
-                    Ok(()) => {
-                        enhanced_normal = Some(ENHANCED_NORMAL_ATTRIBUTE.to_owned());
-                        true
+                Some(vd) => {
+                    match write_vertex_data(
+                        &mut doc,
+                        mesh,
+                        (m, primitive),
+                        group,
+                        vd,
+                        (from_source, out.quantized_normals),
+                    ) {
+                        Ok(()) => {
+                            if out.quantized_normals {
+                                doc.require_extension(MESH_QUANTIZATION_EXTENSION);
+                            }
+                            enhanced_normal = Some(ENHANCED_NORMAL_ATTRIBUTE.to_owned());
+                            true
+                        }
+                        Err(reason) => {
+                            notes.push(format!("mesh {m} primitive {primitive}: normals not written ({reason})"));
+                            false
+                        }
                     }
-                    Err(reason) => {
-                        notes.push(format!("mesh {m} primitive {primitive}: normals not written ({reason})"));
-                        false
-                    }
-                },
+                }
                 None => false,
             };
             if !relaid {
@@ -445,11 +465,10 @@ fn write_textures(doc: &mut Doc, textures: &EmbeddedTextures) -> Result<Textures
 fn write_vertex_data(
     doc: &mut Doc,
     mesh: &Mesh,
-    m: usize,
-    primitive: usize,
+    (m, primitive): (usize, usize),
     group: &TriangleGroup,
     vd: &VertexData,
-    from_source: bool,
+    (from_source, quantized_normals): (bool, bool),
 ) -> Result<(), String> {
     let range = group.start as usize..(group.start + group.count) as usize;
     let mut local_of = vec![u32::MAX; vd.source_vertex.len()];
@@ -490,7 +509,13 @@ fn write_vertex_data(
     let normals: Vec<[f32; 3]> = picks.iter().map(|&(o, _)| vd.normals[o as usize]).collect();
     let enhanced: Vec<[f32; 3]> = picks.iter().map(|&(o, _)| vd.enhanced[o as usize]).collect();
     attributes.insert("POSITION".into(), doc.push_vec3(&positions, true).into());
-    attributes.insert("NORMAL".into(), doc.push_vec3(&normals, false).into());
+    let normal = if quantized_normals {
+        let bytes: Vec<[i8; 3]> = normals.iter().map(|&n| drafter_core::snorm8_encode_unit(n.into())).collect();
+        doc.push_snorm8_attribute(&bytes)
+    } else {
+        doc.push_vec3(&normals, false)
+    };
+    attributes.insert("NORMAL".into(), normal.into());
     // Normalized bytes (stride 4): a quarter of FLOAT, within 0.4° (what gltfpack gives NORMAL).
     let enhanced: Vec<[i8; 3]> = enhanced.iter().map(|&n| drafter_core::snorm8_encode(n.into())).collect();
     attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_attribute(&enhanced).into());

@@ -122,6 +122,7 @@ fn write(textures: Option<EmbeddedTextures>) -> Result<Vec<u8>, FormatError> {
         primitive_edges: vec![vec![]],
         mesh_silhouettes: vec![None],
         textures,
+        quantized_normals: false,
     };
     Ok(drafter_format::write(&out, &Container::Glb)?.main)
 }
