@@ -15,7 +15,73 @@ pub fn all(report: &SweepReport) -> Vec<(&'static str, Figure)> {
         out.push(("segmentation_contacts", segmentation_contacts(report)));
     }
     out.push(("bake", bake(report)));
+    if let Some(f) = quantization(report) {
+        out.push(("quantization", f));
+    }
     out
+}
+
+/// Issue 19: what each byte of the silhouette normals buys (see `crate::quantization`).
+pub fn quantization(report: &SweepReport) -> Option<Figure> {
+    let q = report.quantization.as_ref()?;
+    let label = |bits: u32| match bits {
+        32 => "f32".to_owned(),
+        crate::quantization::SHIPPED_BITS => format!("{bits} (shipped)"),
+        _ => bits.to_string(),
+    };
+    let categories: Vec<String> = q.points.iter().map(|p| label(p.bits)).collect();
+    let at = |f: &dyn Fn(&crate::quantization::QuantizationPoint) -> f64| -> Vec<(f64, f64)> {
+        q.points.iter().enumerate().map(|(i, p)| (i as f64, f(p))).collect()
+    };
+    let positive = |v: Vec<(f64, f64)>| v.into_iter().filter(|p| p.1 > 0.0).collect::<Vec<_>>();
+    let x_label = "bits per component of the stored silhouette normals".to_owned();
+    let bytes = Panel {
+        title: format!("bytes of {} silhouette normals (two per candidate edge)", thousands(2 * q.candidates)),
+        x_label: x_label.clone(),
+        y_label: "MB".into(),
+        categories: categories.clone(),
+        series: vec![
+            Series::new("as stored (tightly packed)", Kind::Bars, 1, at(&|p| p.raw_bytes as f64 / 1e6)),
+            Series::new(
+                "through meshoptimizer (--compress)",
+                Kind::BigPoints,
+                0,
+                at(&|p| p.encoded_bytes as f64 / 1e6),
+            ),
+        ],
+        headroom: 0.25,
+        y_from_zero: true,
+        ..Panel::default()
+    };
+    let error = Panel {
+        title: "angle to the f32 face normal".into(),
+        x_label: x_label.clone(),
+        y_label: "degrees (log)".into(),
+        y_log: true,
+        categories: categories.clone(),
+        series: vec![
+            Series::new("mean", Kind::BigPoints, 0, positive(at(&|p| p.mean_error_deg))),
+            Series::new("largest", Kind::BigPoints, 1, positive(at(&|p| p.max_error_deg))),
+        ],
+        headroom: 0.25,
+        ..Panel::default()
+    };
+    let agreement = Panel {
+        title: format!("silhouette decisions that differ from the f32 normals' ({} orthographic views)", q.views),
+        x_label,
+        y_label: "per million candidate-views (log)".into(),
+        y_log: true,
+        categories,
+        series: vec![Series::new("differing", Kind::BigPoints, 0, positive(at(&|p| p.disagreement_ppm)))],
+        headroom: 0.25,
+        ..Panel::default()
+    };
+    Some(Figure {
+        title: format!("{}: bytes against accuracy of the silhouette normals", model(report)),
+        columns: 1,
+        size: (1400, 1500),
+        panels: vec![bytes, error, agreement],
+    })
 }
 
 fn model(report: &SweepReport) -> String {

@@ -11,6 +11,7 @@ pub mod assemblies;
 pub mod chart;
 pub mod figures;
 pub mod generate;
+pub mod quantization;
 pub mod sweep;
 
 use std::path::Path;

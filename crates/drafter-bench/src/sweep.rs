@@ -96,6 +96,9 @@ pub struct SweepReport {
     pub silhouettes: Option<SilhouetteSweep>,
     pub segmentation: SegmentSweep,
     pub bake: BakeSweep,
+    /// Bytes against accuracy of the silhouette normals (issue 19).
+    #[serde(default)]
+    pub quantization: Option<crate::quantization::QuantizationSweep>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -123,9 +126,21 @@ pub fn run(scene: &Scene, name: &str, options: &SweepOptions, progress: &mut dyn
     let obb = sweep_obb(scene, options, progress);
     let normals = sweep_normals(&topologies, progress);
     let silhouettes = sweep_silhouettes(&topologies, options, progress);
+    progress.stage("quantization", 1);
+    let quantization = crate::quantization::sweep_quantization(&topologies, options.views, options.seed);
+    progress.tick();
     let segmentation = sweep_segmentation(scene, &topologies, progress);
     let bake = sweep_bake(scene, progress);
-    SweepReport { model, threads: rayon::current_num_threads(), obb, normals, silhouettes, segmentation, bake }
+    SweepReport {
+        model,
+        threads: rayon::current_num_threads(),
+        obb,
+        normals,
+        silhouettes,
+        segmentation,
+        bake,
+        quantization,
+    }
 }
 
 fn used_meshes(scene: &Scene) -> Vec<bool> {
