@@ -118,14 +118,19 @@ pub fn snorm16_decode(c: [i16; 3]) -> Vec3 {
 mod tests {
     use super::*;
 
-    fn worst_error_deg(round_trip: impl Fn(Vec3) -> Vec3) -> f32 {
-        let mut s = 3u64;
-        let mut r = move || {
+    /// xorshift64: uniform values in [−1, 1).
+    fn uniform(seed: u64) -> impl FnMut() -> f32 {
+        let mut s = seed;
+        move || {
             s ^= s << 13;
             s ^= s >> 7;
             s ^= s << 17;
             (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        }
+    }
+
+    fn worst_error_deg(round_trip: impl Fn(Vec3) -> Vec3) -> f32 {
+        let mut r = uniform(3);
         let mut worst = 0.0f32;
         for k in 0..20000 {
             let n = match k {
@@ -164,15 +169,9 @@ mod tests {
             let back = snorm8_decode(c).as_dvec3().normalize();
             n.as_dvec3().normalize().dot(back).clamp(-1.0, 1.0).acos().to_degrees()
         };
-        let mut s = 11u64;
+        let mut r = uniform(11);
         let (mut plain, mut direction) = (0.0, 0.0);
         for _ in 0..20000 {
-            let mut r = || {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-            };
             let Some(n) = Vec3::new(r(), r(), r()).try_normalize() else { continue };
             let (a, b) = (angle(n, snorm8_encode(n)), angle(n, snorm8_encode_direction(n)));
             assert!(b <= a + 1e-9, "{n}: {b}° against {a}°");
@@ -189,13 +188,7 @@ mod tests {
 
     #[test]
     fn unit_bytes_pass_the_validator_and_point_the_right_way() {
-        let mut s = 11u64;
-        let mut r = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut r = uniform(11);
         let mut worst = 0.0f32;
         for k in 0..200_000 {
             let n = match k {
