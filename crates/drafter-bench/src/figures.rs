@@ -38,7 +38,7 @@ pub fn quantization(report: &SweepReport) -> Option<Figure> {
     let bytes = Panel {
         title: format!("bytes of {} silhouette normals (two per candidate edge)", thousands(2 * q.candidates)),
         x_label: x_label.clone(),
-        y_label: "MB".into(),
+        y_label: "bytes (MB)".into(),
         categories: categories.clone(),
         series: vec![
             Series::new("as stored (tightly packed)", Kind::Bars, 1, at(&|p| p.raw_bytes as f64 / 1e6)),

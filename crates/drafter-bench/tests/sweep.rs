@@ -67,7 +67,17 @@ fn sweeps_of_the_sample_assembly_are_consistent() {
     // Charts: one per stage, each with its title and axis units.
     let figures = drafter_bench::figures::all(&report);
     let stems: Vec<&str> = figures.iter().map(|f| f.0).collect();
-    assert_eq!(stems, ["obb", "normals", "silhouettes", "segmentation", "segmentation_contacts", "bake"]);
+    assert_eq!(
+        stems,
+        ["obb", "normals", "silhouettes", "segmentation", "segmentation_contacts", "bake", "quantization"]
+    );
+
+    // Quantization (issue 19): every width measured; f32 loses nothing, fewer bits lose more.
+    let q = report.quantization.as_ref().expect("the sample has silhouette candidates");
+    assert_eq!(q.points.iter().map(|p| p.bits).collect::<Vec<_>>(), drafter_bench::quantization::QUANTIZATION_BITS);
+    let last = q.points.last().expect("f32");
+    assert_eq!((last.mean_error_deg, last.disagreement_ppm), (0.0, 0.0));
+    assert!(q.points.windows(2).all(|w| w[1].mean_error_deg < w[0].mean_error_deg), "{:?}", q.points);
     for (stem, figure) in &figures {
         let svg = drafter_bench::chart::to_svg(figure).expect("draws");
         if *stem == "segmentation_contacts" {
