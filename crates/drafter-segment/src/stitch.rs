@@ -14,8 +14,10 @@
 //! hash map and every list is sorted, so the result does not depend on the thread count.
 //!
 //! Hostile input stays linear: the tolerance is a fraction of the mesh's robust diagonal (a stray
-//! vertex far away does not count), the cells double until all pieces fit a budget of 8 per
-//! segment plus 2^20, and a cell with more than [`MAX_CELL_ENTRIES`] segments is not searched.
+//! vertex far away does not count), the cells double until all pieces fit a budget of 4 per
+//! segment plus 2^16 (each piece touches at most 27 cells), the cells are never finer than 2^-30
+//! of the free edges' extent, and a cell with more than [`MAX_CELL_ENTRIES`] segments is not
+//! searched.
 
 use drafter_core::{Aabb, EDGE_NONE, Topology};
 use glam::DVec3;
@@ -53,9 +55,9 @@ struct Segment {
     b: u32,
 }
 
-/// Largest number of pieces one segment is split into for the grid (a segment longer than this
-/// many cells is registered coarsely, in boxes of several cells).
-const MAX_PIECES: f64 = 1024.0;
+/// Cells per axis at most (the cell is at least the free edges' box diagonal over this), so that
+/// cell coordinates stay far inside `u32`.
+const MAX_CELLS_PER_AXIS: f64 = (1u64 << 30) as f64;
 
 /// Cells holding more segments than this are not searched: many free edges through one small
 /// region (a fan of thousands of open slivers around a point) would make the search quadratic.
@@ -91,12 +93,17 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
     }
     region.min -= tol;
     region.max += tol;
-    // A segment is registered piece by piece; the cells double until the pieces stay within a
-    // budget linear in the number of segments (a few very long edges among short ones would
-    // otherwise be cut into millions of pieces).
-    let mut cell = (2.0 * median).max(4.0 * tol).max(f64::MIN_POSITIVE);
-    let budget = (8 * segments.len() + (1 << 20)) as f64;
-    while cell.is_finite() && lengths.iter().map(|&l| (l / cell).ceil().clamp(1.0, MAX_PIECES)).sum::<f64>() > budget {
+    // A segment is registered piece by piece, each piece at most a cell long, so that with the
+    // tolerance at most a quarter cell a piece touches at most 3 cells per axis. The cells double
+    // until the pieces fit a budget linear in the segments (a few very long edges among short ones
+    // would otherwise be cut into millions of pieces), so the entries are at most 27 times that.
+    let extent = region.diagonal();
+    if !extent.is_finite() {
+        return None;
+    }
+    let mut cell = (2.0 * median).max(4.0 * tol).max(extent / MAX_CELLS_PER_AXIS).max(f64::MIN_POSITIVE);
+    let budget = (4 * segments.len() + (1 << 16)) as f64;
+    while lengths.iter().map(|&l| (l / cell).ceil().max(1.0)).sum::<f64>() > budget {
         cell *= 2.0;
     }
     let max_coord = f64::from(u32::MAX - 1);
@@ -110,7 +117,7 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
         .with_min_len(1024)
         .fold(Vec::new, |mut out, (i, s)| {
             let (p, q) = (point(s.a), point(s.b));
-            let pieces = (p.distance(q) / cell).ceil().clamp(1.0, MAX_PIECES);
+            let pieces = (p.distance(q) / cell).ceil().max(1.0);
             let n = pieces as u32;
             for k in 0..n {
                 let (x, y) = (p.lerp(q, f64::from(k) / pieces), p.lerp(q, f64::from(k + 1) / pieces));

@@ -517,3 +517,18 @@ fn thousands_of_open_slivers_through_one_point_are_not_searched_pairwise() {
     assert!(!parts.is_empty());
     assert!(diagnostics.iter().all(|d| d.kind != drafter_core::DiagnosticKind::GluedCrack), "{diagnostics:?}");
 }
+
+#[test]
+fn one_long_free_edge_among_tiny_ones_does_not_blow_up_the_grid() {
+    // Found by the fuzz campaign: 300 separate triangles a nanometre wide near the origin and one
+    // large triangle. The grid cell follows the tiny edges; the large triangle's edges must still
+    // touch a bounded number of cells (they once asked for 8 GB).
+    let mut mesh = Mesh::default();
+    for i in 0..300u32 {
+        let o = Vec3::new(i as f32 * 3e-9, 0.0, 0.0);
+        add_polygon(&mut mesh, &[o, o + Vec3::new(1e-9, 0.0, 0.0), o + Vec3::new(0.0, 1e-9, 0.0)]);
+    }
+    add_polygon(&mut mesh, &[Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 0.0)]);
+    let (parts, _) = segment(&single(mesh), &SegmentOptions::default());
+    assert!(!parts.is_empty());
+}
