@@ -93,8 +93,8 @@ pub struct SilhouetteIndex {
     candidate_edges: Vec<u32>,
     normals: Vec<[Vec3; 2]>,
     points: Vec<Vec3>,
-    /// Built on first use: a reader whose file stores both hierarchies never needs it (on the
-    /// dragon, 47 MB and 50 ms of load saved).
+    /// Built on first use: a reader whose file stores both hierarchies never needs it (an SoA
+    /// copy of every candidate's normals and point).
     brute: std::sync::OnceLock<BruteForce>,
     gauss: Option<GaussMapHierarchy>,
     bvh: Option<ConeBvh>,

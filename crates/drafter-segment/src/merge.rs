@@ -144,20 +144,9 @@ pub(crate) fn merge_small(topo: &Topology, labelling: &Labelling, limits: &Merge
         outcome.merged += 1;
     }
     // Renumber in order of first triangle.
-    let mut label_of_root = vec![u32::MAX; k];
-    let mut next = 0u32;
-    outcome.labels = labels
-        .iter()
-        .map(|&l| {
-            let r = uf.find(l) as usize;
-            if label_of_root[r] == u32::MAX {
-                label_of_root[r] = next;
-                next += 1;
-            }
-            label_of_root[r]
-        })
-        .collect();
-    outcome.count = next;
+    let (new_of, count) = uf.relabel_by_first(labels);
+    outcome.labels = labels.iter().map(|&l| new_of[l as usize]).collect();
+    outcome.count = count;
     outcome
 }
 

@@ -217,20 +217,9 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
         return None;
     }
     // New labels in order of first face.
-    let mut label_of_root = vec![u32::MAX; k];
-    let mut count = 0u32;
-    let new_labels: Vec<u32> = labels
-        .iter()
-        .map(|&l| {
-            let r = uf.find(l) as usize;
-            if label_of_root[r] == u32::MAX {
-                label_of_root[r] = count;
-                count += 1;
-            }
-            label_of_root[r]
-        })
-        .collect();
-    let mut group_of = |l: u32| label_of_root[uf.find(l) as usize];
+    let (new_of, count) = uf.relabel_by_first(labels);
+    let new_labels: Vec<u32> = labels.iter().map(|&l| new_of[l as usize]).collect();
+    let group_of = |l: u32| new_of[l as usize];
     // A glued set stays open where one of its free segments is not covered by its own pieces;
     // a label that was closed stays closed.
     let mut open = vec![false; count as usize];

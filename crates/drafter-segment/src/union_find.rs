@@ -37,6 +37,24 @@ impl UnionFind {
         lo
     }
 
+    /// For a union-find over labels: the new label of each old label, numbered `0..count` in order
+    /// of the first element of `per_face` (each face's old label) whose set it is, and the count.
+    /// How merging and crack gluing renumber their sets in order of first face.
+    pub(crate) fn relabel_by_first(&mut self, per_face: &[u32]) -> (Vec<u32>, u32) {
+        let n = self.parent.len();
+        let mut of_root = vec![u32::MAX; n];
+        let mut count = 0u32;
+        for &l in per_face {
+            let r = self.find(l) as usize;
+            if of_root[r] == u32::MAX {
+                of_root[r] = count;
+                count += 1;
+            }
+        }
+        let new_of = (0..n as u32).map(|l| of_root[self.find(l) as usize]).collect();
+        (new_of, count)
+    }
+
     /// Dense labels `0..count` numbered in order of each set's smallest element, and the count.
     pub(crate) fn labels(mut self) -> (Vec<u32>, u32) {
         let n = self.parent.len();
