@@ -538,6 +538,9 @@ struct Arc {
     n1: DVec3,
     n2: DVec3,
     id: u32,
+    /// A lower bound on the visit probability of any node holding the arc ([`StopRule`]'s
+    /// `p_a`), in the record's padding.
+    p: f32,
 }
 
 impl Arc {
@@ -631,10 +634,12 @@ fn arc_records(normals: &[[Vec3; 2]]) -> Vec<Arc> {
     normals
         .par_iter()
         .enumerate()
-        .map(|(id, &[a, b])| Arc {
-            n1: a.as_dvec3().normalize_or_zero(),
-            n2: b.as_dvec3().normalize_or_zero(),
-            id: id as u32,
+        .map(|(id, &[a, b])| {
+            let (n1, n2) = (a.as_dvec3().normalize_or_zero(), b.as_dvec3().normalize_or_zero());
+            // The visit probability bound of `StopRule`, rounded down.
+            let p = ((n1 - n2).length() * 0.5 + CULL_MARGIN).min(1.0);
+            let p32 = p as f32;
+            Arc { n1, n2, id: id as u32, p: if f64::from(p32) > p { p32.next_down() } else { p32 } }
         })
         .collect()
 }
@@ -646,12 +651,15 @@ struct BuildNode {
     /// End of the subtree's arcs in the final arc order.
     sub_end: u32,
     children: Vec<u32>,
-    cell_center: Option<DVec3>,
     /// The cell's digits: base face, then one digit per 4:1 split (unpadded; 0 for the root).
     key: u32,
-    /// Whether the arcs were offered to the children (false at `max_depth` and at a stored leaf,
-    /// where the bin rule might have taken them further).
+    /// Whether the arcs were offered to the children (false at `max_depth`, at a stored leaf and
+    /// where the build stopped because collapsing is optimal, where the bin rule might have taken
+    /// them further).
     tried: bool,
+    /// The cap over the subtree's endpoints ([`cap_of`]); zero when the caller does not
+    /// need caps (a reader's guided assignment).
+    cap: [f32; 4],
 }
 
 /// Subtrees holding more arcs than this are built on the thread pool (one task per child cell)
@@ -671,6 +679,85 @@ struct Builder {
     bins: Bins,
     max_depth: u8,
     base: Vec<Cell>,
+    /// Compute each node's cap (a build; a reader's guided assignment needs none).
+    caps: bool,
+    /// Stop descending where collapsing the subtree is provably the cheapest choice of the
+    /// cost-model pruning (see [`StopRule`]); `None` builds to `max_depth`.
+    stop: Option<StopRule>,
+}
+
+/// The pruning's costs (see [`GaussMapHierarchy::build_with_cells`]), used during the build to
+/// stop where the pruning would collapse whatever was built below.
+///
+/// A node with visit probability `p` over `n` arcs costs `p · (enter + range + block · ⌈n/4⌉)`
+/// collapsed. Let `p_a` be a lower bound on the visit probability of any node holding arc `a`: a
+/// cap holding both endpoints has a radius of at least half the arc, so its threshold is at least
+/// `sin(θ/2) + ε = |n1 − n2| / 2 + ε` (or the whole sphere, 1). Any split of the node then costs at
+/// least
+/// * `p · (enter + test)`: it is entered and tests at least one child;
+/// * `min(p · range, (enter + range) · max p_a)`: the arc of largest `p_a` is tested either among
+///   the node's own arcs or in a descendant that is entered;
+/// * `block · max(max p_a, Σ p_a / 4)`: every arc is tested in some block of 4, and the arc of
+///   largest `p_a` in a block of its own at worst.
+///
+/// Where the collapsed cost is not above that bound, the bottom-up pruning collapses the node
+/// whatever its subtree, so the build does not make the subtree. On the dragon (1.3M arcs) this skips most of
+/// the 300k nodes below level 6 that the pruning threw away, with the same stored tree.
+#[derive(Clone, Copy)]
+struct StopRule {
+    enter: f64,
+    test: f64,
+    range: f64,
+    block: f64,
+}
+
+/// Chunk of arcs whose endpoint sum is one partial sum of [`subtree_cap`]: sums in fixed chunks,
+/// added in order, give the same bits on any number of threads.
+const CAP_CHUNK: usize = 4096;
+
+/// What [`subtree_cap`] measures of a node's arcs.
+struct Measured {
+    cap: [f32; 4],
+    /// `Σ p_a` and `max p_a` of [`StopRule`].
+    p_sum: f64,
+    p_max: f64,
+}
+
+/// [`cap_of`] over the endpoints of `arcs` (centred on the cell or on the endpoints' mean,
+/// whichever is tighter), and the arcs' probability bounds of [`StopRule`]. Large nodes are
+/// measured on the thread pool, with the same result: the mean is summed in fixed chunks and the
+/// widest angle is an exact maximum.
+fn subtree_cap(arcs: &[Arc], cell_center: Option<DVec3>) -> Measured {
+    let partial = |chunk: &[Arc]| {
+        let (mut sum, mut p_sum, mut p_max) = (DVec3::ZERO, 0.0f64, 0.0f64);
+        for a in chunk {
+            sum += a.n1;
+            sum += a.n2;
+            let p = f64::from(a.p);
+            p_sum += p;
+            p_max = p_max.max(p);
+        }
+        (sum, p_sum, p_max)
+    };
+    let parallel = arcs.len() > PARALLEL_ARCS;
+    let partials: Vec<(DVec3, f64, f64)> = if parallel {
+        arcs.par_chunks(CAP_CHUNK).map(partial).collect()
+    } else {
+        arcs.chunks(CAP_CHUNK).map(partial).collect()
+    };
+    let (mut mean, mut p_sum, mut p_max) = (DVec3::ZERO, 0.0, 0.0f64);
+    for (s, ps, pm) in partials {
+        mean += s;
+        p_sum += ps;
+        p_max = p_max.max(pm);
+    }
+    let widest = |c: DVec3| {
+        let of = |chunk: &[Arc]| widest_angle_of_arcs(c, chunk);
+        if parallel { arcs.par_chunks(CAP_CHUNK).map(of).reduce(|| 0.0, f64::max) } else { of(arcs) }
+    };
+    // A bound below the true one (rounding of the norms and of `sin`) keeps the rule conservative.
+    let shrink = 1.0 - 1e-9;
+    Measured { cap: cap_of(cell_center, mean, widest), p_sum: p_sum * shrink, p_max: p_max * shrink }
 }
 
 /// A stored breadth-first tree and a node's index in it, which a reader's assignment follows.
@@ -718,20 +805,37 @@ impl Builder {
         offset: u32,
         out: &mut Vec<BuildNode>,
         (key, guide): (u32, Guide<'_>),
+        parent_prob: f64,
     ) -> bool {
         let index = out.len();
+        let (cap, stop) = if self.caps {
+            let m = subtree_cap(arcs, cell.map(|c| c.center));
+            let prob = parent_prob.min(f64::from(m.cap[3]).min(1.0));
+            let stop = self.stop.is_some_and(|r| {
+                let n = arcs.len() as f64;
+                let collapsed = prob * (r.enter + r.range + r.block * (n / 4.0).ceil());
+                let split_at_least = prob * (r.enter + r.test)
+                    + (prob * r.range).min((r.enter + r.range) * m.p_max)
+                    + r.block * m.p_max.max(m.p_sum / 4.0);
+                collapsed <= split_at_least * (1.0 - 1e-9)
+            });
+            (m.cap, (prob, stop))
+        } else {
+            ([0.0; 4], (parent_prob, false))
+        };
+        let (prob, stop) = stop;
         out.push(BuildNode {
             depth,
             own: (offset, offset),
             sub_end: offset + arcs.len() as u32,
             children: Vec::new(),
-            cell_center: cell.map(|c| c.center),
             key,
             tried: false,
+            cap,
         });
         let stored_children = guide.map(|(tree, at)| tree[at][1]);
         let children: Vec<BinCell> = match cell {
-            _ if stored_children == Some(0) => Vec::new(),
+            _ if stored_children == Some(0) || stop => Vec::new(),
             None => self.base.iter().map(|&c| self.bin_cell(c)).collect(),
             // Depth 1 is level 0; a cell at level `depth - 1` splits while that is below max_depth.
             Some(c) if depth <= self.max_depth => c.children().iter().map(|&c| self.bin_cell(c)).collect(),
@@ -814,7 +918,7 @@ impl Builder {
                 .into_par_iter()
                 .map(|(cell, these, these_spare, at, g)| {
                     let mut sub = Vec::new();
-                    let ok = self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, &mut sub, g);
+                    let ok = self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, &mut sub, g, prob);
                     (sub, ok)
                 })
                 .collect();
@@ -832,7 +936,7 @@ impl Builder {
         } else {
             for (cell, these, these_spare, at, g) in work {
                 let child = out.len() as u32;
-                if !self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, out, g) {
+                if !self.node(Some(cell), depth + 1, these, these_spare, !flipped, at, out, g, prob) {
                     return false;
                 }
                 out[index].children.push(child);
@@ -846,31 +950,62 @@ impl Builder {
 /// (`atan2` of the cross and dot products, accurate at every size) is evaluated only for points
 /// whose dot product is within rounding of the smallest so far, so the result is the exact
 /// maximum over all points at a few `atan2` calls per node instead of one per point.
-pub(crate) fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
-    // A dot product of unit vectors is off by at most a few ulp of 1; two points whose true
-    // angles are in the opposite order of their rounded dot products differ by less than this.
-    const DOT_SLACK: f64 = 1e-15;
-    let mut cos_min = f64::INFINITY;
-    let mut widest = 0.0f64;
+#[cfg(test)]
+fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
+    let mut w = Widest::default();
     for p in points {
+        w.add(c, p);
+    }
+    w.widest
+}
+
+/// [`widest_angle`] over both endpoints of `arcs` in order (a plain loop: the build runs this over
+/// every arc at every level, and a `flat_map` over the pairs cost a third of it).
+fn widest_angle_of_arcs(c: DVec3, arcs: &[Arc]) -> f64 {
+    let mut w = Widest::default();
+    for a in arcs {
+        w.add(c, a.n1);
+        w.add(c, a.n2);
+    }
+    w.widest
+}
+
+/// The running state of [`widest_angle`].
+struct Widest {
+    cos_min: f64,
+    widest: f64,
+}
+
+impl Default for Widest {
+    fn default() -> Self {
+        Widest { cos_min: f64::INFINITY, widest: 0.0 }
+    }
+}
+
+impl Widest {
+    #[inline(always)]
+    fn add(&mut self, c: DVec3, p: DVec3) {
+        // A dot product of unit vectors is off by at most a few ulp of 1; two points whose true
+        // angles are in the opposite order of their rounded dot products differ by less than this.
+        const DOT_SLACK: f64 = 1e-15;
         let d = c.dot(p);
-        if d <= cos_min + DOT_SLACK {
-            cos_min = cos_min.min(d);
-            widest = widest.max(c.cross(p).length().atan2(d));
+        if d <= self.cos_min + DOT_SLACK {
+            self.cos_min = self.cos_min.min(d);
+            self.widest = self.widest.max(c.cross(p).length().atan2(d));
         }
     }
-    widest
 }
 
 /// The cap of a set of unit endpoints: `[cx, cy, cz, threshold]` with the centre in `f32` and the
-/// threshold `sin r + ε` rounded up, `r` measured from the `f32` centre.
-fn bounding_cap(points: impl Iterator<Item = DVec3> + Clone, cell_center: Option<DVec3>) -> [f32; 4] {
-    let mean = points.clone().fold(DVec3::ZERO, |s, p| s + p);
+/// threshold `sin r + ε` rounded up, `r` measured from the `f32` centre. The centre is the cell's
+/// centre or the endpoints' mean (`mean`: their sum, any length), whichever gives the smaller
+/// radius; `widest` is the widest angle from a unit centre to the endpoints.
+fn cap_of(cell_center: Option<DVec3>, mean: DVec3, widest: impl Fn(DVec3) -> f64) -> [f32; 4] {
     let mut best: Option<([f32; 3], f64)> = None;
     for center in [cell_center, (mean.length() > 1e-12).then(|| mean.normalize())].into_iter().flatten() {
         let c32 = center.as_vec3();
         let c = c32.as_dvec3().normalize();
-        let r = widest_angle(c, points.clone());
+        let r = widest(c);
         if best.is_none_or(|(_, b)| r < b) {
             best = Some((c32.to_array(), r));
         }
@@ -901,20 +1036,30 @@ impl GaussMapHierarchy {
         options: &GaussMapOptions,
         cost: &CostModel,
     ) -> (Self, ArcCells) {
+        Self::build_stopping(normals, options, cost, true)
+    }
+
+    /// [`GaussMapHierarchy::build_with_cells`]; `early_stop` false builds every subtree to
+    /// `max_depth` before pruning (the reference the stop rule is tested against).
+    fn build_stopping(
+        normals: &[[Vec3; 2]],
+        options: &GaussMapOptions,
+        cost: &CostModel,
+        early_stop: bool,
+    ) -> (Self, ArcCells) {
         let max_depth = options.max_depth.unwrap_or_else(|| depth_for_count(normals.len(), options.base)).min(12);
-        let Some((nodes, arcs)) = assign(normals, options.base, options.bins, max_depth, None) else {
+        let stop = (options.prune && early_stop).then(|| StopRule {
+            enter: f64::from(cost.gauss_enter_ns),
+            test: f64::from(cost.gauss_test_ns),
+            range: f64::from(cost.gauss_range_ns),
+            block: f64::from(cost.gauss_block_ns),
+        });
+        let Some((nodes, arcs)) = assign(normals, options.base, options.bins, max_depth, None, stop) else {
             unreachable!("an unguided assignment always succeeds")
         };
         let mut order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
-
-        // Caps over each subtree's endpoints (contiguous in the preorder arc order).
-        let caps: Vec<[f32; 4]> = nodes
-            .par_iter()
-            .map(|n| {
-                let range = &arcs[n.own.0 as usize..n.sub_end as usize];
-                bounding_cap(range.iter().flat_map(|a| [a.n1, a.n2]), n.cell_center)
-            })
-            .collect();
+        // Caps over each subtree's endpoints, computed by the build.
+        let caps: Vec<[f32; 4]> = nodes.iter().map(|n| n.cap).collect();
         let by_id = ArcCells::by_candidate(&nodes, &arcs);
         drop(arcs);
         let assigned =
@@ -1266,18 +1411,22 @@ impl GaussMapHierarchy {
 /// [`GaussMapHierarchy::from_arrays`], so that both find the same cells bit for bit. With `guide`
 /// (a stored breadth-first tree, already checked by [`check_breadth_first`]) the descent stops at
 /// the stored leaves, whose arcs stay in input order; `None` where the arcs do not split as stored.
+/// Without `guide`, every node's cap is computed, and with `stop` the descent ends where the
+/// pruning would collapse the node whatever lies below (see [`StopRule`]).
 fn assign(
     normals: &[[Vec3; 2]],
     base: BaseSolid,
     bins: Bins,
     max_depth: u8,
     guide: Option<&[[u32; 4]]>,
+    stop: Option<StopRule>,
 ) -> Option<(Vec<BuildNode>, Vec<Arc>)> {
     let mut arcs = arc_records(normals);
-    let builder = Builder { bins, max_depth, base: base_cells(base) };
+    let builder = Builder { bins, max_depth, base: base_cells(base), caps: guide.is_none(), stop };
     let mut nodes = Vec::new();
     let mut scratch = vec![Arc::default(); arcs.len()];
-    let ok = builder.node(None, 0, &mut arcs, &mut scratch, false, 0, &mut nodes, (0, guide.map(|g| (g, 0))));
+    let guide = (0, guide.map(|g| (g, 0)));
+    let ok = builder.node(None, 0, &mut arcs, &mut scratch, false, 0, &mut nodes, guide, 1.0);
     ok.then_some((nodes, arcs))
 }
 
@@ -1295,7 +1444,8 @@ fn derived_order(
     bins: Bins,
     max_depth: u8,
 ) -> Result<Derived, ArraysError> {
-    let (nodes, arcs) = assign(normals, base, bins, max_depth, Some(flat)).ok_or(ArraysError::Tree { node: 0 })?;
+    let (nodes, arcs) =
+        assign(normals, base, bins, max_depth, Some(flat), None).ok_or(ArraysError::Tree { node: 0 })?;
     let order: Vec<u32> = arcs.iter().map(|a| a.id).collect();
     let (derived, bfs_order, source) = breadth_first(
         0,
@@ -1408,6 +1558,52 @@ mod tests {
         let unit: Vec<[DVec3; 2]> =
             built.order.iter().map(|&i| normals[i as usize].map(|n| n.as_dvec3().normalize_or_zero())).collect();
         assert!(cells.paths(&unit, 3, factor).is_none());
+    }
+
+    /// The stop rule only skips subtrees the pruning collapses: the stored map (tree, caps, storage
+    /// order, predicted cost) is the one built to `max_depth` and pruned, on arcs of every length,
+    /// on CAD-like repeated normals and under skewed cost models, while most of the deep nodes are
+    /// never made.
+    #[test]
+    fn early_stop_keeps_the_pruned_tree() {
+        let mut rng = crate::measure::ViewRng::new(19);
+        let mixed: Vec<[Vec3; 2]> = (0..40_000)
+            .map(|k| {
+                let a = rng.direction();
+                let spread = [0.0, 1e-5, 1e-3, 1e-2, 0.1, 0.7][k % 6];
+                [a, (a + rng.direction() * spread).normalize_or_zero()]
+            })
+            .collect();
+        // A machined part: a few exact directions, arcs between neighbouring ones and fillets.
+        let axes = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::NEG_X, Vec3::NEG_Y, Vec3::NEG_Z];
+        let cad: Vec<[Vec3; 2]> = (0..20_000)
+            .map(|k| {
+                let a = axes[k % 6];
+                let b = if k % 3 == 0 { axes[(k / 6) % 6] } else { (a + rng.direction() * 0.05).normalize() };
+                if a.dot(b) < -0.5 { [a, a] } else { [a, b] }
+            })
+            .collect();
+        let skewed = CostModel { gauss_enter_ns: 20.0, gauss_block_ns: 0.5, ..CostModel::default() };
+        let blocky = CostModel { gauss_test_ns: 0.2, gauss_block_ns: 8.0, ..CostModel::default() };
+        let mut skipped = 0;
+        for (name, normals) in [("mixed", &mixed), ("cad", &cad)] {
+            for cost in [CostModel::default(), skewed, blocky] {
+                let options = GaussMapOptions::default();
+                let (fast, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, true);
+                let (full, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, false);
+                assert_eq!(fast.flat, full.flat, "{name}: tree");
+                assert_eq!(fast.caps, full.caps, "{name}: caps");
+                assert_eq!(fast.order, full.order, "{name}: storage order");
+                assert_eq!(fast.predicted_ns, full.predicted_ns, "{name}: predicted cost");
+                let made = |h: &GaussMapHierarchy| {
+                    let a = h.assigned_histogram().unwrap();
+                    a.root.nodes + a.levels.iter().map(|l| l.nodes).sum::<usize>()
+                };
+                assert!(made(&fast) <= made(&full));
+                skipped += made(&full) - made(&fast);
+            }
+        }
+        assert!(skipped > 10_000, "the rule skipped only {skipped} nodes");
     }
 
     #[test]
