@@ -500,17 +500,29 @@ impl ConeBvh {
             tree.order.par_iter().map(|&i| (points[i as usize], unit[i as usize])).unzip();
         drop(unit);
         let range = |start: u32, end: u32| start as usize..end as usize;
-        let (boxes, cones): (Vec<[f32; 6]>, Vec<[f32; 4]>) = tree
+        let cones: Vec<[f32; 4]> =
+            tree.nodes.par_iter().map(|&[start, end, _, _]| bounding_cone(&tree_unit[range(start, end)])).collect();
+        // Boxes bottom-up: a leaf's from its points, an inner node's the union of its children's
+        // (whose ranges tile its own), the same box as from its points at a fraction of the work.
+        let mut boxes: Vec<[f32; 6]> = tree
             .nodes
             .par_iter()
-            .map(|&[start, end, _, _]| {
-                let r = range(start, end);
-                (
-                    bounding_box(tree_points[r.clone()].iter().copied()),
-                    bounding_cone(tree_unit[r].iter().flatten().copied()),
-                )
-            })
-            .unzip();
+            .map(
+                |&[start, end, _, leaf]| {
+                    if leaf == 1 { bounding_box(tree_points[range(start, end)].iter().copied()) } else { EMPTY_AABB }
+                },
+            )
+            .collect();
+        for i in (0..tree.nodes.len()).rev() {
+            for &c in &tree.children[i] {
+                let b = boxes[c as usize];
+                let a = &mut boxes[i];
+                for k in 0..3 {
+                    a[k] = a[k].min(b[k]);
+                    a[k + 3] = a[k + 3].max(b[k + 3]);
+                }
+            }
+        }
         let planes: Vec<PlaneBound> = tree
             .nodes
             .par_iter()
@@ -1442,6 +1454,10 @@ fn gather(bvh: &obvhs::bvh2::Bvh2, i: usize, ids: &[u32], order: &mut Vec<u32>) 
     }
 }
 
+/// The box of no points (what [`bounding_box`] returns for none).
+const EMPTY_AABB: [f32; 6] =
+    [f32::INFINITY, f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+
 fn bounding_box(points: impl Iterator<Item = Vec3>) -> [f32; 6] {
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in points {
@@ -1451,10 +1467,15 @@ fn bounding_box(points: impl Iterator<Item = Vec3>) -> [f32; 6] {
     [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
 }
 
-/// Cone around the normalised mean of unit `normals`: `[axis, sin α + margin]` with α measured from
-/// the `f32` axis, or a never-culled cone.
-fn bounding_cone(normals: impl Iterator<Item = DVec3> + Clone) -> [f32; 4] {
-    let sum = normals.clone().fold(DVec3::ZERO, |s, n| s + n);
+/// Cone around the normalised mean of the unit normals of `pairs` (both of each, in order):
+/// `[axis, sin α + margin]` with α measured from the `f32` axis, or a never-culled cone. Plain
+/// loops over the pairs: the build runs this over every candidate at every level, where a
+/// flattening iterator cost several times the arithmetic.
+fn bounding_cone(pairs: &[[DVec3; 2]]) -> [f32; 4] {
+    let mut sum = DVec3::ZERO;
+    for &[a, b] in pairs {
+        sum = sum + a + b;
+    }
     if sum.length().is_nan() || sum.length() <= 1e-12 {
         return [0.0, 0.0, 1.0, NEVER_CULL];
     }
@@ -1462,7 +1483,7 @@ fn bounding_cone(normals: impl Iterator<Item = DVec3> + Clone) -> [f32; 4] {
     let axis = axis32.as_dvec3().normalize();
     let mut cos_min = 1.0f64;
     let mut max_angle = 0.0f64;
-    for n in normals {
+    for n in pairs.iter().flatten().copied() {
         if n == DVec3::ZERO {
             return [axis32.x, axis32.y, axis32.z, NEVER_CULL];
         }
@@ -1583,9 +1604,8 @@ mod tests {
                 points.push(v);
             }
             let b = bounding_box(points.iter().copied());
-            let unit: Vec<DVec3> = normals.iter().flatten().map(|v| v.as_dvec3().normalize()).collect();
-            let c = bounding_cone(unit.iter().copied());
             let pairs: Vec<[DVec3; 2]> = normals.iter().map(|&n| unit_pair(n)).collect();
+            let c = bounding_cone(&pairs);
             let p = PlaneBound::of(&pairs, &points, &b, &c);
             for k in 0..200 {
                 let dir = Vec3::new(r(), r(), r()).normalize();
