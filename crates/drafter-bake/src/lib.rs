@@ -484,8 +484,12 @@ fn compute_lines(
                     }
                 })
                 .collect();
+            // The classes, face normals and candidate arrays (85 MB on the dragon) are not needed
+            // by the hierarchies, which are built from what the file holds: freed before them.
+            let counts = feature.counts;
+            drop(feature);
             let silhouettes = silhouettes_of(mesh, &edges, vertex_data[m].as_ref(), stage.hierarchies);
-            Some((edges, silhouettes, feature.counts, diagnostics))
+            Some((edges, silhouettes, counts, diagnostics))
         })
         .collect();
     let mut summary = LinesSummary::default();
@@ -583,7 +587,10 @@ fn silhouettes_of(
     }
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
-    let index = SilhouetteIndex::from_candidates(corners.clone(), normals.clone(), points, &options);
+    // The normals as the writer lists them, taken before the index (which reorders its own copy)
+    // consumes them.
+    let candidate_normals: Vec<f32> = normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect();
+    let index = SilhouetteIndex::from_candidates(corners.clone(), normals, points, &options);
     // The hierarchies store no candidate order (format 0.2): a reader derives it from the
     // candidates in the Khronos order, as the index was built from them here.
     let arrays = index.to_arrays();
@@ -593,7 +600,7 @@ fn silhouettes_of(
         HierarchyChoice::BruteForce(_) => "bruteForce",
     };
     Some(MeshSilhouettes {
-        candidate_normals: normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect(),
+        candidate_normals,
         candidate_corners: corners,
         orthographic: choice(arrays.orthographic).to_owned(),
         perspective: choice(arrays.perspective).to_owned(),
