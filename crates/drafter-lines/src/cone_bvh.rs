@@ -595,9 +595,12 @@ impl ConeBvh {
             predicted_ns: 0.0,
         };
         if !eyes.is_empty() {
-            let mut out = EdgeSet::default();
-            let total: f64 = eyes.iter().map(|&e| bvh.query_counted(e, &mut out).cost_ns(cost, false)).sum();
-            bvh.predicted_ns = total / eyes.len() as f64;
+            // On the thread pool, summed in eye order: the same figure at any thread count.
+            let costs: Vec<f64> = eyes
+                .par_iter()
+                .map_init(EdgeSet::default, |out, &e| bvh.query_counted(e, out).cost_ns(cost, false))
+                .collect();
+            bvh.predicted_ns = costs.iter().sum::<f64>() / eyes.len() as f64;
         }
         bvh
     }
