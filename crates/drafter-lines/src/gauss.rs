@@ -868,14 +868,17 @@ impl Builder {
             arcs.iter().map(target).collect()
         };
         let bucket = |t: u8| if t == STAY { 0 } else { usize::from(t) + 1 };
-        let mut starts = vec![0usize; children.len() + 2];
+        // At most the 20 base cells, the own arcs and an end: on the stack (one node per cell).
+        let mut starts = [0usize; 22];
+        let starts = &mut starts[..children.len() + 2];
         for &t in &targets {
             starts[bucket(t) + 1] += 1;
         }
         for k in 1..starts.len() {
             starts[k] += starts[k - 1];
         }
-        let mut next = starts.clone();
+        let mut next = [0usize; 22];
+        next[..starts.len()].copy_from_slice(starts);
         for (g, &t) in arcs.iter().zip(&targets) {
             let b = bucket(t);
             spare[next[b]] = *g;

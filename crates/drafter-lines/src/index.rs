@@ -1,6 +1,7 @@
 //! [`SilhouetteIndex`]: brute force plus whichever hierarchies pay for themselves.
 
 use glam::Vec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::{
@@ -142,13 +143,14 @@ impl SilhouetteIndex {
                     predicted_speedup: speedup,
                 };
                 let (g, permutation) = g.into_storage_order();
+                // Gathers of a million candidates each (a cache miss apiece): on the thread pool.
                 let pick = |k: &u32| *k as usize;
                 if candidate_edges.len() == n {
-                    candidate_edges = permutation.iter().map(|k| candidate_edges[pick(k)]).collect();
+                    candidate_edges = permutation.par_iter().map(|k| candidate_edges[pick(k)]).collect();
                 }
-                normals = permutation.iter().map(|k| normals[pick(k)]).collect();
+                normals = permutation.par_iter().map(|k| normals[pick(k)]).collect();
                 if points.len() == n {
-                    points = permutation.iter().map(|k| points[pick(k)]).collect();
+                    points = permutation.par_iter().map(|k| points[pick(k)]).collect();
                 }
                 (Some((g, cells)), choice)
             } else {
