@@ -1182,8 +1182,9 @@ impl GaussMapHierarchy {
         LevelHistogram::from_nodes(self.flat.iter().zip(depth).map(|(n, d)| (d, (n[3] - n[2]) as usize)))
     }
 
-    /// Arcs per level as assigned by the bins, before pruning (Table 2 of the paper); `None` for a
-    /// hierarchy loaded from arrays.
+    /// Arcs per level as assigned by the bins, before pruning (Table 2 of the paper), as far as
+    /// the build descended (it stops where the pruning provably collapses a subtree, whose arcs
+    /// then count at that node); `None` for a hierarchy loaded from arrays.
     pub fn assigned_histogram(&self) -> Option<&LevelHistogram> {
         self.assigned.as_ref()
     }

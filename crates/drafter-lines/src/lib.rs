@@ -26,7 +26,10 @@
 //!    normals, stored in a hierarchy of spherical triangles (icosahedron, 4:1 splits) at the
 //!    deepest cell whose overlapping bin holds it (Gooch et al. §5.1.2, Fig. 8, Table 2); each
 //!    node has a data-dependent bounding cap; a query enters only the nodes whose cap the view's
-//!    great circle meets. [`LevelHistogram`] is the paper's Table 2.
+//!    great circle meets. The [`CostModel`] collapses subtrees that are cheaper as one node, and
+//!    the build does not descend where a lower bound on any split's cost proves the collapse
+//!    (same map, at a fraction of the nodes). [`LevelHistogram`] is the paper's Table 2 as far as
+//!    the build descended.
 //! 5. [`ConeBvh`] (perspective): candidates split by normal (the Gauss-map cell their arc is
 //!    stored in), then within each cell a binned-SAH tree in the dual space of face planes
 //!    (a plane is the 4D point `(k·n̂, n̂·(v − c))`, an eye a hyperplane through them; Hertzmann &
