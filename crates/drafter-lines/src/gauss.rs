@@ -701,8 +701,8 @@ struct Builder {
 ///   largest `p_a` in a block of its own at worst.
 ///
 /// Where the collapsed cost is not above that bound, the bottom-up pruning collapses the node
-/// whatever its subtree, so the build does not make the subtree. On the dragon (1.3M arcs) this skips most of
-/// the 300k nodes below level 6 that the pruning threw away, with the same stored tree.
+/// whatever its subtree, so the build does not make the subtree. On the dragon (1.3M arcs) the
+/// build makes 201k nodes instead of 396k (of which the pruning kept 24k either way).
 #[derive(Clone, Copy)]
 struct StopRule {
     enter: f64,
@@ -808,7 +808,7 @@ impl Builder {
         parent_prob: f64,
     ) -> bool {
         let index = out.len();
-        let (cap, stop) = if self.caps {
+        let (cap, prob, stop) = if self.caps {
             let m = subtree_cap(arcs, cell.map(|c| c.center));
             let prob = parent_prob.min(f64::from(m.cap[3]).min(1.0));
             let stop = self.stop.is_some_and(|r| {
@@ -819,11 +819,10 @@ impl Builder {
                     + r.block * m.p_max.max(m.p_sum / 4.0);
                 collapsed <= split_at_least * (1.0 - 1e-9)
             });
-            (m.cap, (prob, stop))
+            (m.cap, prob, stop)
         } else {
-            ([0.0; 4], (parent_prob, false))
+            ([0.0; 4], parent_prob, false)
         };
-        let (prob, stop) = stop;
         out.push(BuildNode {
             depth,
             own: (offset, offset),
@@ -962,8 +961,9 @@ fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
     w.widest
 }
 
-/// [`widest_angle`] over both endpoints of `arcs` in order (a plain loop: the build runs this over
-/// every arc at every level, and a `flat_map` over the pairs cost a third of it).
+/// [`widest_angle`] over both endpoints of `arcs` in order. A plain loop: the build runs this over
+/// every arc at every level, and through a `flat_map` over the pairs it was 22 % of a one-thread
+/// profile of the dragon's build, against 4 % now.
 fn widest_angle_of_arcs(c: DVec3, arcs: &[Arc]) -> f64 {
     let mut w = Widest::default();
     for a in arcs {

@@ -114,7 +114,8 @@ pub struct SilhouettesEncoded {
     face_rounded: Vec<bool>,
     /// Candidate index of every topology edge (`u32::MAX`: not a candidate), built by the first
     /// chunk: one table lookup per corner instead of a binary search over a million candidates
-    /// (a cache miss per step; a third of this function's time on the dragon).
+    /// (a cache miss per step; the dragon's encoding took 367 ms with the search, 279 with the
+    /// table, at two threads).
     candidate_of_edge: Vec<u32>,
 }
 
