@@ -376,11 +376,13 @@ fn compute_normals(
             } else {
                 (&normals.normals, &normals.enhanced_normals)
             };
+            let (normals_out, enhanced_out) =
+                (plain.iter().map(|n| n.to_array()).collect(), enhanced.iter().map(|n| n.to_array()).collect());
             let data = VertexData {
-                source_vertex: normals.layout.source_vertex.clone(),
-                triangles: normals.layout.triangles.clone(),
-                normals: plain.iter().map(|n| n.to_array()).collect(),
-                enhanced: enhanced.iter().map(|n| n.to_array()).collect(),
+                source_vertex: normals.layout.source_vertex,
+                triangles: normals.layout.triangles,
+                normals: normals_out,
+                enhanced: enhanced_out,
             };
             Some((data, normals.report, diagnostics))
         })

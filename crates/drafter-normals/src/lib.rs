@@ -134,8 +134,6 @@ pub struct NormalsReport {
     pub boundary_edges: usize,
     /// Face-iterations of the low-pass filter (faces × iterations).
     pub face_iterations: u64,
-    /// How uneven the tessellation is.
-    pub tessellation: TessellationStats,
 }
 
 /// The stage's result for one mesh.
@@ -173,7 +171,6 @@ pub fn compute_normals(mesh: &Mesh, topology: &Topology, options: &NormalsOption
         nonmanifold_edges: topology.nonmanifold_edge_count(),
         boundary_edges: topology.boundary_edge_count(),
         face_iterations: faces.face_iterations,
-        tessellation: TessellationStats::measure(topology),
     };
     let mut diagnostics = Diagnostics::new();
     diagnostics.push(DiagnosticKind::DegenerateTriangle, report.degenerate_faces, || {
