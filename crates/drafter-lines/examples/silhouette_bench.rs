@@ -71,12 +71,21 @@ fn parse_args() -> Result<Args, String> {
                     l => NormalSplit::Level(l.parse().map_err(|e| format!("--normal-level: {e}"))?),
                 };
             }
+            // Cost-model overrides (ns), to see how the pruning's choices move query times.
+            "--bvh-block" => {
+                args.options.cost.bvh_block_ns =
+                    value("--bvh-block")?.parse().map_err(|e| format!("--bvh-block: {e}"))?
+            }
+            "--bvh-range" => {
+                args.options.cost.bvh_range_ns =
+                    value("--bvh-range")?.parse().map_err(|e| format!("--bvh-range: {e}"))?
+            }
             "--seed" => args.seed = value("--seed")?.parse().map_err(|e| format!("--seed: {e}"))?,
             "-h" | "--help" => {
                 return Err(
                     "usage: silhouette_bench [FILE ...] [--views N] [--sphere SEGMENTS] [--no-sphere] [--seed S] \
                      [--calibrate] [--overlap F | --strict-bins] [--depth D] [--no-prune] [--leaf N] \
-                     [--normal-level off|auto|L]"
+                     [--normal-level off|auto|L] [--bvh-block NS] [--bvh-range NS]"
                         .into(),
                 );
             }

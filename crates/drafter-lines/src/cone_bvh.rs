@@ -94,7 +94,7 @@ use crate::{ArraysError, CostModel, EdgeSet};
 pub const CONE_MARGIN: f64 = 1e-5;
 
 /// Default largest leaf, in candidates.
-pub const DEFAULT_LEAF_SIZE: u32 = 16;
+pub const DEFAULT_LEAF_SIZE: u32 = 64;
 
 /// Default number of eyes sampled to estimate visit frequencies.
 pub const DEFAULT_SAMPLE_EYES: u32 = 96;

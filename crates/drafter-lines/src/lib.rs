@@ -64,7 +64,7 @@
 //! Crease above [`DEFAULT_CREASE_ANGLE_DEG`] (30°), coplanar at or below
 //! [`DEFAULT_COPLANAR_ANGLE_DEG`] (0.001°), icosahedron with overlapping bins of
 //! [`DEFAULT_OVERLAP`] (1.5) circumradii and depth by [`depth_for_count`], cone-BVH leaves of
-//! [`DEFAULT_LEAF_SIZE`] (16) before pruning, [`DEFAULT_SAMPLE_EYES`] (96) sampled eyes, cost
+//! [`DEFAULT_LEAF_SIZE`] (64) before pruning, [`DEFAULT_SAMPLE_EYES`] (96) sampled eyes, cost
 //! constants in [`CostModel`].
 //!
 //! # Limits
