@@ -211,9 +211,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     // Primitives within 16-bit indices: groups split by the vertices the writer will write, before
     // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
     // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
-    eprintln!("ZZ normals done {:.1}", start.elapsed().as_secs_f64() * 1e3);
     let (splits, split_summary) = split::split_scene(scene, &vertex_data);
-    eprintln!("ZZ split done {:.1}", start.elapsed().as_secs_f64() * 1e3);
     let compressing = config.compress == Compression::Meshopt && config.container == Container::Glb;
     let mut vertex_data = vertex_data;
     let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) && !compressing {
