@@ -592,10 +592,10 @@ fn silhouettes_of(
     // The normals as the writer lists them, taken before the index (which reorders its own copy)
     // consumes them.
     let candidate_normals: Vec<f32> = normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect();
-    let index = SilhouetteIndex::from_candidates(corners.clone(), normals, points, &options);
     // The hierarchies store no candidate order (format 0.2): a reader derives it from the
-    // candidates in the Khronos order, as the index was built from them here.
-    let arrays = index.to_arrays();
+    // candidates in the Khronos order, as the index was built from them here. Built for storage:
+    // the bake never queries them.
+    let arrays = SilhouetteIndex::stored_hierarchies(normals, points, &options);
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",
         HierarchyChoice::ConeBvh { .. } => "coneBvh",

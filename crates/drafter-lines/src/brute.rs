@@ -572,13 +572,8 @@ impl Stream {
         normals: &[[Vec3; 2]],
         points: &[Vec3],
     ) -> (Self, Vec<(u32, u32)>) {
-        let mut at = Vec::with_capacity(ranges.len());
-        let mut quads = 0usize;
-        for &(start, end) in ranges {
-            let blocks = (end - start).div_ceil(4);
-            at.push((quads as u32, blocks as u32));
-            quads += 10 * blocks;
-        }
+        let at = Self::layout(ranges);
+        let quads = at.last().map_or(0, |&(q, b)| q as usize + 10 * b as usize);
         let parts: Vec<Stream> = ranges
             .par_iter()
             .map(|&(start, end)| {
@@ -592,6 +587,18 @@ impl Stream {
             stream.quads.extend_from_slice(&part.quads);
         }
         (stream, at)
+    }
+
+    /// Where [`Stream::from_ranges`] puts each range: its first quad and its number of blocks.
+    pub fn layout(ranges: &[(usize, usize)]) -> Vec<(u32, u32)> {
+        let mut at = Vec::with_capacity(ranges.len());
+        let mut quads = 0usize;
+        for &(start, end) in ranges {
+            let blocks = (end - start).div_ceil(4);
+            at.push((quads as u32, blocks as u32));
+            quads += 10 * blocks;
+        }
+        at
     }
 
     /// Appends candidates `ids` as whole blocks; returns the number of blocks.

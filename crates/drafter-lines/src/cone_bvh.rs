@@ -87,7 +87,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
 use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
-use crate::tree::{breadth_first, check_breadth_first, push_children, widest_level, with_levels};
+use crate::tree::{Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cone's half-angle.
@@ -238,18 +238,21 @@ struct Assembled {
     stream: Stream,
 }
 
-/// Query records, bound arrays and blocks of a breadth-first tree.
+/// Query records, bound arrays and blocks of a breadth-first tree; the blocks only with the
+/// candidates' normals and points (a [`Purpose::Query`] build).
 fn assemble(
     flat: &[[u32; 4]],
     boxes: &[[f32; 6]],
     cones: &[[f32; 4]],
     planes: &[PlaneBound],
     order: &[u32],
-    normals: &[[Vec3; 2]],
-    points: &[Vec3],
+    candidates: Option<(&[[Vec3; 2]], &[Vec3])>,
 ) -> Assembled {
     let ranges: Vec<(usize, usize)> = flat.iter().map(|&[_, _, start, end]| (start as usize, end as usize)).collect();
-    let (stream, at) = Stream::from_ranges(&ranges, order, normals, points);
+    let (stream, at) = match candidates {
+        Some((normals, points)) => Stream::from_ranges(&ranges, order, normals, points),
+        None => (Stream::new(), Stream::layout(&ranges)),
+    };
     let mut nodes: Vec<BvhNode> = flat
         .iter()
         .enumerate()
@@ -474,17 +477,20 @@ const PARALLEL_CANDIDATES: usize = 32 * 1024;
 impl ConeBvh {
     /// Builds the hierarchy over candidates with `normals` and points `points` (one each).
     pub fn build(normals: &[[Vec3; 2]], points: &[Vec3], options: &ConeBvhOptions, cost: &CostModel) -> Self {
-        Self::build_with_cells(normals, points, options, cost, None)
+        Self::build_with_cells(normals, points, options, cost, None, Purpose::Query)
     }
 
     /// [`ConeBvh::build`] over candidates in a Gauss map's storage order, whose arc cells the
-    /// normal split reads (`cells`) instead of assigning the arcs again.
+    /// normal split reads (`cells`) instead of assigning the arcs again. A [`Purpose::Storage`]
+    /// build has no candidate stream and cannot answer queries; only its arrays and predicted
+    /// cost are used.
     pub(crate) fn build_with_cells(
         normals: &[[Vec3; 2]],
         points: &[Vec3],
         options: &ConeBvhOptions,
         cost: &CostModel,
         cells: Option<&ArcCells>,
+        purpose: Purpose,
     ) -> Self {
         let n = normals.len().min(points.len());
         let (normals, points) = (&normals[..n], &points[..n]);
@@ -583,7 +589,8 @@ impl ConeBvh {
             .zip(&source)
             .map(|(&[first, count, _, _], &i)| [first, count, tree.nodes[i][0], tree.nodes[i][1]])
             .collect();
-        let a = assemble(&flat, &boxes, &cones, &planes, &order, normals, points);
+        let candidates = (purpose == Purpose::Query).then_some((normals, points));
+        let a = assemble(&flat, &boxes, &cones, &planes, &order, candidates);
         let mut bvh = ConeBvh {
             nodes: a.nodes,
             widest: a.widest,
@@ -603,7 +610,7 @@ impl ConeBvh {
             // On the thread pool, summed in eye order: the same figure at any thread count.
             let costs: Vec<f64> = eyes
                 .par_iter()
-                .map_init(EdgeSet::default, |out, &e| bvh.query_counted(e, out).cost_ns(cost, false))
+                .map(|&e| bvh.walk::<true, false>(e, &mut EdgeSet::default()).cost_ns(cost, false))
                 .collect();
             bvh.predicted_ns = costs.iter().sum::<f64>() / eyes.len() as f64;
         }
@@ -645,12 +652,12 @@ impl ConeBvh {
 
     /// Silhouettes seen from `eye` into `out` (reset to [`ConeBvh::len`]).
     pub fn query(&self, eye: Vec3, out: &mut EdgeSet) {
-        self.walk::<false>(eye, out);
+        self.walk::<false, true>(eye, out);
     }
 
     /// [`ConeBvh::query`] that also counts its work.
     pub fn query_counted(&self, eye: Vec3, out: &mut EdgeSet) -> QueryCounts {
-        self.walk::<true>(eye, out)
+        self.walk::<true, true>(eye, out)
     }
 
     /// Bits of the nodes `first..first + 4` that the plane-offset test culls: [`plane_culls`] on 4
@@ -676,10 +683,14 @@ impl ConeBvh {
         (min - hi).cmpgt(tol).bitmask() | (max - lo).cmplt(-tol).bitmask()
     }
 
-    /// Breadth-first walk, as in the Gauss map.
+    /// Breadth-first walk, as in the Gauss map. Without `TEST` no candidate is tested and `out`
+    /// is left alone: which nodes a walk enters and which blocks it reads depend on the bounds
+    /// alone, so the counts are those of the query.
     #[inline]
-    fn walk<const COUNT: bool>(&self, eye: Vec3, out: &mut EdgeSet) -> QueryCounts {
-        out.reset(self.len());
+    fn walk<const COUNT: bool, const TEST: bool>(&self, eye: Vec3, out: &mut EdgeSet) -> QueryCounts {
+        if TEST {
+            out.reset(self.len());
+        }
         let mut counts = QueryCounts::default();
         if self.flat.is_empty() || self.culls4(0, eye) & 1 == 1 {
             counts.bounds_tested = usize::from(COUNT);
@@ -703,13 +714,15 @@ impl ConeBvh {
                 }
                 for (j, &i) in level[..width].iter().enumerate() {
                     // Start loading a later leaf while this one is tested (see `brute::prefetch`).
-                    if let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
+                    if TEST && let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
                         let a = &self.nodes[ahead as usize];
                         self.stream.prefetch(a.quad as usize, a.blocks);
                     }
                     let n = &self.nodes[i as usize];
                     if n.blocks > 0 {
-                        self.stream.perspective(n.quad as usize, n.blocks, eye, words);
+                        if TEST {
+                            self.stream.perspective(n.quad as usize, n.blocks, eye, words);
+                        }
                         if COUNT {
                             let [_, _, start, end] = self.flat[i as usize];
                             counts.ranges += 1;
@@ -838,7 +851,7 @@ impl ConeBvh {
                 Ok(acc.finish(&cones[node]))
             })
             .collect::<Result<_, _>>()?;
-        let a = assemble(&flat, &boxes, &cones, &planes, &order, normals, points);
+        let a = assemble(&flat, &boxes, &cones, &planes, &order, Some((normals, points)));
         Ok(ConeBvh {
             nodes: a.nodes,
             widest: a.widest,
@@ -1541,6 +1554,30 @@ pub(crate) fn sample_eyes(points: &[Vec3], count: u32) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The predicted cost walks without testing candidates: its counts must be a query's.
+    #[test]
+    fn counting_walk_counts_what_a_query_does() {
+        let mut rng = crate::measure::ViewRng::new(4);
+        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction() * 3.0).collect();
+        let normals: Vec<[Vec3; 2]> = points
+            .iter()
+            .map(|&p| {
+                let n = p.normalize();
+                [(n + rng.direction() * 0.2).normalize(), (n + rng.direction() * 0.2).normalize()]
+            })
+            .collect();
+        let bvh = ConeBvh::build(&normals, &points, &ConeBvhOptions::default(), &CostModel::default());
+        let mut out = EdgeSet::default();
+        let mut entered = 0;
+        for k in 0..500 {
+            let eye = rng.direction() * if k % 2 == 0 { 10.0 } else { 1.5 };
+            let counted = bvh.walk::<true, false>(eye, &mut EdgeSet::default());
+            assert_eq!(counted, bvh.query_counted(eye, &mut out), "eye {eye}");
+            entered += counted.nodes_entered;
+        }
+        assert!(entered > 500, "the walks entered {entered} nodes");
+    }
 
     /// The corner test agrees with dense sampling of the box and the cone.
     #[test]

@@ -60,7 +60,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::brute::{OrthoBlocks, unit_direction};
-use crate::tree::{breadth_first, check_breadth_first, depths, push_children, widest_level, with_levels, with_ranges};
+use crate::tree::{
+    Purpose, breadth_first, check_breadth_first, depths, push_children, widest_level, with_levels, with_ranges,
+};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cap radius (see the module docs).
@@ -290,7 +292,7 @@ struct Assembled {
 }
 
 /// Query records, cap arrays and blocks of a breadth-first tree.
-fn assemble(flat: &[[u32; 4]], caps: &[[f32; 4]], order: &[u32], normals: &[[Vec3; 2]]) -> Assembled {
+fn assemble(flat: &[[u32; 4]], caps: &[[f32; 4]], order: &[u32], normals: &[[Vec3; 2]], purpose: Purpose) -> Assembled {
     let mut nodes: Vec<GaussNode> = flat
         .iter()
         .zip(caps)
@@ -306,7 +308,11 @@ fn assemble(flat: &[[u32; 4]], caps: &[[f32; 4]], order: &[u32], normals: &[[Vec
     let pad =
         GaussNode { cap: Vec4::new(0.0, 0.0, 0.0, -1.0), first_child: 0, child_count: 0, block_start: 0, block_end: 0 };
     nodes.extend(std::iter::repeat_n(pad, 4));
-    Assembled { nodes, widest: widest_level(flat), blocks: OrthoBlocks::new(order, normals) }
+    let blocks = match purpose {
+        Purpose::Query => OrthoBlocks::new(order, normals),
+        Purpose::Storage => OrthoBlocks::default(),
+    };
+    Assembled { nodes, widest: widest_level(flat), blocks }
 }
 
 /// Fixed view directions for estimating a hierarchy's cost (a Fibonacci sphere).
@@ -1030,16 +1036,19 @@ fn round_up(x: f64) -> f32 {
 impl GaussMapHierarchy {
     /// Builds the hierarchy over candidates with `normals` (see [`crate::FeatureEdges`]).
     pub fn build(normals: &[[Vec3; 2]], options: &GaussMapOptions, cost: &CostModel) -> Self {
-        Self::build_with_cells(normals, options, cost).0
+        Self::build_with_cells(normals, options, cost, Purpose::Query).0
     }
 
-    /// [`GaussMapHierarchy::build`], also giving where each arc went (in storage order).
+    /// [`GaussMapHierarchy::build`], also giving where each arc went (in storage order). A
+    /// [`Purpose::Storage`] build cannot answer queries (it has no arc blocks); only its arrays,
+    /// predicted cost and cells are used.
     pub(crate) fn build_with_cells(
         normals: &[[Vec3; 2]],
         options: &GaussMapOptions,
         cost: &CostModel,
+        purpose: Purpose,
     ) -> (Self, ArcCells) {
-        Self::build_stopping(normals, options, cost, true)
+        Self::build_stopping(normals, options, cost, true, purpose)
     }
 
     /// [`GaussMapHierarchy::build_with_cells`]; `early_stop` false builds every subtree to
@@ -1049,6 +1058,7 @@ impl GaussMapHierarchy {
         options: &GaussMapOptions,
         cost: &CostModel,
         early_stop: bool,
+        purpose: Purpose,
     ) -> (Self, ArcCells) {
         let max_depth = options.max_depth.unwrap_or_else(|| depth_for_count(normals.len(), options.base)).min(12);
         let stop = (options.prune && early_stop).then(|| StopRule {
@@ -1118,7 +1128,7 @@ impl GaussMapHierarchy {
             },
         );
         let flat_caps: Vec<[f32; 4]> = source.iter().map(|&i| caps[i]).collect();
-        let a = assemble(&flat, &flat_caps, &bfs_order, normals);
+        let a = assemble(&flat, &flat_caps, &bfs_order, normals, purpose);
         let cells = ArcCells::new(options.base, options.bins, &by_id, &bfs_order);
         let mut h = GaussMapHierarchy {
             base: options.base,
@@ -1147,10 +1157,7 @@ impl GaussMapHierarchy {
     fn estimate_ns(&self, cost: &CostModel) -> f64 {
         let dirs = sample_directions(64);
         // On the thread pool, summed in direction order: the same figure at any thread count.
-        let costs: Vec<f64> = dirs
-            .par_iter()
-            .map_init(EdgeSet::default, |out, &d| self.query_counted(d, out).cost_ns(cost, true))
-            .collect();
+        let costs: Vec<f64> = dirs.par_iter().map(|&d| self.counts_only(d).cost_ns(cost, true)).collect();
         costs.iter().sum::<f64>() / dirs.len() as f64
     }
 
@@ -1216,6 +1223,13 @@ impl GaussMapHierarchy {
         d.abs().cmpgt(m.w_axis).bitmask() ^ 0xF
     }
 
+    /// The counts of [`GaussMapHierarchy::query_counted`] without testing any arc: which nodes a
+    /// walk enters and which blocks it reads depend on the caps alone.
+    fn counts_only(&self, direction: Vec3) -> QueryCounts {
+        let Some(u) = unit_direction(direction) else { return QueryCounts::default() };
+        self.walk_into::<true, false>(u, &mut [], &mut Vec::new())
+    }
+
     /// Answers in storage order (`into_storage_order`) go straight into `out`; otherwise through
     /// a storage-order bitset mapped by `order`.
     #[inline]
@@ -1224,10 +1238,10 @@ impl GaussMapHierarchy {
         let Some(u) = unit_direction(direction) else { return QueryCounts::default() };
         if self.identity {
             let (words, dirty) = out.words_and_dirty();
-            return self.walk_into::<COUNT>(u, words, dirty);
+            return self.walk_into::<COUNT, true>(u, words, dirty);
         }
         let mut storage = vec![0u64; self.len().div_ceil(64)];
-        let counts = self.walk_into::<COUNT>(u, &mut storage, &mut Vec::new());
+        let counts = self.walk_into::<COUNT, true>(u, &mut storage, &mut Vec::new());
         for (w, &word) in storage.iter().enumerate() {
             let mut bits = word;
             while bits != 0 {
@@ -1242,9 +1256,15 @@ impl GaussMapHierarchy {
     /// Breadth-first walk: for the nodes of a level, test their children's caps (4 at a time)
     /// into the next level and collect their own block ranges; then test the ranges in one
     /// stream (the data of a query over a large model is scattered over far more memory than the
-    /// caches hold, and a stream keeps the loads in flight). Hits set storage positions in `words`.
+    /// caches hold, and a stream keeps the loads in flight). Hits set storage positions in `words`;
+    /// without `TEST` no arc is tested (the counts alone).
     #[inline]
-    fn walk_into<const COUNT: bool>(&self, u: Vec3, words: &mut [u64], dirty: &mut Vec<u32>) -> QueryCounts {
+    fn walk_into<const COUNT: bool, const TEST: bool>(
+        &self,
+        u: Vec3,
+        words: &mut [u64],
+        dirty: &mut Vec<u32>,
+    ) -> QueryCounts {
         let mut counts = QueryCounts { bounds_tested: usize::from(COUNT), ..Default::default() };
         if self.flat.is_empty() || self.meets4(0, u) & 1 == 0 {
             return counts;
@@ -1277,7 +1297,9 @@ impl GaussMapHierarchy {
                     width = next_width;
                 }
             });
-            self.blocks.test_ranges(ranges, u, words, dirty);
+            if TEST {
+                self.blocks.test_ranges(ranges, u, words, dirty);
+            }
         });
         counts
     }
@@ -1392,7 +1414,7 @@ impl GaussMapHierarchy {
             Ok(())
         })?;
         drop(arcs);
-        let a = assemble(&flat, &caps, &order, normals);
+        let a = assemble(&flat, &caps, &order, normals, Purpose::Query);
         let cells = ArcCells::new(base, bins, &by_id, &order);
         let h = GaussMapHierarchy {
             base,
@@ -1540,7 +1562,7 @@ mod tests {
         // stops), so the descent goes on from their cells.
         for max_depth in [1u8, 3, 8] {
             let options = GaussMapOptions { max_depth: Some(max_depth), ..Default::default() };
-            let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &options, &cost);
+            let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &options, &cost, Purpose::Query);
             let (loaded, loaded_cells) =
                 GaussMapHierarchy::from_arrays_with_cells(&built.to_arrays(), &normals).unwrap();
             assert_eq!(loaded.order, built.order);
@@ -1561,7 +1583,7 @@ mod tests {
         }
         // Another rule: no paths.
         let octahedron = GaussMapOptions { base: BaseSolid::Octahedron, ..Default::default() };
-        let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &octahedron, &cost);
+        let (built, cells) = GaussMapHierarchy::build_with_cells(&normals, &octahedron, &cost, Purpose::Query);
         let unit: Vec<[DVec3; 2]> =
             built.order.iter().map(|&i| normals[i as usize].map(|n| n.as_dvec3().normalize_or_zero())).collect();
         assert!(cells.paths(&unit, 3, factor).is_none());
@@ -1596,8 +1618,9 @@ mod tests {
         for (name, normals) in [("mixed", &mixed), ("cad", &cad)] {
             for cost in [CostModel::default(), skewed, blocky] {
                 let options = GaussMapOptions::default();
-                let (fast, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, true);
-                let (full, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, false);
+                // The stopping build as a bake makes it (no arc blocks), the reference with them.
+                let (fast, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, true, Purpose::Storage);
+                let (full, _) = GaussMapHierarchy::build_stopping(normals, &options, &cost, false, Purpose::Query);
                 assert_eq!(fast.flat, full.flat, "{name}: tree");
                 assert_eq!(fast.caps, full.caps, "{name}: caps");
                 assert_eq!(fast.order, full.order, "{name}: storage order");
@@ -1611,6 +1634,29 @@ mod tests {
             }
         }
         assert!(skipped > 10_000, "the rule skipped only {skipped} nodes");
+    }
+
+    /// The predicted cost walks without testing arcs: its counts must be a query's.
+    #[test]
+    fn counting_walk_counts_what_a_query_does() {
+        let mut rng = crate::measure::ViewRng::new(8);
+        let normals: Vec<[Vec3; 2]> = (0..30_000)
+            .map(|_| {
+                let a = rng.direction();
+                [a, (a + rng.direction() * 0.3).normalize()]
+            })
+            .collect();
+        let h = GaussMapHierarchy::build(&normals, &GaussMapOptions::default(), &CostModel::default());
+        let mut out = EdgeSet::default();
+        let mut blocks = 0;
+        for _ in 0..500 {
+            let d = rng.direction();
+            let counted = h.counts_only(d);
+            assert_eq!(counted, h.query_counted(d, &mut out), "direction {d}");
+            blocks += counted.blocks_tested;
+        }
+        assert_eq!(h.counts_only(Vec3::ZERO), h.query_counted(Vec3::ZERO, &mut out), "no direction");
+        assert!(blocks > 500, "the walks read {blocks} blocks");
     }
 
     #[test]

@@ -115,7 +115,7 @@ pub use gauss::{
 };
 pub use index::{
     BruteForceReason, DEFAULT_MIN_HIERARCHY_CANDIDATES, DEFAULT_MIN_SPEEDUP, HierarchyChoice, SilhouetteArrays,
-    SilhouetteIndex, SilhouetteOptions,
+    SilhouetteIndex, SilhouetteOptions, StoredHierarchies,
 };
 pub use set::EdgeSet;
 pub use visibility::{

@@ -15,6 +15,15 @@ use std::cell::RefCell;
 
 use crate::ArraysError;
 
+/// What a hierarchy build makes: everything a query reads, or only what a file stores and the
+/// cost estimate counts. The query layouts (the Gauss map's arc blocks and their 16-bit copy,
+/// the cone BVH's candidate stream) are 80 MB on the dragon, and a bake never queries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Purpose {
+    Query,
+    Storage,
+}
+
 thread_local! {
     /// The current and next level of a breadth-first walk, reused across queries on a thread.
     static LEVELS: RefCell<(Vec<u32>, Vec<u32>)> = RefCell::new(Default::default());

@@ -387,3 +387,34 @@ fn parallel_builds_equal_single_thread_builds() {
     let v = views(&x, &mut rng, 300, 300);
     assert_eq!(check(&x, &v), 600, "every view checked against brute force");
 }
+
+/// A bake stores hierarchies built without their query layouts (arc blocks, candidate stream),
+/// whose costs are predicted by walks that test no candidate: the arrays and the choices, with
+/// their predicted speedups, must be exactly those of an index built for queries, under the
+/// default options (hierarchies kept or refused by cost) and forced ones.
+#[test]
+fn stored_hierarchies_equal_the_arrays_of_a_built_index() {
+    let meshes = [noisy_sphere(160, 80, 0.02, 3), plate_with_holes(24, 24), random_blob(2), uv_sphere(64, 32)];
+    let mut stored_any = 0;
+    for (m, mesh) in meshes.iter().enumerate() {
+        let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+        let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+        for options in [SilhouetteOptions::default(), forced(Default::default(), Default::default())] {
+            let built = SilhouetteIndex::build(&lines, &options).to_arrays();
+            let stored = SilhouetteIndex::stored_hierarchies(
+                lines.candidate_normals.clone(),
+                lines.candidate_points.clone(),
+                &options,
+            );
+            stored_any += usize::from(stored.gauss_map.is_some()) + usize::from(stored.cone_bvh.is_some());
+            let expected = StoredHierarchies {
+                gauss_map: built.gauss_map,
+                cone_bvh: built.cone_bvh,
+                orthographic: built.orthographic,
+                perspective: built.perspective,
+            };
+            assert_eq!(stored, expected, "mesh {m}, {options:?}");
+        }
+    }
+    assert!(stored_any >= 8, "only {stored_any} hierarchies stored");
+}
