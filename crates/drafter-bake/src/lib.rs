@@ -440,7 +440,9 @@ fn compute_lines(
             }
             let topology = &topologies[m];
             let face_parts: Option<Vec<PartId>> = labels[m].map(|l| l.iter().map(|&x| PartId(x)).collect());
-            let feature = match drafter_lines::classify_edges(topology, face_parts.as_deref(), &options) {
+            // Without the candidates' normals and points (47 MB on the dragon): the encoder does not
+            // read them, and the hierarchies are built from what the file holds.
+            let feature = match drafter_lines::classify_edges_for_encoding(topology, face_parts.as_deref(), &options) {
                 Ok(f) => f,
                 Err(e) => {
                     let d = Diagnostic {
@@ -589,13 +591,18 @@ fn silhouettes_of(
     }
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
-    // The normals as the writer lists them, taken before the index (which reorders its own copy)
-    // consumes them.
-    let candidate_normals: Vec<f32> = normals.iter().flat_map(|[a, b]| [a.x, a.y, a.z, b.x, b.y, b.z]).collect();
     // The hierarchies store no candidate order (format 0.2): a reader derives it from the
     // candidates in the Khronos order, as the index was built from them here. Built for storage:
     // the bake never queries them.
     let arrays = SilhouetteIndex::stored_hierarchies(normals, points, &options);
+    // The normals as the writer lists them, decoded again rather than copied before the index
+    // consumed its own (31 MB less at the bake's peak on the dragon).
+    let candidate_normals: Vec<f32> = edges
+        .iter()
+        .flatten()
+        .flat_map(|e| (0..e.silhouette_slots().count() * 2).map(|j| e.silhouette_normals.decoded(j)))
+        .flat_map(|n| n.unwrap_or(glam::Vec3::ZERO).to_array())
+        .collect();
     let choice = |c: HierarchyChoice| match c {
         HierarchyChoice::GaussMap { .. } => "gaussMap",
         HierarchyChoice::ConeBvh { .. } => "coneBvh",

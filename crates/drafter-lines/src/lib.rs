@@ -101,7 +101,7 @@ pub use brute::{
 };
 pub use classify::{
     DEFAULT_COPLANAR_ANGLE_DEG, DEFAULT_CREASE_ANGLE_DEG, EdgeClass, EdgeClassCounts, FeatureEdges, LineOptions,
-    classify_edges, face_normals,
+    classify_edges, classify_edges_for_encoding, face_normals,
 };
 pub use cone_bvh::{
     CONE_MARGIN, ConeBvh, ConeBvhArrays, ConeBvhOptions, DEFAULT_LEAF_SIZE, DEFAULT_SAMPLE_EYES, DUAL_NORMAL_WEIGHT,

@@ -53,6 +53,31 @@ fn round_trip(mesh: &TestMesh) {
     }
 }
 
+/// The bake classifies without the candidates' normals and points: everything else, and the
+/// encoding made from it, must be what the full classification gives.
+#[test]
+fn classification_for_encoding_equals_the_full_one() {
+    let meshes = [uv_sphere(64, 40), plate_with_holes(12, 16), random_blob(3), random_lattice_mesh(30, 120, 4)];
+    for mesh in &meshes {
+        let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+        let full = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+        let lean = classify_edges_for_encoding(&topology, None, &LineOptions::default()).unwrap();
+        assert!(!full.candidates.is_empty() && lean.candidate_normals.is_empty() && lean.candidate_points.is_empty());
+        let expected = FeatureEdges { candidate_normals: Vec::new(), candidate_points: Vec::new(), ..full.clone() };
+        // Dihedral angles are NaN for boundary edges: compared as bits.
+        let bits = |f: &FeatureEdges| f.dihedral_deg.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&lean), bits(&expected), "{}", mesh.name);
+        let no_angles = |f: &FeatureEdges| FeatureEdges { dihedral_deg: Vec::new(), ..f.clone() };
+        assert_eq!(no_angles(&lean), no_angles(&expected), "{}", mesh.name);
+        assert_eq!(
+            encode_edge_visibility(&mesh.triangles, &topology, &lean).unwrap(),
+            encode_edge_visibility(&mesh.triangles, &topology, &full).unwrap(),
+            "{}",
+            mesh.name
+        );
+    }
+}
+
 #[test]
 fn sphere_round_trips() {
     round_trip(&uv_sphere(64, 40));
