@@ -41,7 +41,9 @@
 //!    says what it chose and why ([`HierarchyChoice`]), and converts to and from flat `u32`/`f32`
 //!    arrays for glTF buffer views ([`SilhouetteArrays`]; loading validates that every bound holds
 //!    its candidates). When a Gauss map is stored, the index numbers its candidates in the map's
-//!    storage order ([`SilhouetteIndex::candidate_edges`] gives the edge id of each).
+//!    storage order ([`SilhouetteIndex::candidate_edges`] gives the edge id of each). A writer that
+//!    never queries takes [`SilhouetteIndex::stored_hierarchies`]: the same arrays and choices,
+//!    built without the query layouts.
 //!
 //! Both hierarchies are laid out breadth-first with up to 4 children tested per SIMD pass and
 //! candidates in blocks of 4 lanes: on these machines a dependent cache miss costs 50–350 ns while
