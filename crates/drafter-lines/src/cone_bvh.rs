@@ -95,10 +95,11 @@ pub const CONE_MARGIN: f64 = 1e-5;
 
 /// Default largest leaf, in candidates, before the cost-model pruning. The pruning keeps leaves of
 /// about 120 candidates on average on the dragon, so a build that starts from 16 makes levels it
-/// only collapses (dragon: 243,802 nodes built, 15,592 stored). Measured with `silhouette_bench --leaf` (16 → 64):
-/// predicted query cost +0.1% on the dragon and the bunny, +0.2% rocker-arm, +2.6% a 100k-face
-/// sphere, +6.8% fandisk (1.21 → 1.29 µs a view); measured perspective speedups equal within the
-/// noise; both hierarchies built in 1.38–1.43 s instead of 1.59–1.88 s on the dragon.
+/// only collapses (dragon: 243,802 nodes built, 15,592 stored). Measured with
+/// `silhouette_bench --leaf` (16 → 64): predicted query cost +0.1% on the dragon and the bunny,
+/// +0.2% rocker-arm, +2.6% a 100k-face sphere, +6.8% fandisk (1.21 → 1.29 µs a view); measured
+/// perspective query times equal within the noise; both hierarchies of the dragon built in
+/// 1.38–1.43 s instead of 1.59–1.88 s.
 pub const DEFAULT_LEAF_SIZE: u32 = 64;
 
 /// Default number of eyes sampled to estimate visit frequencies.
