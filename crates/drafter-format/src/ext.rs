@@ -421,8 +421,11 @@ pub struct ConeBvhRecord {
     /// Unsigned integers, 4 per node: first child, child count, start and end of the subtree's
     /// candidates in the replayed tree's order.
     pub nodes: u32,
-    /// UNSIGNED_BYTE: the split of every inner node of the dual-space trees, in preorder.
-    pub splits: u32,
+    /// UNSIGNED_BYTE: the split of every inner node of the dual-space trees, in preorder. Absent
+    /// when no dual-space tree splits (every normal cell fits one leaf): glTF accessors may not be
+    /// empty.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub splits: Option<u32>,
     /// Unsigned integers: where each dual-space tree's splits start.
     pub split_starts: u32,
 }

@@ -233,7 +233,11 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                         node_boxes: f32s(b.node_boxes)?,
                         node_cones: f32s(b.node_cones)?,
                         nodes: u32s(b.nodes)?,
-                        splits: u32s(b.splits)?
+                        splits: b
+                            .splits
+                            .map(u32s)
+                            .transpose()?
+                            .unwrap_or_default()
                             .into_iter()
                             .map(|v| {
                                 u8::try_from(v)

@@ -710,7 +710,7 @@ fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord
         node_boxes: doc.push_f32_scalars(&b.node_boxes) as u32,
         node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
         nodes: doc.push_scalars(&b.nodes, None) as u32,
-        splits: doc.push_typed_scalars(UNSIGNED_BYTE, &b.splits, b.splits.len()) as u32,
+        splits: (!b.splits.is_empty()).then(|| doc.push_typed_scalars(UNSIGNED_BYTE, &b.splits, b.splits.len()) as u32),
         split_starts: doc.push_scalars(&b.split_starts, None) as u32,
     });
     SilhouettesRecord {
