@@ -141,8 +141,9 @@ impl SilhouetteIndex {
 
     /// What a file stores of the index over these candidates (see [`StoredHierarchies`]): the
     /// same hierarchies as [`SilhouetteIndex::from_candidates`], built without what only a query
-    /// reads (the arc blocks and the candidate stream: 80 MB and about 0.1 s on the dragon) and
-    /// without copying the candidates back out.
+    /// reads (the arc blocks and the candidate stream; without them the dragon's lines stage went
+    /// from 1.77 to 1.39 s and the bake's peak RSS from 541 to 486 MB) and without copying the
+    /// candidates back out.
     pub fn stored_hierarchies(
         normals: Vec<[Vec3; 2]>,
         points: Vec<Vec3>,

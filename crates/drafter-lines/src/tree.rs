@@ -17,7 +17,8 @@ use crate::ArraysError;
 
 /// What a hierarchy build makes: everything a query reads, or only what a file stores and the
 /// cost estimate counts. The query layouts (the Gauss map's arc blocks and their 16-bit copy,
-/// the cone BVH's candidate stream) are 80 MB on the dragon, and a bake never queries.
+/// the cone BVH's candidate stream) cost the dragon's bake 55 MB of peak RSS and 0.4 s, and a bake
+/// never queries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Purpose {
     Query,
