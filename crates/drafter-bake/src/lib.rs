@@ -25,7 +25,7 @@ pub mod split;
 pub mod textures;
 
 use std::borrow::Cow;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use drafter_bounds::{Obb, ObbOptions, Projector, oriented_box};
 use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, Weld};
@@ -181,7 +181,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     };
     let mut stages = Vec::new();
     let mut timed =
-        |name: &'static str, start: Instant| stages.push(StageTiming { name, ms: start.elapsed().as_secs_f64() * 1e3 });
+        |name: &'static str, time: Duration| stages.push(StageTiming { name, ms: time.as_secs_f64() * 1e3 });
     let mut begin = |name: &str| {
         on_stage(STAGE_NAMES.iter().position(|&n| n == name).unwrap_or(0));
         Instant::now()
@@ -190,51 +190,40 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     // Welded topology of every mesh used by an instance, built once and shared by the stages.
     let start = begin("topology");
     let mut topologies = build_topologies(scene, config.segment.weld);
-    timed("topology", start);
+    timed("topology", start.elapsed());
 
     let start = begin("segment");
     let (parts, mut diagnostics) = drafter_segment::segment_with_topologies(scene, &topologies, &config.segment);
-    timed("segment", start);
+    timed("segment", start.elapsed());
 
-    let start = begin("bounds");
-    let records = bound_parts(scene, &parts, config)?;
-    timed("bounds", start);
-
-    let start = begin("normals");
-    let (vertex_data, normals_summary) = if config.normals.enabled {
-        let (data, summary, normal_diagnostics) = compute_normals(scene, &topologies, &config.normals);
-        diagnostics.extend(normal_diagnostics);
-        (data, Some(summary))
-    } else {
-        (vec![None; scene.meshes.len()], None)
-    };
-    // Primitives within 16-bit indices: groups split by the vertices the writer will write, before
-    // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
-    // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
-    let (splits, split_summary) = split::split_scene(scene, &vertex_data);
-    let compressing = config.compress == Compression::Meshopt && config.container == Container::Glb;
-    let mut vertex_data = vertex_data;
-    let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) && !compressing {
-        Cow::Borrowed(scene)
-    } else {
-        let mut copy = scene.clone();
-        for (mesh, split) in copy.meshes.iter_mut().zip(&splits) {
-            if let Some(split) = split {
-                mesh.groups = split.groups.clone();
-            }
-        }
-        if compressing {
-            // Each triangle starts at the corner the index codec keeps (`reorder.rs`).
-            for ((mesh, layout), topology) in copy.meshes.iter_mut().zip(&mut vertex_data).zip(&mut topologies) {
-                if let Some(layout) = layout {
-                    let groups = mesh.groups.clone();
-                    reorder::settle_rotations(mesh, layout, topology, &groups);
-                }
-            }
-        }
-        Cow::Owned(copy)
-    };
-    timed("normals", start);
+    // Bounds and normals read only the scene, the topologies and the parts: they run side by side.
+    // Bounds is one task per part, so a single-part mesh (the dragon: 87 ms of hull and search) ran
+    // on one core while the other waited; beside the normals' many small tasks it no longer does.
+    // Their timings overlap in the report.
+    begin("bounds");
+    let bounds_start = Instant::now();
+    let (records, normals_result) = rayon::join(
+        || bound_parts(scene, &parts, config).map(|records| (records, bounds_start.elapsed())),
+        || {
+            let start = Instant::now();
+            let result = normals_and_split(scene, &mut topologies, config);
+            (result, start.elapsed())
+        },
+    );
+    let (records, bounds_time) = records?;
+    let (normals, normals_time) = normals_result;
+    let NormalsAndSplit {
+        vertex_data,
+        summary: normals_summary,
+        diagnostics: normal_diagnostics,
+        splits,
+        split_summary,
+        written_scene,
+    } = normals;
+    diagnostics.extend(normal_diagnostics);
+    timed("bounds", bounds_time);
+    timed("normals", normals_time);
+    begin("normals");
 
     let start = begin("lines");
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
@@ -245,7 +234,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     } else {
         (vec![Vec::new(); scene.meshes.len()], vec![None; scene.meshes.len()], None)
     };
-    timed("lines", start);
+    timed("lines", start.elapsed());
 
     let start = begin("textures");
     let metal_parts = textures::metal_parts(scene, &parts, &records, config.textures.metallic_threshold);
@@ -255,7 +244,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     } else {
         Some(textures::bake(&request, metal_parts, config.textures.metallic_threshold)?)
     };
-    timed("textures", start);
+    timed("textures", start.elapsed());
 
     let start = begin("write");
     let bounds = scene.world_bounds();
@@ -299,7 +288,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         primitive_edges,
         mesh_silhouettes,
         textures: embedded,
-        quantized_normals: compressing,
+        quantized_normals: config.compress == Compression::Meshopt && config.container == Container::Glb,
     };
     let written = drafter_format::write(&output, &config.container).map_err(|e| match e {
         // The input's own JSON that cannot be carried over (a number beyond f64, nesting deeper
@@ -329,7 +318,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
             return Err(BakeError::Config("compression (meshopt) writes .glb files only".into()));
         }
     };
-    timed("write", start);
+    timed("write", start.elapsed());
     let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
     diagnostics.sort_by_key(|d| d.kind);
     let report = BakeReport {
@@ -348,6 +337,55 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     };
     begin("done");
     Ok(Baked { written, report, textures: texture_images })
+}
+
+/// What the normals stage hands on: per-mesh vertex data, the primitives split within 16-bit
+/// indices, and the scene as it will be written.
+struct NormalsAndSplit<'a> {
+    vertex_data: Vec<Option<VertexData>>,
+    summary: Option<NormalsSummary>,
+    diagnostics: Vec<Diagnostic>,
+    splits: Vec<Option<split::SplitGroups>>,
+    split_summary: split::SplitSummary,
+    written_scene: Cow<'a, Scene>,
+}
+
+/// The normals stage, then the primitives' split within 16-bit indices (and, when compressing, each
+/// triangle's rotation).
+fn normals_and_split<'a>(scene: &'a Scene, topologies: &mut [Topology], config: &BakeConfig) -> NormalsAndSplit<'a> {
+    let (vertex_data, summary, diagnostics) = if config.normals.enabled {
+        let (data, summary, diagnostics) = compute_normals(scene, topologies, &config.normals);
+        (data, Some(summary), diagnostics)
+    } else {
+        (vec![None; scene.meshes.len()], None, Vec::new())
+    };
+    // Primitives within 16-bit indices: groups split by the vertices the writer will write, before
+    // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
+    // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
+    let (splits, split_summary) = split::split_scene(scene, &vertex_data);
+    let compressing = config.compress == Compression::Meshopt && config.container == Container::Glb;
+    let mut vertex_data = vertex_data;
+    let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) && !compressing {
+        Cow::Borrowed(scene)
+    } else {
+        let mut copy = scene.clone();
+        for (mesh, split) in copy.meshes.iter_mut().zip(&splits) {
+            if let Some(split) = split {
+                mesh.groups = split.groups.clone();
+            }
+        }
+        if compressing {
+            // Each triangle starts at the corner the index codec keeps (`reorder.rs`).
+            for ((mesh, layout), topology) in copy.meshes.iter_mut().zip(&mut vertex_data).zip(topologies.iter_mut()) {
+                if let Some(layout) = layout {
+                    let groups = mesh.groups.clone();
+                    reorder::settle_rotations(mesh, layout, topology, &groups);
+                }
+            }
+        }
+        Cow::Owned(copy)
+    };
+    NormalsAndSplit { vertex_data, summary, diagnostics, splits, split_summary, written_scene }
 }
 
 /// Normals of every mesh used by an instance, in mesh order. UV seams are kept where the mesh has
