@@ -20,7 +20,8 @@
 //! window's surface compatibility check) then decides.
 //!
 //! The variable must be set before any thread exists (setting the environment is not thread
-//! safe), so `main` calls this first; this module is the crate's second `unsafe` place.
+//! safe), so `main` calls this first. This module is one of the crate's three `unsafe` places
+//! (with `interrupt` and `heap`).
 #![allow(unsafe_code)]
 
 /// The layer's off switch.

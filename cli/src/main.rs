@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 mod cmd;
 mod exit;
 mod gpu_env;
+mod heap;
 mod interrupt;
 
 #[derive(Debug, Parser)]
