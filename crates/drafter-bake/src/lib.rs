@@ -503,8 +503,14 @@ fn compute_lines(
                         encoded = drafter_lines::SilhouettesEncoded::default();
                     }
                     let triangles = &mesh.triangles[g.start as usize..(g.start + g.count) as usize];
-                    match drafter_lines::encode_edge_visibility_continuing(triangles, topology, &feature, &mut encoded)
-                    {
+                    let first_face = g.start as usize;
+                    match drafter_lines::encode_faces_continuing(
+                        triangles,
+                        first_face,
+                        topology,
+                        &feature,
+                        &mut encoded,
+                    ) {
                         Ok(v) if v.has_visible_edges() => Some(PrimitiveEdges {
                             hard_edge_classes: v
                                 .hard_edges

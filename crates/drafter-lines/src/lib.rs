@@ -17,7 +17,9 @@
 //!    `visibility` values plus `silhouetteNormals` as VEC3 normalized bytes (the merged draft);
 //!    [`decode_edge_visibility`] reads them back and recounts every edge against the encode-once
 //!    rules; [`encode_edge_visibility_continuing`] encodes the chunks of a primitive split for
-//!    16-bit indices (hard edges per chunk, each silhouette candidate once over the chunks).
+//!    16-bit indices (hard edges per chunk, each silhouette candidate once over the chunks), and
+//!    [`encode_faces_continuing`] does the same for a range of the topology's own faces, reading
+//!    each corner's edge id instead of searching for it (the bake's path; same bytes, tested).
 //! 3. [`BruteForce`] tests every candidate: the reference and the fallback. Structure of arrays,
 //!    64 candidates per step into one bitset word, SSE2 by auto-vectorisation, rayon above
 //!    [`PARALLEL_MIN_CANDIDATES`]; about 1.2–2 G orthographic and 0.6–1.7 G perspective candidates
@@ -123,4 +125,5 @@ pub use set::EdgeSet;
 pub use visibility::{
     DecodedEdgeVisibility, EdgeVisibility, HARD, HARD_REPEATED, HIDDEN, SILHOUETTE, SilhouettesEncoded,
     VisibilityError, decode_edge_visibility, encode_edge_visibility, encode_edge_visibility_continuing,
+    encode_faces_continuing,
 };

@@ -30,7 +30,7 @@
 
 use std::collections::HashMap;
 
-use drafter_core::{Topology, snorm8_encode_direction};
+use drafter_core::{EDGE_NONE, Topology, snorm8_encode_direction};
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -130,7 +130,41 @@ pub fn encode_edge_visibility_continuing(
     lines: &FeatureEdges,
     encoded: &mut SilhouettesEncoded,
 ) -> Result<EdgeVisibility, VisibilityError> {
-    let lookup = EdgeLookup::new(topology);
+    encode_chunk(triangles, None, topology, lines, encoded)
+}
+
+/// [`encode_edge_visibility_continuing`] for triangles that are the faces `first_face..` of the mesh
+/// `topology` was built from (a primitive's range of them, as the bake writes it): each corner's
+/// edge is read from `topology.face_edges` instead of searched for by its welded vertex pair
+/// (a binary search per corner, a third of the dragon's serial encoding time). Same output.
+pub fn encode_faces_continuing(
+    triangles: &[[u32; 3]],
+    first_face: usize,
+    topology: &Topology,
+    lines: &FeatureEdges,
+    encoded: &mut SilhouettesEncoded,
+) -> Result<EdgeVisibility, VisibilityError> {
+    encode_chunk(triangles, Some(first_face), topology, lines, encoded)
+}
+
+fn encode_chunk(
+    triangles: &[[u32; 3]],
+    first_face: Option<usize>,
+    topology: &Topology,
+    lines: &FeatureEdges,
+    encoded: &mut SilhouettesEncoded,
+) -> Result<EdgeVisibility, VisibilityError> {
+    // The faces' own edge ids, where the caller says the triangles are the topology's faces.
+    let face_edges = match first_face {
+        Some(first) => Some(
+            first
+                .checked_add(triangles.len())
+                .and_then(|end| topology.face_edges.get(first..end))
+                .ok_or(VisibilityError::UnknownEdge { triangle: 0, corner: 0 })?,
+        ),
+        None => None,
+    };
+    let lookup = if face_edges.is_some() { None } else { Some(EdgeLookup::new(topology)) };
     let mut out = EdgeVisibility { visibility: vec![0; (6 * triangles.len()).div_ceil(8)], ..Default::default() };
     let mut written = vec![false; topology.edges.len()];
     if encoded.candidate_of_edge.len() != topology.edges.len() {
@@ -153,7 +187,15 @@ pub fn encode_edge_visibility_continuing(
         }
         for k in 0..3 {
             let (a, b) = (welded[k], welded[(k + 1) % 3]);
-            let e = lookup.find(a, b).ok_or(VisibilityError::UnknownEdge { triangle: t, corner: k })?;
+            let e = match (face_edges, &lookup) {
+                // A triangle that is not the topology's face breaks the caller's promise: reported
+                // as an unknown edge, never read as another face's edge.
+                (Some(edges), _) => (topology.faces[first_face.unwrap_or(0) + t] == welded && edges[t][k] != EDGE_NONE)
+                    .then_some(edges[t][k] as usize),
+                (None, Some(lookup)) => lookup.find(a, b),
+                (None, None) => None,
+            }
+            .ok_or(VisibilityError::UnknownEdge { triangle: t, corner: k })?;
             let class = lines.classes[e];
             let value = if class.is_hard() {
                 if written[e] {

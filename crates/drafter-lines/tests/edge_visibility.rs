@@ -180,3 +180,31 @@ fn chunks_of_a_split_primitive_encode_hard_edges_each_and_silhouettes_once() {
             .unwrap();
     assert_eq!(again, whole);
 }
+
+#[test]
+fn encoding_faces_by_their_edge_ids_equals_the_searching_encoder() {
+    // The bake's encoder reads each corner's edge from `Topology::face_edges`; the general one finds
+    // it by its welded vertex pair. Same bytes, chunk by chunk, on meshes with degenerate, collapsed,
+    // non-manifold and boundary faces (the random lattices have all of them).
+    let mut meshes = vec![uv_sphere(32, 20), plate_with_holes(4, 12)];
+    meshes.extend((0..6).map(|seed| random_lattice_mesh(300, 1500, seed)));
+    for mesh in &meshes {
+        let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
+        let lines = classify_edges(&topology, None, &LineOptions::default()).unwrap();
+        let n = mesh.triangles.len();
+        let cuts = [0, n / 3, 2 * n / 3, n];
+        let (mut searching, mut by_id) = (SilhouettesEncoded::default(), SilhouettesEncoded::default());
+        for w in cuts.windows(2) {
+            let chunk = &mesh.triangles[w[0]..w[1]];
+            let expected = encode_edge_visibility_continuing(chunk, &topology, &lines, &mut searching).unwrap();
+            let got = encode_faces_continuing(chunk, w[0], &topology, &lines, &mut by_id).unwrap();
+            assert_eq!(got, expected, "{}: chunk at {}", mesh.name, w[0]);
+        }
+        // Triangles that are not the faces named are refused, never read as other faces' edges.
+        let shifted =
+            encode_faces_continuing(&mesh.triangles[1..], 0, &topology, &lines, &mut SilhouettesEncoded::default());
+        assert!(matches!(shifted, Err(VisibilityError::UnknownEdge { .. })), "{}", mesh.name);
+        let beyond = encode_faces_continuing(&mesh.triangles, 1, &topology, &lines, &mut SilhouettesEncoded::default());
+        assert!(matches!(beyond, Err(VisibilityError::UnknownEdge { .. })), "{}", mesh.name);
+    }
+}
