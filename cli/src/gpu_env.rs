@@ -20,8 +20,7 @@
 //! window's surface compatibility check) then decides.
 //!
 //! The variable must be set before any thread exists (setting the environment is not thread
-//! safe), so `main` calls this first. This module is one of the crate's three `unsafe` places
-//! (with `interrupt` and `heap`).
+//! safe), so `main` calls this first; this module is the crate's second `unsafe` place.
 #![allow(unsafe_code)]
 
 /// The layer's off switch.

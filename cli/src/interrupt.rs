@@ -3,9 +3,9 @@
 //! an interrupted bake leaves nothing behind, and the previous output, which only the final rename
 //! replaces, stays intact.
 //!
-//! One of the crate's three `unsafe` places (the others are `gpu_env` and `heap`): a POSIX signal
-//! handler may only call async-signal-safe functions, so it reads the registered path from an
-//! atomic pointer and calls `unlink` and `_exit` (both async-signal-safe), nothing else.
+//! One of the crate's two `unsafe` places (the other is `gpu_env`): a POSIX signal handler may
+//! only call async-signal-safe functions, so it reads the registered path from an atomic pointer
+//! and calls `unlink` and `_exit` (both async-signal-safe), nothing else.
 #![allow(unsafe_code)]
 
 use std::ffi::CString;

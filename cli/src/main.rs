@@ -11,7 +11,6 @@ use clap::{Parser, Subcommand};
 mod cmd;
 mod exit;
 mod gpu_env;
-mod heap;
 mod interrupt;
 
 #[derive(Debug, Parser)]

@@ -162,13 +162,7 @@ pub fn run(args: Args) -> Result<()> {
         sha256: sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect(),
     };
 
-    let mut on_stage = |i: usize| {
-        if drafter_bake::STAGE_NAMES[i] == "lines" {
-            // The lines stage is where a bake's memory peaks: it starts from what is live.
-            crate::heap::release_free_memory();
-        }
-        progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
-    };
+    let mut on_stage = |i: usize| progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
     let mut baked = drafter_bake::bake_observed(&imported.scene, &config, &mut on_stage).map_err(|e| match e {
         BakeError::Config(_) | BakeError::Input(_) => {
             anyhow::Error::from(BadInput(format!("{}: {e}", input_path.display())))
