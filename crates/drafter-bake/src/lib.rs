@@ -588,6 +588,18 @@ fn hard_edge_code(class: EdgeClass) -> u8 {
     }
 }
 
+/// `data` cut into consecutive slices of `per_item · count` elements, one per count, so that each
+/// primitive fills its own slice on the thread pool.
+fn split_by_counts<'a, T>(mut data: &'a mut [T], counts: &[usize], per_item: usize) -> Vec<&'a mut [T]> {
+    let mut slices = Vec::with_capacity(counts.len());
+    for &count in counts {
+        let (slice, rest) = data.split_at_mut(per_item * count);
+        slices.push(slice);
+        data = rest;
+    }
+    slices
+}
+
 /// The mesh's silhouette candidates as every reader of the file sees them (format 0.2): the edges
 /// its primitives' `EXT_mesh_primitive_edge_visibility` encodes as 1, primitive by primitive in
 /// encoding order, with the decoded `silhouetteNormals` and, as the perspective test's point, the
@@ -611,45 +623,43 @@ fn silhouettes_of(
     let mut corners = vec![0u32; total];
     let mut normals = vec![[glam::Vec3::ZERO; 2]; total];
     let mut points = vec![glam::Vec3::ZERO; total];
-    let mut slices = Vec::with_capacity(edges.len());
-    let (mut corners_left, mut normals_left, mut points_left) = (&mut corners[..], &mut normals[..], &mut points[..]);
-    for &count in &counts {
-        let (c, rest_c) = corners_left.split_at_mut(count);
-        let (n, rest_n) = normals_left.split_at_mut(count);
-        let (p, rest_p) = points_left.split_at_mut(count);
-        slices.push((c, n, p));
-        (corners_left, normals_left, points_left) = (rest_c, rest_n, rest_p);
-    }
-    mesh.groups.par_iter().zip(edges).zip(slices).for_each(|((group, primitive_edges), (corners, normals, points))| {
-        let Some(e) = primitive_edges else { return };
-        let range = group.start as usize..(group.start + group.count) as usize;
-        // The position the writer gives each corner: with a new vertex layout, an output vertex
-        // takes the mesh vertex of its first corner in this primitive (as `write_vertex_data` does).
-        // Output vertex → the mesh vertex of its first corner here (u32::MAX: not in this primitive).
-        let written: Option<Vec<u32>> = layout.map(|vd| {
-            let mut first = vec![u32::MAX; vd.source_vertex.len()];
-            for (t, mesh_triangle) in vd.triangles[range.clone()].iter().zip(&mesh.triangles[range.clone()]) {
-                for (&o, &v) in t.iter().zip(mesh_triangle) {
-                    if let Some(slot) = first.get_mut(o as usize).filter(|s| **s == u32::MAX) {
-                        *slot = v;
+    let slices = split_by_counts(&mut corners, &counts, 1)
+        .into_iter()
+        .zip(split_by_counts(&mut normals, &counts, 1))
+        .zip(split_by_counts(&mut points, &counts, 1))
+        .map(|((c, n), p)| (c, n, p));
+    mesh.groups.par_iter().zip(edges).zip(slices.collect::<Vec<_>>()).for_each(
+        |((group, primitive_edges), (corners, normals, points))| {
+            let Some(e) = primitive_edges else { return };
+            let range = group.start as usize..(group.start + group.count) as usize;
+            // The position the writer gives each corner: with a new vertex layout, an output vertex
+            // takes the mesh vertex of its first corner in this primitive (as `write_vertex_data` does).
+            // Output vertex → the mesh vertex of its first corner here (u32::MAX: not in this primitive).
+            let written: Option<Vec<u32>> = layout.map(|vd| {
+                let mut first = vec![u32::MAX; vd.source_vertex.len()];
+                for (t, mesh_triangle) in vd.triangles[range.clone()].iter().zip(&mesh.triangles[range.clone()]) {
+                    for (&o, &v) in t.iter().zip(mesh_triangle) {
+                        if let Some(slot) = first.get_mut(o as usize).filter(|s| **s == u32::MAX) {
+                            *slot = v;
+                        }
                     }
                 }
+                first
+            });
+            for (i, slot) in e.silhouette_slots().enumerate() {
+                let t = group.start as usize + slot as usize / 3;
+                let k = slot as usize % 3;
+                let vertex = match (&written, layout) {
+                    (Some(first), Some(vd)) => first[vd.triangles[t][k] as usize],
+                    _ => mesh.triangles[t][k],
+                };
+                corners[i] = 3 * t as u32 + k as u32;
+                let decoded = |j: usize| e.silhouette_normals.decoded(j).unwrap_or(glam::Vec3::ZERO);
+                normals[i] = [decoded(2 * i), decoded(2 * i + 1)];
+                points[i] = mesh.positions[vertex as usize];
             }
-            first
-        });
-        for (i, slot) in e.silhouette_slots().enumerate() {
-            let t = group.start as usize + slot as usize / 3;
-            let k = slot as usize % 3;
-            let vertex = match (&written, layout) {
-                (Some(first), Some(vd)) => first[vd.triangles[t][k] as usize],
-                _ => mesh.triangles[t][k],
-            };
-            corners[i] = 3 * t as u32 + k as u32;
-            let decoded = |j: usize| e.silhouette_normals.decoded(j).unwrap_or(glam::Vec3::ZERO);
-            normals[i] = [decoded(2 * i), decoded(2 * i + 1)];
-            points[i] = mesh.positions[vertex as usize];
-        }
-    });
+        },
+    );
     let options =
         SilhouetteOptions { orthographic: hierarchies, perspective: hierarchies, ..SilhouetteOptions::default() };
     // The hierarchies store no candidate order (format 0.2): a reader derives it from the
@@ -660,13 +670,7 @@ fn silhouettes_of(
     // consumed its own (31 MB less at the bake's peak on the dragon).
     // Per primitive on the thread pool, each into its own slice (as the gather above).
     let mut candidate_normals = vec![0.0f32; 6 * total];
-    let mut slices = Vec::with_capacity(edges.len());
-    let mut left = &mut candidate_normals[..];
-    for &count in &counts {
-        let (slice, rest) = left.split_at_mut(6 * count);
-        slices.push(slice);
-        left = rest;
-    }
+    let slices = split_by_counts(&mut candidate_normals, &counts, 6);
     edges.par_iter().zip(slices).for_each(|(e, out)| {
         let Some(e) = e else { return };
         for (j, xyz) in out.chunks_exact_mut(3).enumerate() {
