@@ -22,6 +22,12 @@ pub fn snorm8_encode(n: Vec3) -> [i8; 3] {
     encode(n, 127.0).map(|c| c as i8)
 }
 
+/// The squared lengths of the lattice points whose length is within 0.866026 (√3/2 rounded up:
+/// how far per-component rounding can move a point of the lattice) of 127: 126.134² = 15909.8
+/// and 127.867² = 16349.7, and no integer is near either bound (the test
+/// `lattice_length_range_is_the_float_rule` checks every integer against the lengths).
+const LATTICE_LENGTHS_SQUARED: std::ops::RangeInclusive<f64> = 15910.0..=16349.0;
+
 /// A unit vector as the normalized signed bytes whose direction is nearest to it: of the 8 points
 /// `floor`/`ceil` of `127·n` per component whose length is within `√3/2` of 127 (as long or short
 /// as per-component rounding can make it, so the decoded vector stays within 0.7 % of unit length,
@@ -31,8 +37,6 @@ pub fn snorm8_encode(n: Vec3) -> [i8; 3] {
 /// the mean angular error from 0.17° to 0.14° and the largest from 0.38° to 0.31°. A non-finite or
 /// zero `n` encodes as [`snorm8_encode`] does.
 pub fn snorm8_encode_direction(n: Vec3) -> [i8; 3] {
-    // √3/2, rounded up: how far per-component rounding can move a point of the lattice.
-    const HALF_LATTICE_DIAGONAL: f64 = 0.866_026;
     let plain = snorm8_encode(n);
     if !n.is_finite() || n == Vec3::ZERO {
         return plain;
@@ -45,10 +49,14 @@ pub fn snorm8_encode_direction(n: Vec3) -> [i8; 3] {
         let pick = |axis: usize, l: f64, h: f64| if k >> (2 - axis) & 1 == 0 { l } else { h };
         let c = glam::DVec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
             .clamp(glam::DVec3::splat(-127.0), glam::DVec3::splat(127.0));
-        let length = c.length();
-        if length == 0.0 || (length - 127.0).abs() > HALF_LATTICE_DIAGONAL {
+        // The components are integers, so the squared length is an exact integer: the length
+        // test is an integer range, and the square root is taken only for the points it keeps
+        // (the silhouette candidates of a million-triangle mesh call this over a million times).
+        let length_squared = c.dot(c);
+        if !LATTICE_LENGTHS_SQUARED.contains(&length_squared) {
             continue;
         }
+        let length = length_squared.sqrt();
         let cos = c.dot(n) / length;
         if cos > best.0 {
             best = (cos, [c.x as i8, c.y as i8, c.z as i8]);
@@ -144,6 +152,16 @@ mod tests {
             worst = worst.max(n.as_dvec3().normalize().dot(back).clamp(-1.0, 1.0).acos().to_degrees() as f32);
         }
         worst
+    }
+
+    #[test]
+    fn lattice_length_range_is_the_float_rule() {
+        const HALF_LATTICE_DIAGONAL: f64 = 0.866_026;
+        for k in 0..=3 * 127 * 127 {
+            let length = f64::from(k).sqrt();
+            let float_rule = length != 0.0 && (length - 127.0).abs() <= HALF_LATTICE_DIAGONAL;
+            assert_eq!(LATTICE_LENGTHS_SQUARED.contains(&f64::from(k)), float_rule, "squared length {k}");
+        }
     }
 
     #[test]

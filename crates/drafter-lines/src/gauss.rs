@@ -487,7 +487,9 @@ fn most_inside(cells: &[Cell], p: DVec3) -> usize {
 /// The midpoint of the arc between unit normals `n1`, `n2`; `None` for a zero or antipodal arc.
 fn arc_mid([n1, n2]: [DVec3; 2]) -> Option<DVec3> {
     let sum = n1 + n2;
-    (n1 != DVec3::ZERO && n2 != DVec3::ZERO && sum.length() > 1e-9).then(|| sum.normalize())
+    let length = sum.length();
+    // `sum * (1 / length)` is glam's `normalize`, without taking the length a second time.
+    (n1 != DVec3::ZERO && n2 != DVec3::ZERO && length > 1e-9).then(|| sum * (1.0 / length))
 }
 
 /// The cell with digits `key` ([`BuildNode::key`]) `cells` cells down from `base`.
@@ -757,9 +759,10 @@ fn subtree_cap(arcs: &[Arc], cell_center: Option<DVec3>) -> Measured {
         p_sum += ps;
         p_max = p_max.max(pm);
     }
-    let widest = |c: DVec3| {
-        let of = |chunk: &[Arc]| widest_angle_of_arcs(c, chunk);
-        if parallel { arcs.par_chunks(CAP_CHUNK).map(of).reduce(|| 0.0, f64::max) } else { of(arcs) }
+    let widest = |c: &[DVec3]| {
+        let of = |chunk: &[Arc]| widest_angles_of_arcs(c, chunk);
+        let max = |a: [f64; 2], b: [f64; 2]| [a[0].max(b[0]), a[1].max(b[1])];
+        if parallel { arcs.par_chunks(CAP_CHUNK).map(of).reduce(|| [0.0; 2], max) } else { of(arcs) }
     };
     // A bound below the true one (rounding of the norms and of `sin`) keeps the rule conservative.
     let shrink = 1.0 - 1e-9;
@@ -855,14 +858,21 @@ impl Builder {
         }
         out[index].tried = true;
         // Where each arc goes, then a stable counting scatter: own arcs first, then by child.
+        let quad = (children.len() == 4).then(|| Quad::of(&children));
         let target = |g: &Arc| {
             g.mid()
                 .and_then(|m| {
-                    let (best, _) = children
-                        .iter()
-                        .enumerate()
-                        .map(|(k, c)| (k, c.cell.score(m)))
-                        .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
+                    let best = match &quad {
+                        Some(q) => q.most_inside(m),
+                        None => {
+                            children
+                                .iter()
+                                .enumerate()
+                                .map(|(k, c)| (k, c.cell.score(m)))
+                                .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
+                                .0
+                        }
+                    };
                     (best < children.len() && self.fits(&children[best], g)).then_some(best as u8)
                 })
                 .unwrap_or(STAY)
@@ -954,6 +964,45 @@ impl Builder {
     }
 }
 
+/// The four children of a cell ([`Cell::children`]: three corners, then the middle one) for
+/// [`Quad::most_inside`]. Each corner shares one edge with the middle cell, and its edge plane
+/// is the middle's plane negated, bit for bit (a cross product with its factors swapped, then
+/// normalised), so the four scores need 9 dot products instead of 12.
+struct Quad {
+    /// Each corner's two planes not shared with the middle cell.
+    outer: [[DVec3; 2]; 3],
+    middle: [DVec3; 3],
+}
+
+impl Quad {
+    fn of(children: &[BinCell]) -> Quad {
+        let [c0, c1, c2, c3] = [0, 1, 2, 3].map(|k| children[k].cell.planes);
+        debug_assert!(c0[1] == -c3[2] && c1[2] == -c3[0] && c2[0] == -c3[1]);
+        Quad { outer: [[c0[0], c0[2]], [c1[0], c1[1]], [c2[1], c2[2]]], middle: c3 }
+    }
+
+    /// What `Cell::score` and the first-of-equals maximum give over the four children.
+    #[inline(always)]
+    fn most_inside(&self, p: DVec3) -> usize {
+        let d = self.middle.map(|m| m.dot(p));
+        let o = self.outer.map(|[a, b]| [a.dot(p), b.dot(p)]);
+        // `Cell::score`'s order of minima (a minimum of non-NaN values does not depend on it).
+        let scores = [
+            o[0][0].min(-d[2]).min(o[0][1]),
+            o[1][0].min(o[1][1]).min(-d[0]),
+            (-d[1]).min(o[2][0]).min(o[2][1]),
+            d[0].min(d[1]).min(d[2]),
+        ];
+        let mut best = (usize::MAX, f64::NEG_INFINITY);
+        for (k, s) in scores.into_iter().enumerate() {
+            if s > best.1 {
+                best = (k, s);
+            }
+        }
+        best.0
+    }
+}
+
 /// The widest angle between the unit vector `c` and the unit vectors `points`. The exact angle
 /// (`atan2` of the cross and dot products, accurate at every size) is evaluated only for points
 /// whose dot product is within rounding of the smallest so far, so the result is the exact
@@ -967,16 +1016,30 @@ fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
     w.widest
 }
 
-/// [`widest_angle`] over both endpoints of `arcs` in order. A plain loop: the build runs this over
-/// every arc at every level, and through a `flat_map` over the pairs it was 22 % of a one-thread
-/// profile of the dragon's build, against 4 % now.
-fn widest_angle_of_arcs(c: DVec3, arcs: &[Arc]) -> f64 {
-    let mut w = Widest::default();
-    for a in arcs {
-        w.add(c, a.n1);
-        w.add(c, a.n2);
+/// [`widest_angle`] over both endpoints of `arcs` in order, from each of up to two centres `cs`
+/// in one pass over the arcs (the first `cs.len()` results; the others are 0). A plain loop: the
+/// build runs this over every arc at every level, and through a `flat_map` over the pairs it was
+/// 22 % of a one-thread profile of the dragon's build, against 4 % then.
+fn widest_angles_of_arcs(cs: &[DVec3], arcs: &[Arc]) -> [f64; 2] {
+    let mut w = [Widest::default(), Widest::default()];
+    match *cs {
+        [c] => {
+            for a in arcs {
+                w[0].add(c, a.n1);
+                w[0].add(c, a.n2);
+            }
+        }
+        [c0, c1] => {
+            for a in arcs {
+                w[0].add(c0, a.n1);
+                w[0].add(c0, a.n2);
+                w[1].add(c1, a.n1);
+                w[1].add(c1, a.n2);
+            }
+        }
+        _ => {}
     }
-    w.widest
+    [w[0].widest, w[1].widest]
 }
 
 /// The running state of [`widest_angle`].
@@ -1009,12 +1072,18 @@ impl Widest {
 /// threshold `sin r + ε` rounded up, `r` measured from the `f32` centre. The centre is the cell's
 /// centre or the endpoints' mean (`mean`: their sum, any length), whichever gives the smaller
 /// radius; `widest` is the widest angle from a unit centre to the endpoints.
-fn cap_of(cell_center: Option<DVec3>, mean: DVec3, widest: impl Fn(DVec3) -> f64) -> [f32; 4] {
-    let mut best: Option<([f32; 3], f64)> = None;
+fn cap_of(cell_center: Option<DVec3>, mean: DVec3, widest: impl Fn(&[DVec3]) -> [f64; 2]) -> [f32; 4] {
+    let mut centres = [(Vec3::ZERO, DVec3::ZERO); 2];
+    let mut count = 0;
     for center in [cell_center, (mean.length() > 1e-12).then(|| mean.normalize())].into_iter().flatten() {
         let c32 = center.as_vec3();
-        let c = c32.as_dvec3().normalize();
-        let r = widest(c);
+        centres[count] = (c32, c32.as_dvec3().normalize());
+        count += 1;
+    }
+    let units = centres.map(|(_, c)| c);
+    let radii = widest(&units[..count]);
+    let mut best: Option<([f32; 3], f64)> = None;
+    for ((c32, _), r) in centres.into_iter().zip(radii).take(count) {
         if best.is_none_or(|(_, b)| r < b) {
             best = Some((c32.to_array(), r));
         }
@@ -1516,6 +1585,43 @@ fn visit_probabilities(nodes: &[BuildNode], caps: &[[f32; 4]]) -> Vec<f64> {
 mod tests {
     use super::*;
 
+    /// The nine-product scoring of four children picks the child `Cell::score` and the
+    /// first-of-equals maximum pick, on points inside, on the edges and at the corners of cells
+    /// down to level 8, and on points far outside.
+    #[test]
+    fn quad_scores_pick_the_cell_scores_pick() {
+        let mut rng = crate::measure::ViewRng::new(11);
+        let mut cell = base_cells(BaseSolid::Icosahedron)[3];
+        for level in 0..9 {
+            let children = cell.children();
+            let bins: Vec<BinCell> = children.iter().map(|&cell| BinCell { cell, cos_bin: 0.0 }).collect();
+            let quad = Quad::of(&bins);
+            let [a, b, c] = cell.v;
+            let mut points = vec![a, b, c, (a + b).normalize(), (b + c).normalize(), (c + a).normalize()];
+            for _ in 0..3000 {
+                let w = [rng.unit().abs(), rng.unit().abs(), rng.unit().abs()];
+                // Inside, and pulled onto an edge by zeroing one weight.
+                let k = points.len() % 4;
+                let w = if k < 3 { std::array::from_fn(|i| if i == k { 0.0 } else { w[i] }) } else { w };
+                points.push((a * f64::from(w[0]) + b * f64::from(w[1]) + c * f64::from(w[2])).normalize_or_zero());
+                points.push(rng.direction().as_dvec3().normalize());
+            }
+            for p in points {
+                if p == DVec3::ZERO {
+                    continue;
+                }
+                let expected = children
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| (k, c.score(p)))
+                    .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
+                    .0;
+                assert_eq!(quad.most_inside(p), expected, "level {level}, point {p}");
+            }
+            cell = children[level % 4];
+        }
+    }
+
     #[test]
     fn arc_paths_equal_arc_path_arc_by_arc() {
         let mut rng = crate::measure::ViewRng::new(7);
@@ -1668,6 +1774,12 @@ mod tests {
             let points: Vec<DVec3> = (0..500).map(|_| (c + rng.direction().as_dvec3() * spread).normalize()).collect();
             let exact = points.iter().map(|p| c.cross(*p).length().atan2(c.dot(*p))).fold(0.0f64, f64::max);
             assert_eq!(widest_angle(c, points.iter().copied()), exact, "round {round}");
+            // The pass over arcs from two centres at once gives each centre's widest angle.
+            let arcs: Vec<Arc> = points.chunks_exact(2).map(|p| Arc { n1: p[0], n2: p[1], ..Arc::default() }).collect();
+            let other = (c + rng.direction().as_dvec3() * spread).normalize();
+            let of_other = widest_angle(other, points.iter().copied());
+            assert_eq!(widest_angles_of_arcs(&[c, other], &arcs), [exact, of_other], "round {round}");
+            assert_eq!(widest_angles_of_arcs(&[other], &arcs), [of_other, 0.0], "round {round}");
         }
     }
 
