@@ -145,6 +145,10 @@ pub fn encode_faces_continuing(
     lines: &FeatureEdges,
     encoded: &mut SilhouettesEncoded,
 ) -> Result<EdgeVisibility, VisibilityError> {
+    // On one thread the passes cost more than the serial walk (dragon: 250 against 207 ms).
+    if rayon::current_num_threads() == 1 {
+        return encode_chunk(triangles, Some(first_face), topology, lines, encoded);
+    }
     encode_faces_in_blocks(triangles, first_face, topology, lines, encoded, FACE_BLOCK)
 }
 
@@ -152,9 +156,9 @@ pub fn encode_faces_continuing(
 /// visibility bits fill whole bytes.
 const FACE_BLOCK: usize = 4096;
 
-/// [`encode_chunk`] over the topology's faces `first_face..`, on the thread pool: the serial walk
-/// took 23–33 ms for each of the dragon's eight chunks (about 0.23 s of its 1.5 s lines stage at
-/// two threads); these passes, with the normals' rounding on the pool too, 19–23 ms.
+/// [`encode_chunk`] over the topology's faces `first_face..`, on the thread pool. The dragon's
+/// eight chunks, two threads, six bakes each: 171–187 ms for the serial walk, 142–168 ms here;
+/// the walk does not use a second core at all, these passes use every core there is.
 ///
 /// The encode-once rules only ask whether a corner is its edge's first in the chunk, so the
 /// serial walk becomes three passes: each triangle's edges, each edge's first corner (an atomic
