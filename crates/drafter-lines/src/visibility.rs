@@ -190,32 +190,30 @@ fn encode_faces_in_blocks(
     // Each triangle's edges ([`NO_EDGES`] for a collapsed one), or the error the serial walk
     // meets at it, with its corner slot (the walk checks a triangle's vertices before its edges).
     const NO_EDGES: [u32; 3] = [EDGE_NONE; 3];
-    let corners: Vec<Result<[u32; 3], (u32, VisibilityError)>> = triangles
-        .par_iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let slot = 3 * t as u32;
-            let welded = welded_triangle(tri, t, &topology.welded_of_vertex).map_err(|e| (slot, e))?;
-            if collapsed(&welded) {
-                return Ok(NO_EDGES);
-            }
-            let edges = face_edges[t];
-            match (0..3).find(|&k| faces[t] != welded || edges[k] == EDGE_NONE) {
-                Some(k) => Err((slot + k as u32, unknown(t, k))),
-                None => Ok(edges),
-            }
-        })
-        .collect();
-    let first_error = corners.par_iter().find_first(|c| c.is_err()).and_then(|c| c.clone().err());
+    let edges_of = |t: usize| -> Result<[u32; 3], (u32, VisibilityError)> {
+        let slot = 3 * t as u32;
+        let welded = welded_triangle(&triangles[t], t, &topology.welded_of_vertex).map_err(|e| (slot, e))?;
+        if collapsed(&welded) {
+            return Ok(NO_EDGES);
+        }
+        let edges = face_edges[t];
+        match (0..3).find(|&k| faces[t] != welded || edges[k] == EDGE_NONE) {
+            Some(k) => Err((slot + k as u32, unknown(t, k))),
+            None => Ok(edges),
+        }
+    };
+    // Kept as bare edge ids (12 bytes a triangle; a broken triangle has none), and the first
+    // error found in a second pass.
+    let corners: Vec<[u32; 3]> =
+        (0..triangles.len()).into_par_iter().map(|t| edges_of(t).unwrap_or(NO_EDGES)).collect();
+    let first_error = (0..triangles.len()).into_par_iter().find_map_first(|t| edges_of(t).err());
 
     // Each edge's first corner slot in this chunk.
     let first: Vec<AtomicU32> = (0..topology.edges.len()).into_par_iter().map(|_| AtomicU32::new(u32::MAX)).collect();
-    corners.par_iter().enumerate().for_each(|(t, c)| {
-        if let Ok(edges) = c {
-            for (k, &e) in edges.iter().enumerate() {
-                if e != EDGE_NONE {
-                    first[e as usize].fetch_min(3 * t as u32 + k as u32, Ordering::Relaxed);
-                }
+    corners.par_iter().enumerate().for_each(|(t, edges)| {
+        for (k, &e) in edges.iter().enumerate() {
+            if e != EDGE_NONE {
+                first[e as usize].fetch_min(3 * t as u32 + k as u32, Ordering::Relaxed);
             }
         }
     });
@@ -230,8 +228,7 @@ fn encode_faces_in_blocks(
         .enumerate()
         .map(|(b, (corners, bytes))| {
             let (mut hard, mut silhouettes) = (Vec::new(), Vec::new());
-            for (i, c) in corners.iter().enumerate() {
-                let Ok(edges) = c else { continue };
+            for (i, edges) in corners.iter().enumerate() {
                 let t = b * block + i;
                 for (k, &e) in edges.iter().enumerate() {
                     if e == EDGE_NONE {
