@@ -43,7 +43,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    // Before anything else, while the process has one thread (see the module's docs).
+    // Before anything else, while the process has one thread (see the modules' docs).
+    drafter_bake::heap::keep_freed_memory();
     gpu_env::quiet_device_select();
     let cli = Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {

@@ -1,24 +1,60 @@
-//! Hands freed heap pages back to the kernel before the lines stage, where a bake's memory peaks.
+//! The heap between stages: freed arrays are reused, or handed back before the lines stage.
 //!
-//! glibc keeps a freed block in the arena of the thread that freed it, and every rayon worker has
-//! its own arena. Since bounds and normals run side by side, the blocks they free stay spread over
-//! those arenas: at the dragon's peak 30–60 MB of freed memory still counted as resident (494 MB
-//! against 443 MB with the stages in turn), and 180 MB at the 2.18M-triangle level of the scaling
-//! benchmark. `malloc_trim` returns the free pages of every arena; called as the lines stage
-//! starts, the peak is back below where it was (dragon 430 MB, 2.18M level 581 MB); the bake's wall
-//! time did not measurably change (interleaved runs, docs/bench.md).
+//! A bake allocates and frees arrays of tens of megabytes stage after stage. Two glibc habits cost
+//! memory or time there:
 //!
-//! The crate's one `unsafe` place: a call into the C library with no preconditions. Off glibc
-//! (musl, macOS, Windows) there is nothing to call.
+//! * Every rayon worker has its own arena, and a freed block stays in the arena of the thread that
+//!   freed it. Since bounds and normals run side by side, the blocks they free stay spread over those
+//!   arenas: at the dragon's peak 30–60 MB of freed memory still counted as resident (494 MB against
+//!   443 MB with the stages in turn), and 180 MB at the 2.18M-triangle level of the scaling benchmark.
+//! * Every block above the mmap threshold (at most 32 MB) gets a mapping of its own, unmapped on free,
+//!   so the next stage's arrays fault in and zero fresh pages again: the dragon bake touched 900 MB of
+//!   new pages (233k page faults) to peak at 450 MB, 0.6–0.8 s of system time in 3.7 CPU-seconds.
+//!
+//! [`keep_freed_memory`], for a process that bakes (the command-line tool calls it first thing), turns
+//! both off: one arena, no block mappings, no trimming. Freed blocks stay in one heap and the next
+//! stage reuses them: 110k page faults, 0.43–0.46 s of system time, the same peak (docs/bench.md,
+//! "Heap reuse"). mimalloc was measured too: it kept 535 MB instead of 443 MB at the peak and spent as
+//! much system time. In a process that did not call it (a library user with its own allocator
+//! policy), [`release_free_memory`] instead returns the free pages of every arena to the kernel as the
+//! lines stage starts, where a bake's memory peaks (dragon 430 MB, 2.18M level 581 MB).
+//!
+//! The crate's one `unsafe` place: calls into the C library with no preconditions beyond the one
+//! stated. Off glibc (musl, macOS, Windows) there is nothing to call.
 #![allow(unsafe_code)]
 
-/// Returns the free pages of glibc's arenas to the kernel; a no-op off glibc. Only unused memory is
-/// touched: the bake's data and its output do not change.
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set once [`keep_freed_memory`] has run: the process keeps freed blocks for reuse.
+static KEEPING: AtomicBool = AtomicBool::new(false);
+
+/// Keeps freed heap memory in one glibc arena for reuse instead of unmapping or trimming it (see the
+/// module docs). Call it first thing in `main`, while the process has one thread; the memory a bake
+/// frees then stays with the process until it exits, which suits a command-line bake. A no-op off glibc.
+pub fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `mallopt` only changes glibc's allocator parameters; the caller runs it before any
+    // other thread exists, as glibc asks for `M_ARENA_MAX`.
+    unsafe {
+        // One heap for all threads: a block freed by one worker is reused by any other.
+        libc::mallopt(libc::M_ARENA_MAX, 1);
+        // No block is served by a mapping of its own, so no free unmaps one.
+        libc::mallopt(libc::M_MMAP_MAX, 0);
+        // The top of the heap is never given back while the process runs.
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+        KEEPING.store(true, Ordering::Relaxed);
+    }
+}
+
+/// Returns the free pages of glibc's arenas to the kernel, unless [`keep_freed_memory`] asked to keep
+/// them; a no-op off glibc. Only unused memory is touched: the bake's data and its output do not change.
 pub(crate) fn release_free_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: `malloc_trim` only gives unused heap pages back to the kernel; any thread may call it
-    // at any time.
-    unsafe {
-        libc::malloc_trim(0);
+    if !KEEPING.load(Ordering::Relaxed) {
+        // SAFETY: `malloc_trim` only gives unused heap pages back to the kernel; any thread may call it
+        // at any time.
+        unsafe {
+            libc::malloc_trim(0);
+        }
     }
 }

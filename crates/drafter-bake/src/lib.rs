@@ -20,7 +20,7 @@
 //! collected in part order).
 
 mod config;
-mod heap;
+pub mod heap;
 mod reorder;
 pub mod split;
 pub mod textures;
@@ -224,7 +224,8 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     diagnostics.extend(normal_diagnostics);
     timed("bounds", bounds_time);
     timed("normals", normals_time);
-    // The lines stage is where a bake's memory peaks: it starts from what is live (`heap.rs`).
+    // The lines stage is where a bake's memory peaks: it starts from what is live (`heap.rs`), unless
+    // the process keeps freed memory for reuse.
     heap::release_free_memory();
     begin("normals");
 
