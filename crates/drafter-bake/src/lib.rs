@@ -621,9 +621,9 @@ fn silhouettes_of(
     if total == 0 {
         return None;
     }
-    let mut corners = vec![0u32; total];
-    let mut normals = vec![[glam::Vec3::ZERO; 2]; total];
-    let mut points = vec![glam::Vec3::ZERO; total];
+    let mut corners = drafter_core::filled_in_parallel(total, 0u32);
+    let mut normals = drafter_core::filled_in_parallel(total, [glam::Vec3::ZERO; 2]);
+    let mut points = drafter_core::filled_in_parallel(total, glam::Vec3::ZERO);
     let slices = split_by_counts(&mut corners, &counts, 1)
         .into_iter()
         .zip(split_by_counts(&mut normals, &counts, 1))

@@ -1548,10 +1548,7 @@ fn assign(
     let mut arcs = arc_records(normals);
     let builder = Builder { bins, max_depth, base: base_cells(base), caps: guide.is_none(), stop };
     let mut nodes = Vec::new();
-    // Filled on the thread pool: a serial fill of the dragon's 73 MB was 50 ms on one core, most
-    // of it first touches of its pages.
-    let mut scratch = Vec::new();
-    (0..arcs.len()).into_par_iter().map(|_| Arc::default()).collect_into_vec(&mut scratch);
+    let mut scratch = drafter_core::filled_in_parallel(arcs.len(), Arc::default());
     let guide = (0, guide.map(|g| (g, 0)));
     let ok = builder.node(None, 0, &mut arcs, &mut scratch, false, 0, &mut nodes, guide, 1.0);
     ok.then_some((nodes, arcs))
