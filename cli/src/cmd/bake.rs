@@ -155,11 +155,14 @@ pub fn run(args: Args) -> Result<()> {
     check_output(&output, &config.container, args.input.as_deref(), &bytes, args.force)?;
 
     progress.step(1, "importing");
-    let imported = drafter_io::import_bytes(&input_path, &bytes)?;
+    // The input's digest (for the report) beside the import: 9 ms of one core on the dragon's 16 MB.
+    let (imported, digest) =
+        rayon::join(|| drafter_io::import_bytes(&input_path, &bytes), || sha2::Sha256::digest(&bytes));
+    let imported = imported?;
     config.input = InputInfo {
         name: input_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
         format: format!("{:?}", imported.scene.format).to_lowercase(),
-        sha256: sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect(),
+        sha256: digest.iter().map(|b| format!("{b:02x}")).collect(),
     };
 
     let mut on_stage = |i: usize| progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
