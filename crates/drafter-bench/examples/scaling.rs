@@ -95,6 +95,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|| "../shared/models/obj/cad-denoising-set/partLp.obj".into()),
     );
     if let Some(level) = flag("--level") {
+        // The heap policy of `drafter bake` (one arena, freed memory reused), so that a level's time
+        // and peak are the command's.
+        drafter_bake::heap::keep_freed_memory();
         return child(&model, level.parse()?);
     }
     let max_triangles: usize = flag("--max-triangles").map_or(Ok(2_200_000), |v| v.parse())?;
