@@ -9,7 +9,7 @@
 //!   443 MB with the stages in turn), and 180 MB at the 2.18M-triangle level of the scaling benchmark.
 //! * Every block above the mmap threshold (at most 32 MB) gets a mapping of its own, unmapped on free,
 //!   so the next stage's arrays fault in and zero fresh pages again: the dragon bake touched 900 MB of
-//!   new pages (233k page faults) to peak at 450 MB, 0.6–0.8 s of system time in 3.7 CPU-seconds.
+//!   new pages (233k page faults) to peak at about 440 MB, 0.6–0.8 s of system time in 3.7 CPU-seconds.
 //!
 //! [`keep_freed_memory`], for a process that bakes (the command-line tool calls it first thing), turns
 //! both off: one arena, no block mappings, no trimming. Freed blocks stay in one heap and the next
@@ -33,8 +33,8 @@ static KEEPING: AtomicBool = AtomicBool::new(false);
 /// frees then stays with the process until it exits, which suits a command-line bake. A no-op off glibc.
 pub fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: `mallopt` only changes glibc's allocator parameters; the caller runs it before any
-    // other thread exists, as glibc asks for `M_ARENA_MAX`.
+    // SAFETY: `mallopt` only changes glibc's allocator parameters and has no preconditions; it is
+    // called before other threads exist so that no thread has an arena of its own yet.
     unsafe {
         // One heap for all threads: a block freed by one worker is reused by any other.
         libc::mallopt(libc::M_ARENA_MAX, 1);
