@@ -214,9 +214,9 @@ pub fn face_normals(topology: &Topology) -> Vec<Option<DVec3>> {
         .collect()
 }
 
-/// "Is the angle `atan2(sine, cosine)` in degrees above `threshold`?" as [`angle_deg`] would
-/// answer it, mostly without the arctangent (an `atan2` per edge was 65 ms of the dragon's
-/// classification). For `sine ≥ 0` the angle lies in `[0°, 180°]` and, for a threshold `α`
+/// "Is the dihedral angle `atan2(sine, cosine)` in degrees (`sine = |n₁ × n₂|`, `cosine = n₁·n₂`,
+/// accurate near 0° and 180°) above `threshold`?", answered as the arctangent answers it but mostly
+/// without it (an `atan2` per edge was 65 ms of the dragon's classification). For `sine ≥ 0` the angle lies in `[0°, 180°]` and, for a threshold `α`
 /// strictly inside that range, `sine·cos α − cosine·sin α` has the sign of the angle minus `α`.
 /// Both the product and the arctangent are accurate to a few units in the last place, so where
 /// that sign clears [`AngleTest::MARGIN`] of `|sine| + |cosine|` they agree; nearer, and for a
@@ -251,11 +251,6 @@ impl AngleTest {
         }
         sine.atan2(cosine).to_degrees() > self.threshold
     }
-}
-
-/// Angle between two unit vectors in degrees, accurate near 0° and 180°.
-fn angle_deg(n1: DVec3, n2: DVec3) -> f64 {
-    n1.cross(n2).length().atan2(n1.dot(n2)).to_degrees()
 }
 
 /// Classifies every edge of `topology`. `face_parts`, when given, holds one part id per face.
@@ -294,8 +289,7 @@ fn classify(
     let face_normals = face_normals(topology);
     let crease = f64::from(options.crease_angle_deg);
     let coplanar = f64::from(options.coplanar_angle_deg);
-    // Without the angles (the encoder's classification), each threshold is compared without an
-    // arctangent where that decides it (see `AngleTest`).
+    // Each threshold is compared without an arctangent where that decides it (see `AngleTest`).
     let (crease_test, coplanar_test) = (AngleTest::new(crease), AngleTest::new(coplanar));
     let per_edge: Vec<(EdgeClass, f32, bool)> = (0..topology.edges.len())
         .into_par_iter()
@@ -308,38 +302,19 @@ fn classify(
             }
             let (f1, f2) = (faces[0] as usize, faces[1] as usize);
             let consistent = runs_forward(topology, f1, e) != runs_forward(topology, f2, e);
-            let (n1, n2) = (face_normals[f1], face_normals[f2]);
-            if !candidate_arrays {
-                let class = if face_parts.is_some_and(|p| p[f1] != p[f2]) {
-                    EdgeClass::PartBorder
-                } else if let (Some(n1), Some(n2)) = (n1, n2) {
-                    let (sine, cosine) = (n1.cross(n2).length(), n1.dot(n2));
-                    if crease_test.above(sine, cosine) {
-                        EdgeClass::Crease
-                    } else if !coplanar_test.above(sine, cosine) {
-                        EdgeClass::Coplanar
-                    } else {
-                        EdgeClass::SilhouetteCandidate
-                    }
-                } else {
-                    EdgeClass::Degenerate
-                };
-                return (class, f32::NAN, !consistent);
-            }
-            let dihedral = match (n1, n2) {
-                (Some(n1), Some(n2)) => angle_deg(n1, n2),
-                _ => f64::NAN,
+            // The sine and cosine of the dihedral angle (both faces have a normal); the classes come
+            // from them without an arctangent, the angle itself only where it is kept.
+            let angle = face_normals[f1].zip(face_normals[f2]).map(|(n1, n2)| (n1.cross(n2).length(), n1.dot(n2)));
+            let class = match angle {
+                _ if face_parts.is_some_and(|p| p[f1] != p[f2]) => EdgeClass::PartBorder,
+                None => EdgeClass::Degenerate,
+                Some((sine, cosine)) if crease_test.above(sine, cosine) => EdgeClass::Crease,
+                Some((sine, cosine)) if !coplanar_test.above(sine, cosine) => EdgeClass::Coplanar,
+                Some(_) => EdgeClass::SilhouetteCandidate,
             };
-            let class = if face_parts.is_some_and(|p| p[f1] != p[f2]) {
-                EdgeClass::PartBorder
-            } else if dihedral.is_nan() {
-                EdgeClass::Degenerate
-            } else if dihedral > crease {
-                EdgeClass::Crease
-            } else if dihedral <= coplanar {
-                EdgeClass::Coplanar
-            } else {
-                EdgeClass::SilhouetteCandidate
+            let dihedral = match angle {
+                Some((sine, cosine)) if candidate_arrays => sine.atan2(cosine).to_degrees(),
+                _ => f64::NAN,
             };
             (class, dihedral as f32, !consistent)
         })
