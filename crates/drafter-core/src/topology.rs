@@ -1050,32 +1050,43 @@ mod tests {
         (of_vertex, welded_positions)
     }
 
+    /// A seeded xorshift generator of integers below its argument.
+    fn xorshift(seed: u64) -> impl FnMut(u32) -> u32 {
+        let mut state = seed;
+        move |m| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % u64::from(m)) as u32
+        }
+    }
+
+    /// `count` positions on a grid of `grid` steps of `step` per axis, many repeated; one in eight
+    /// with a negated x (so -0.0 against 0.0), one in eight with `noise` added to y.
+    fn grid_positions(rnd: &mut impl FnMut(u32) -> u32, count: u32, grid: u32, step: f32, noise: f32) -> Vec<Vec3> {
+        (0..count)
+            .map(|_| {
+                let mut c = [0.0f32; 3].map(|_| rnd(grid) as f32 * step);
+                match rnd(8) {
+                    0 => c[0] = -c[0],
+                    1 => c[1] += noise,
+                    _ => {}
+                }
+                Vec3::from(c)
+            })
+            .collect()
+    }
+
     /// Random meshes with duplicated positions (also -0.0 against 0.0 and snap-sized noise),
     /// unreferenced vertices, repeated indices, zero-area and non-manifold faces, against
     /// [`reference_tables`] and [`reference_weld`], for every weld.
     #[test]
     fn every_table_matches_a_brute_force_reference() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = |m: u32| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % u64::from(m)) as u32
-        };
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
         for _ in 0..400 {
             let nv = 1 + rnd(40);
             let grid = 1 + rnd(4);
-            let positions: Vec<Vec3> = (0..nv)
-                .map(|_| {
-                    let mut c = [0.0f32; 3].map(|_| rnd(grid) as f32);
-                    match rnd(8) {
-                        0 => c[0] = -c[0],
-                        1 => c[1] += 1e-12,
-                        _ => {}
-                    }
-                    Vec3::from(c)
-                })
-                .collect();
+            let positions = grid_positions(&mut rnd, nv, grid, 1.0, 1e-12);
             let triangles: Vec<[u32; 3]> = (0..rnd(60)).map(|_| [rnd(nv), rnd(nv), rnd(nv)]).collect();
 
             let exact = Topology::from_triangles(&positions, &triangles, Weld::Exact);
@@ -1105,27 +1116,11 @@ mod tests {
     /// more buckets than vertices), exact and snapped keys.
     #[test]
     fn partitioned_weld_is_the_serial_weld() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = |m: u32| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % u64::from(m)) as u32
-        };
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
         for round in 0..60 {
             let nv = 1 + rnd(if round % 10 == 0 { 70_000 } else { 3000 });
             let grid = 1 + rnd(20);
-            let positions: Vec<Vec3> = (0..nv)
-                .map(|_| {
-                    let mut c = [0.0f32; 3].map(|_| rnd(grid) as f32 * 0.25);
-                    match rnd(8) {
-                        0 => c[0] = -c[0],
-                        1 => c[1] += 1e-6,
-                        _ => {}
-                    }
-                    Vec3::from(c)
-                })
-                .collect();
+            let positions = grid_positions(&mut rnd, nv, grid, 0.25, 1e-6);
             for bits in [1, 3, 10] {
                 let exact = weld_partitioned(&positions, &weld_key, &|k: [u32; 3]| hash_words(k.map(u64::from)), bits);
                 let expected = reference_weld(&positions, |p| weld_key(p).map(i64::from));
