@@ -311,7 +311,8 @@ pub fn robust_diagonal(positions: &[Vec3]) -> f64 {
 /// keys (recomputed from the cluster's first position) only when the tags agree. A general hash
 /// map would store every key again and hash it with a slower general-purpose hasher. The result
 /// depends only on the input, not on the hash: a vertex joins the cluster of the first earlier
-/// vertex with an equal key, or opens the next cluster.
+/// vertex with an equal key, or opens the next cluster. From [`PARTITIONED_WELD_MIN`] vertices,
+/// with more than one thread, [`weld_partitioned`] gives the same result on the pool.
 fn weld_by_keys<K: Copy + PartialEq + Send + Sync>(
     positions: &[Vec3],
     key_of: impl Fn(Vec3) -> K + Sync,
@@ -370,8 +371,9 @@ type Entry<K> = (u32, u64, K);
 /// vertex order within a bucket), then each bucket finds, for each of its vertices, the first
 /// earlier vertex with an equal key, over a table of its own that stays in cache; a last pass in
 /// vertex order numbers the clusters ([`number_clusters`]). The serial pass probes one table of
-/// twice the vertex count at random, which missed the cache on every vertex of a large mesh (a
-/// third of the dragon's serial topology time in a profile).
+/// twice the vertex count at random, which misses the cache more as the mesh grows (about a third
+/// of the dragon's serial topology time in a profile; with this, the dragon's topology stage went
+/// from 113–136 to 102–110 ms at two threads, docs/bench.md "Scaling").
 fn weld_partitioned<K: Copy + PartialEq + Send + Sync>(
     positions: &[Vec3],
     key_of: &(impl Fn(Vec3) -> K + Sync),
