@@ -47,3 +47,51 @@ pub fn filled_in_parallel<T: Copy + Send + Sync>(len: usize, value: T) -> Vec<T>
     (0..len).into_par_iter().map(|_| value).collect_into_vec(&mut items);
     items
 }
+
+/// The stable counting scatter of `items` into `out` (as long) by `bucket_of(i)`, the bucket of
+/// item `i` (below `starts.len() - 1`), on the thread pool: each chunk of `chunk` items counts its
+/// buckets, then writes its own slice of every bucket, the slices laid out bucket by bucket and
+/// chunk by chunk, which is the order a serial stable scatter gives, at any thread count. Sets
+/// `starts[b]` to where bucket `b` begins, the last entry to the total. Written here because rayon
+/// has no stable partition into many buckets; used by the weld and the Gauss map's build.
+pub fn scatter_in_parallel<T: Copy + Send + Sync>(
+    items: &[T],
+    bucket_of: impl Fn(usize) -> usize + Sync,
+    chunk: usize,
+    out: &mut [T],
+    starts: &mut [usize],
+) {
+    use rayon::prelude::*;
+    let (buckets, chunk) = (starts.len() - 1, chunk.max(1));
+    let counts: Vec<Vec<usize>> = (0..items.len().div_ceil(chunk))
+        .into_par_iter()
+        .map(|c| {
+            let mut count = vec![0usize; buckets];
+            for i in c * chunk..((c + 1) * chunk).min(items.len()) {
+                count[bucket_of(i)] += 1;
+            }
+            count
+        })
+        .collect();
+    starts[0] = 0;
+    for b in 0..buckets {
+        starts[b + 1] = starts[b] + counts.iter().map(|c| c[b]).sum::<usize>();
+    }
+    let mut pieces: Vec<Vec<&mut [T]>> = counts.iter().map(|_| Vec::with_capacity(buckets)).collect();
+    let mut rest = &mut out[..];
+    for b in 0..buckets {
+        for (count, chunk_pieces) in counts.iter().zip(&mut pieces) {
+            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(count[b]);
+            chunk_pieces.push(piece);
+            rest = tail;
+        }
+    }
+    items.par_chunks(chunk).zip(pieces).enumerate().for_each(|(c, (items, mut pieces))| {
+        let mut next = vec![0usize; buckets];
+        for (k, item) in items.iter().enumerate() {
+            let b = bucket_of(c * chunk + k);
+            pieces[b][next[b]] = *item;
+            next[b] += 1;
+        }
+    });
+}

@@ -367,15 +367,15 @@ const PARTITION_BITS: u32 = 8;
 type Entry<K> = (u32, u64, K);
 
 /// [`weld_by_keys`] on the thread pool, with the same result. Equal keys have equal hashes, so
-/// the vertices are first sorted by their hash's top `bits` (a stable counting sort in chunks:
+/// the vertices are first sorted by their hash's top `bits` ([`crate::scatter_in_parallel`]:
 /// vertex order within a bucket), then each bucket finds, for each of its vertices, the first
 /// earlier vertex with an equal key, over a table of its own that stays in cache; a last pass in
 /// vertex order numbers the clusters ([`number_clusters`]). The serial pass probes one table of
 /// twice the vertex count at random, which misses the cache more as the mesh grows (about a third
 /// of the dragon's serial topology time in a profile; with this, the dragon's topology stage went
 /// from 113–136 to 102–110 ms at two threads, docs/bench.md "Scaling"). It holds each vertex's
-/// hash and key twice while it sorts (72 bytes a vertex with the snapped key, against the serial
-/// table's 8 to 16): 31 MB on the dragon, far below the peak of the later lines stage (440 MB, unchanged).
+/// hash and key twice while it sorts (80 bytes a vertex with the snapped key, against the serial
+/// table's 8 to 16): 35 MB on the dragon, far below the peak of the later lines stage (440 MB, unchanged).
 fn weld_partitioned<K: Copy + PartialEq + Send + Sync>(
     positions: &[Vec3],
     key_of: &(impl Fn(Vec3) -> K + Sync),
@@ -388,54 +388,22 @@ fn weld_partitioned<K: Copy + PartialEq + Send + Sync>(
     let Some(&first) = positions.first() else { return Welded { of_vertex: Vec::new(), positions: Vec::new() } };
     let buckets = 1usize << bits;
     let bucket_of = |h: u64| (h >> (64 - bits)) as usize;
-    // Each key once (the snapped key divides and rounds every coordinate).
-    let keyed: Vec<(u64, K)> = positions
+    // Each key once (the snapped key divides and rounds every coordinate), then the vertices with
+    // their hashes and keys in bucket order, vertex order within a bucket.
+    let entries: Vec<Entry<K>> = positions
         .par_iter()
-        .map(|&p| {
+        .enumerate()
+        .map(|(v, &p)| {
             let key = key_of(p);
-            (hash_of(key), key)
+            (v as u32, hash_of(key), key)
         })
         .collect();
-    let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
-    let counts: Vec<Vec<u32>> = keyed
-        .par_chunks(chunk)
-        .map(|entries| {
-            let mut count = vec![0u32; buckets];
-            for &(h, _) in entries {
-                count[bucket_of(h)] += 1;
-            }
-            count
-        })
-        .collect();
-    // The vertices with their hashes and keys, bucket after bucket and within a bucket chunk after
-    // chunk: each chunk owns one slice per bucket.
-    let filler = (0u32, 0u64, key_of(first));
-    let mut sorted = vec![filler; n];
-    let mut bucket_slices = Vec::with_capacity(buckets);
-    let mut slices: Vec<Vec<&mut [Entry<K>]>> = (0..counts.len()).map(|_| Vec::with_capacity(buckets)).collect();
-    {
-        let mut rest: &mut [Entry<K>] = &mut sorted;
-        let mut at = 0usize;
-        for b in 0..buckets {
-            let start = at;
-            for (c, count) in counts.iter().enumerate() {
-                let (slice, tail) = std::mem::take(&mut rest).split_at_mut(count[b] as usize);
-                slices[c].push(slice);
-                rest = tail;
-                at += count[b] as usize;
-            }
-            bucket_slices.push(start..at);
-        }
-    }
-    slices.into_par_iter().zip(keyed.par_chunks(chunk)).enumerate().for_each(|(c, (mut slices, entries))| {
-        let mut filled = vec![0usize; buckets];
-        for (k, &(h, key)) in entries.iter().enumerate() {
-            let b = bucket_of(h);
-            slices[b][filled[b]] = ((c * chunk + k) as u32, h, key);
-            filled[b] += 1;
-        }
-    });
-    drop(keyed);
+    let mut sorted = vec![(0u32, 0u64, key_of(first)); n];
+    let mut starts = vec![0usize; buckets + 1];
+    let chunk = n.div_ceil(4 * rayon::current_num_threads());
+    crate::scatter_in_parallel(&entries, |i| bucket_of(entries[i].1), chunk, &mut sorted, &mut starts);
+    drop(entries);
+    let bucket_slices: Vec<std::ops::Range<usize>> = starts.windows(2).map(|w| w[0]..w[1]).collect();
     // Each vertex's first earlier vertex with an equal key (itself if none), bucket by bucket.
     let representative: Vec<AtomicU32> = (0..n as u32).into_par_iter().map(AtomicU32::new).collect();
     bucket_slices.into_par_iter().for_each(|range| {

@@ -465,56 +465,9 @@ pub(crate) fn arc_paths(unit: &[[DVec3; 2]], base: &[Cell], level: u8, factor: f
     paths
 }
 
-/// Arcs per task of [`scatter_in_parallel`].
+/// Arcs per task of [`drafter_core::scatter_in_parallel`] (serial, the dragon's root level was
+/// 30 ms of one core).
 const SCATTER_CHUNK: usize = 1 << 16;
-
-/// The stable counting scatter of a large node's `arcs` into `spare` by `bucket(target)`, on the
-/// thread pool: each chunk of arcs counts its buckets, then writes its own slice of every bucket,
-/// the slices laid out bucket by bucket and chunk by chunk, which is the order a serial scatter
-/// gives. (Serial, the dragon's root level was 30 ms of one core.) Sets `starts` as the serial
-/// scatter does: `starts[b]` is where bucket `b` begins, the last entry the total.
-fn scatter_in_parallel(
-    arcs: &[Arc],
-    targets: &[u8],
-    spare: &mut [Arc],
-    starts: &mut [usize],
-    bucket: impl Fn(u8) -> usize + Sync,
-) {
-    let buckets = starts.len() - 1;
-    let counts: Vec<[usize; 22]> = targets
-        .par_chunks(SCATTER_CHUNK)
-        .map(|chunk| {
-            let mut count = [0usize; 22];
-            for &t in chunk {
-                count[bucket(t)] += 1;
-            }
-            count
-        })
-        .collect();
-    starts[0] = 0;
-    for b in 0..buckets {
-        starts[b + 1] = starts[b] + counts.iter().map(|c| c[b]).sum::<usize>();
-    }
-    let mut pieces: Vec<Vec<&mut [Arc]>> = counts.iter().map(|_| Vec::with_capacity(buckets)).collect();
-    let mut rest = &mut spare[..];
-    for b in 0..buckets {
-        for (count, chunk_pieces) in counts.iter().zip(&mut pieces) {
-            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(count[b]);
-            chunk_pieces.push(piece);
-            rest = tail;
-        }
-    }
-    arcs.par_chunks(SCATTER_CHUNK).zip(targets.par_chunks(SCATTER_CHUNK)).zip(pieces).for_each(
-        |((arcs, targets), mut pieces)| {
-            let mut next = [0usize; 22];
-            for (g, &t) in arcs.iter().zip(targets) {
-                let b = bucket(t);
-                pieces[b][next[b]] = *g;
-                next[b] += 1;
-            }
-        },
-    );
-}
 
 /// Sorts `items[r]` for every range `r` of `ranges`: on the thread pool where the ranges are
 /// disjoint and in increasing order (as the outermost collapsed subtrees of a preorder are),
@@ -962,7 +915,7 @@ impl Builder {
         let mut starts = [0usize; 22];
         let starts = &mut starts[..children.len() + 2];
         if arcs.len() > PARALLEL_ARCS {
-            scatter_in_parallel(arcs, &targets, spare, starts, bucket);
+            drafter_core::scatter_in_parallel(arcs, |i| bucket(targets[i]), SCATTER_CHUNK, spare, starts);
         } else {
             for &t in &targets {
                 starts[bucket(t) + 1] += 1;
@@ -1693,7 +1646,7 @@ mod tests {
             }
             let mut spare = vec![Arc { id: u32::MAX, ..Arc::default() }; len];
             let mut starts = vec![0usize; children + 2];
-            scatter_in_parallel(&arcs, &targets, &mut spare, &mut starts, bucket);
+            drafter_core::scatter_in_parallel(&arcs, |i| bucket(targets[i]), SCATTER_CHUNK, &mut spare, &mut starts);
             assert_eq!(starts, expected_starts);
             assert!(spare.iter().map(|a| a.id).eq(expected.iter().copied()), "{len} arcs, {children} children");
         }
