@@ -159,6 +159,9 @@ pub fn run(args: Args) -> Result<()> {
     let (imported, digest) =
         rayon::join(|| drafter_io::import_bytes(&input_path, &bytes), || sha2::Sha256::digest(&bytes));
     let imported = imported?;
+    // The scene holds what it needs of the file (a glTF's buffers, for the writer's pass-through):
+    // the file's bytes (16 MB for the dragon) are not kept through the bake, where memory peaks.
+    drop(bytes);
     config.input = InputInfo {
         name: input_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
         format: format!("{:?}", imported.scene.format).to_lowercase(),

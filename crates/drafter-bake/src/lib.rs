@@ -232,7 +232,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     let start = begin("lines");
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
         let (edges, silhouettes, summary, line_diagnostics) =
-            compute_lines(&written_scene, &splits, &topologies, &parts, &vertex_data, &config.lines);
+            compute_lines(&written_scene, &splits, topologies, &parts, &vertex_data, &config.lines);
         diagnostics.extend(line_diagnostics);
         (edges, silhouettes, Some(summary))
     } else {
@@ -458,7 +458,7 @@ type LinesResult = (Vec<Vec<Option<PrimitiveEdges>>>, Vec<Option<MeshSilhouettes
 fn compute_lines(
     scene: &Scene,
     splits: &[Option<split::SplitGroups>],
-    topologies: &[Topology],
+    topologies: Vec<Topology>,
     parts: &Parts,
     vertex_data: &[Option<VertexData>],
     stage: &LinesStage,
@@ -475,12 +475,13 @@ fn compute_lines(
     let results: Vec<_> = scene
         .meshes
         .par_iter()
+        .zip(topologies)
         .enumerate()
-        .map(|(m, mesh)| {
+        .map(|(m, (mesh, owned_topology))| {
             if !used[m] || mesh.triangles.is_empty() {
                 return None;
             }
-            let topology = &topologies[m];
+            let topology = &owned_topology;
             let face_parts: Option<Vec<PartId>> = labels[m].map(|l| l.iter().map(|&x| PartId(x)).collect());
             // Without the candidates' normals and points (47 MB on the dragon): the encoder does not
             // read them, and the hierarchies are built from what the file holds.
@@ -540,6 +541,8 @@ fn compute_lines(
             // by the hierarchies, which are built from what the file holds: freed before them.
             let counts = feature.counts;
             drop(feature);
+            // Nor the topology (53 MB on the dragon), which no later stage reads.
+            drop(owned_topology);
             let silhouettes = silhouettes_of(mesh, &edges, vertex_data[m].as_ref(), stage.hierarchies);
             Some((edges, silhouettes, counts, diagnostics))
         })
