@@ -251,16 +251,32 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
                     ));
                 }
             }
-            let mut values = Vec::with_capacity(count);
-            for i in 0..count {
-                let at = start + i * stride;
-                let mut v = [0.0f32; N];
-                for (c, slot) in v.iter_mut().enumerate() {
-                    *slot = decode_component(&bytes[at + c * component..], data_type, normalized);
+            if data_type == DataType::F32 && stride == element {
+                // Tightly packed floats (positions and normals, mostly): one loop without the
+                // per-component type dispatch.
+                // In range when there is an element (checked above); an empty accessor may lie anywhere.
+                bytes
+                    .get(start..start + count * element)
+                    .unwrap_or_default()
+                    .chunks_exact(element)
+                    .map(|e| {
+                        std::array::from_fn(|c| {
+                            f32::from_le_bytes([e[4 * c], e[4 * c + 1], e[4 * c + 2], e[4 * c + 3]])
+                        })
+                    })
+                    .collect()
+            } else {
+                let mut values = Vec::with_capacity(count);
+                for i in 0..count {
+                    let at = start + i * stride;
+                    let mut v = [0.0f32; N];
+                    for (c, slot) in v.iter_mut().enumerate() {
+                        *slot = decode_component(&bytes[at + c * component..], data_type, normalized);
+                    }
+                    values.push(v);
                 }
-                values.push(v);
+                values
             }
-            values
         }
         None => {
             // No buffer view: zeros (then sparse). The count has no data behind it, so it is bounded
@@ -413,15 +429,27 @@ fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: us
             ),
         ));
     }
-    let mut out = Vec::with_capacity(count);
-    for i in 0..count {
-        let at = start + i * stride;
-        let v = match size {
-            1 => bytes[at] as u32,
-            2 => u16::from_le_bytes([bytes[at], bytes[at + 1]]) as u32,
-            _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
-        };
-        out.push(check_index(v, i, vertex_count, &pointer)?);
+    let index = |at: usize| match size {
+        1 => bytes[at] as u32,
+        2 => u16::from_le_bytes([bytes[at], bytes[at + 1]]) as u32,
+        _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
+    };
+    let out: Vec<u32> = if stride == size {
+        // Tightly packed (every index buffer we have seen): decoded per component type in one
+        // loop each, and checked in a second pass; one loop matching the type and checking the
+        // range per index was 17 ms of the dragon's serial 43 ms parse.
+        // In range when there is an index (checked above); an empty accessor may lie anywhere.
+        let data = bytes.get(start..start + count * size).unwrap_or_default();
+        match size {
+            1 => data.iter().map(|&b| u32::from(b)).collect(),
+            2 => data.chunks_exact(2).map(|c| u32::from(u16::from_le_bytes([c[0], c[1]]))).collect(),
+            _ => data.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect(),
+        }
+    } else {
+        (0..count).map(|i| index(start + i * stride)).collect()
+    };
+    if let Some(i) = out.iter().position(|&v| v as usize >= vertex_count) {
+        check_index(out[i], i, vertex_count, &pointer)?;
     }
     Ok(out)
 }

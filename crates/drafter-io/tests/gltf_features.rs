@@ -232,3 +232,59 @@ fn sparse_accessor_without_buffer_view() {
     let message = err.to_string();
     assert!(message.contains("/accessors/2") && message.contains("50000000 elements"), "{message}");
 }
+
+/// Tightly packed accessors take a fast path of their own; strided ones (interleaved data) the
+/// general one. Both must give the same scene, the same error at the same element, and no panic
+/// for an empty accessor whose offset lies past its view.
+#[test]
+fn packed_and_strided_accessors_decode_alike() {
+    let quad = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.5]];
+    let corners: [u32; 6] = [0, 1, 2, 2, 1, 3];
+    let document = |b: Builder, pos: usize, idx: usize| {
+        b.document(json!({
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "indices": idx}]}]
+        }))
+    };
+    let packed = |corners: &[u32]| {
+        let mut b = Builder::default();
+        let pos = b.positions(&quad);
+        let bytes: Vec<u8> = corners.iter().flat_map(|c| c.to_le_bytes()).collect();
+        let idx = b.push(&bytes, json!({"componentType": 5125, "count": corners.len(), "type": "SCALAR"}));
+        document(b, pos, idx)
+    };
+    let strided = |corners: &[u32]| {
+        let mut b = Builder::default();
+        // Positions with a padding float after each (stride 16), indices as u16 with padding (stride 4).
+        let bytes: Vec<u8> = quad.iter().flat_map(|p| [p[0], p[1], p[2], 9.0]).flat_map(f32::to_le_bytes).collect();
+        let pos = b
+            .push(&bytes, json!({"componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0.5]}));
+        b.views[pos]["byteStride"] = 16.into();
+        let bytes: Vec<u8> = corners.iter().flat_map(|&c| [c as u16, 0xffff]).flat_map(u16::to_le_bytes).collect();
+        let idx = b.push(&bytes, json!({"componentType": 5123, "count": corners.len(), "type": "SCALAR"}));
+        b.views[idx]["byteStride"] = 4.into();
+        document(b, pos, idx)
+    };
+    let (a, b) = (import(&packed(&corners)).scene, import(&strided(&corners)).scene);
+    assert_eq!(a.meshes[0].positions, b.meshes[0].positions);
+    assert_eq!(a.meshes[0].triangles, b.meshes[0].triangles);
+    assert_eq!(a.meshes[0].triangles, [[0, 1, 2], [2, 1, 3]]);
+    assert_eq!(a.meshes[0].positions[3], Vec3::new(1.0, 1.0, 0.5));
+
+    let bad = [0, 1, 2, 2, 7, 3];
+    for doc in [packed(&bad), strided(&bad)] {
+        let error =
+            drafter_io::import_bytes(Path::new("mem.gltf"), &doc).err().expect("index 7 is rejected").to_string();
+        assert!(error.contains("index 7 at element 4"), "{error}");
+    }
+
+    let mut b = Builder::default();
+    let pos = b.positions(&quad);
+    let idx = b.push(&[0u8; 4], json!({"componentType": 5125, "count": 0, "type": "SCALAR", "byteOffset": 4096}));
+    let empty = document(b, pos, idx);
+    // Either a scene without triangles or an error; never a panic.
+    if let Ok(imported) = drafter_io::import_bytes(Path::new("mem.gltf"), &empty) {
+        assert!(imported.scene.meshes.iter().all(|m| m.triangles.is_empty()));
+    }
+}
