@@ -48,6 +48,25 @@ pub fn filled_in_parallel<T: Copy + Send + Sync>(len: usize, value: T) -> Vec<T>
     items
 }
 
+/// The slices `items[r]` for every range `r` of `ranges`, as mutable slices that can go to
+/// different threads; `None` unless the ranges are in increasing order, disjoint and within
+/// `items` (gaps between them are left out).
+pub fn disjoint_slices_mut<'a, T>(items: &'a mut [T], ranges: &[std::ops::Range<usize>]) -> Option<Vec<&'a mut [T]>> {
+    let ordered = ranges.iter().try_fold(0usize, |at, r| (at <= r.start && r.start <= r.end).then_some(r.end));
+    if ordered.is_none_or(|end| end > items.len()) {
+        return None;
+    }
+    let mut slices = Vec::with_capacity(ranges.len());
+    let (mut rest, mut at) = (items, 0usize);
+    for r in ranges {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(r.start - at);
+        let (slice, tail) = tail.split_at_mut(r.end - r.start);
+        slices.push(slice);
+        (rest, at) = (tail, r.end);
+    }
+    Some(slices)
+}
+
 /// The stable counting scatter of `items` into `out` (as long) by `bucket_of(i)`, the bucket of
 /// item `i` (below `starts.len() - 1`), on the thread pool: each chunk of `chunk` items counts its
 /// buckets, then writes its own slice of every bucket, the slices laid out bucket by bucket and
@@ -94,4 +113,21 @@ pub fn scatter_in_parallel<T: Copy + Send + Sync>(
             next[b] += 1;
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    /// Increasing disjoint ranges (gaps and empty ranges allowed) give exactly those slices;
+    /// unordered, overlapping or out-of-bounds ranges give none.
+    #[test]
+    fn disjoint_slices_are_the_ranges() {
+        let mut items: Vec<u32> = (0..10).collect();
+        let slices = super::disjoint_slices_mut(&mut items, &[0..2, 2..2, 4..7, 9..10]).expect("valid ranges");
+        let got: Vec<Vec<u32>> = slices.iter().map(|s| s.to_vec()).collect();
+        assert_eq!(got, [vec![0, 1], vec![], vec![4, 5, 6], vec![9]]);
+        let r = |start: usize, end: usize| start..end;
+        for bad in [vec![r(3, 5), r(0, 2)], vec![r(0, 5), r(4, 6)], vec![r(8, 11)], vec![r(5, 4)]] {
+            assert!(super::disjoint_slices_mut(&mut items, &bad).is_none(), "{bad:?}");
+        }
+    }
 }

@@ -473,24 +473,16 @@ const SCATTER_CHUNK: usize = 1 << 16;
 /// disjoint and in increasing order (as the outermost collapsed subtrees of a preorder are),
 /// one after the other otherwise.
 fn sort_ranges(items: &mut [u32], ranges: &[std::ops::Range<usize>]) {
-    let disjoint = ranges.iter().try_fold(0usize, |at, r| (at <= r.start && r.start <= r.end).then_some(r.end));
-    if disjoint.is_none_or(|end| end > items.len()) {
-        for r in ranges {
-            if let Some(slice) = items.get_mut(r.clone()) {
-                slice.sort_unstable();
+    match drafter_core::disjoint_slices_mut(items, ranges) {
+        Some(slices) => slices.into_par_iter().for_each(|s| s.sort_unstable()),
+        None => {
+            for r in ranges {
+                if let Some(slice) = items.get_mut(r.clone()) {
+                    slice.sort_unstable();
+                }
             }
         }
-        return;
     }
-    let mut slices = Vec::with_capacity(ranges.len());
-    let (mut rest, mut at) = (items, 0usize);
-    for r in ranges {
-        let (_, tail) = std::mem::take(&mut rest).split_at_mut(r.start - at);
-        let (slice, tail) = tail.split_at_mut(r.end - r.start);
-        slices.push(slice);
-        (rest, at) = (tail, r.end);
-    }
-    slices.into_par_iter().for_each(|s| s.sort_unstable());
 }
 
 /// Cosine of the overlapping bin radius of `c` (`factor` circumradii, at most π).
