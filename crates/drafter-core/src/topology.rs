@@ -375,7 +375,7 @@ type Entry<K> = (u32, u64, K);
 /// of the dragon's serial topology time in a profile; with this, the dragon's topology stage went
 /// from 113–136 to 102–110 ms at two threads, docs/bench.md "Scaling"). It holds each vertex's
 /// hash and key twice while it sorts (80 bytes a vertex with the snapped key, against the serial
-/// table's 8 to 16): 35 MB on the dragon, far below the peak of the later lines stage (440 MB, unchanged).
+/// table's 8 to 16): 35 MB on the dragon, far below the peak of the later lines stage (380 MB).
 fn weld_partitioned<K: Copy + PartialEq + Send + Sync>(
     positions: &[Vec3],
     key_of: &(impl Fn(Vec3) -> K + Sync),
