@@ -198,23 +198,13 @@ const STREAM_AHEAD_LINES: usize = 48;
 /// line), so that a hierarchy walk overlaps the memory latency of data it will test soon with
 /// testing the current data. A walk's ranges are short (tens of blocks) and scattered over arrays
 /// far larger than the caches, so their first lines miss before the hardware prefetcher sees a
-/// stream. A hint only: no effect on results, and nothing on targets without one. Hand-written
-/// because std has no safe prefetch.
+/// stream. A hint only ([`drafter_core::prefetch`]).
 #[inline(always)]
-#[allow(unsafe_code)]
 pub(crate) fn prefetch<T>(items: &[T], lines: usize) {
     const { assert!(std::mem::size_of::<T>() == 16) };
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        for line in items.chunks(4).take(lines) {
-            // SAFETY: SSE is part of the x86_64 baseline, and a prefetch never faults (the
-            // pointer is in bounds anyway).
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(line.as_ptr().cast()) };
-        }
+    for line in items.chunks(4).take(lines) {
+        drafter_core::prefetch(&line[0]);
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (items, lines);
 }
 
 /// A position in the concatenation of block ranges, walked one cache line at a time ahead of the

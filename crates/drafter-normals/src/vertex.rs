@@ -201,6 +201,12 @@ fn smooth_pairs(topology: &Topology, geometry: &FaceGeometry, cos_crease: f32) -
         .into_par_iter()
         .with_min_len(FACE_CHUNK)
         .map(|e| {
+            if e + LAYOUT_PREFETCH_AHEAD < topology.edge_count() {
+                for &g in topology.faces_of_edge(e + LAYOUT_PREFETCH_AHEAD) {
+                    drafter_core::prefetch(&geometry.areas[g as usize]);
+                    drafter_core::prefetch(&geometry.normals[g as usize]);
+                }
+            }
             let mut pair = [EDGE_NONE; 2];
             let mut count = 0;
             for &g in topology.faces_of_edge(e) {
@@ -265,7 +271,17 @@ impl Grouping<'_> {
         let mut linked: Vec<u32> = Vec::new();
         let mut group_of_root: Vec<u32> = Vec::new();
         let mut members: Vec<(u32, u32)> = Vec::new();
+        let end = vertices.end;
         for v in vertices {
+            // What the fans of a vertex a few steps ahead read, loading now (`LAYOUT_PREFETCH_AHEAD`).
+            if v + LAYOUT_PREFETCH_AHEAD < end {
+                for &f in self.topology.faces_of_vertex(v + LAYOUT_PREFETCH_AHEAD) {
+                    let f = f as usize;
+                    drafter_core::prefetch(&self.topology.faces[f]);
+                    drafter_core::prefetch(&self.topology.face_edges[f]);
+                    drafter_core::prefetch(&self.geometry.areas[f]);
+                }
+            }
             let faces = self.topology.faces_of_vertex(v);
             if faces.is_empty() {
                 continue;
@@ -387,6 +403,15 @@ impl Grouping<'_> {
         out
     }
 }
+
+/// How many welded vertices ahead the grouping prefetches the faces around a vertex (their
+/// corners, edges and areas), and how many edges ahead [`smooth_pairs`] prefetches its faces'
+/// areas and normals. Where the vertex order scatters a vertex's faces over the arrays (the scaling
+/// benchmark's subdivision order), these reads missed the cache: at 2.18M triangles the layout took
+/// 597 ms in that order against 288 ms in first-use order, and about 390 against 300 ms with this
+/// (smooth pairs 59 → 30 ms). Prefetching the vertex normals' face normals and the layout's
+/// triangle writes measured no gain and is not done.
+const LAYOUT_PREFETCH_AHEAD: usize = 16;
 
 fn find(parent: &mut [u32], mut x: usize) -> u32 {
     while parent[x] as usize != x {
