@@ -240,22 +240,9 @@ fn settle_group(g: &mut GroupSlices<'_>) -> usize {
     rotated
 }
 
-/// `triangles` (output vertex ids) renumbered in order of first use, flat: the writer's indices.
+/// `triangles` (output vertex ids) renumbered in order of first use, flat: the writer's indices
+/// ([`drafter_format::first_use`]).
 fn first_use_stream(triangles: &[[u32; 3]]) -> Vec<u32> {
-    // A table over the vertex ids rather than a hash map: the ids are dense output vertices.
-    let size = triangles.iter().flatten().max().map_or(0, |&m| m as usize + 1);
-    let mut local = vec![u32::MAX; size];
-    let mut next = 0u32;
-    triangles
-        .iter()
-        .flatten()
-        .map(|&o| {
-            let slot = &mut local[o as usize];
-            if *slot == u32::MAX {
-                *slot = next;
-                next += 1;
-            }
-            *slot
-        })
-        .collect()
+    let count = triangles.iter().flatten().max().map_or(0, |&m| m.saturating_add(1));
+    drafter_format::first_use(triangles, 0, count).map_or_else(Vec::new, |(_, local)| local)
 }

@@ -37,7 +37,7 @@ pub use reader::{
 pub use writer::{
     BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,
     MAX_PRIMITIVE_VERTICES, MeshSilhouettes, PrimitiveEdges, SamplerDesc, StoredNormals, TextureImage, VertexData,
-    Written, write,
+    Written, first_use, write,
 };
 
 /// `drafter <version>`, written as the generator.

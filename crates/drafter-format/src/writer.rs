@@ -301,7 +301,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     }
     let mut edge_material: Option<usize> = None;
     // Every primitive's new layout at once, on the thread pool; the document is then written in
-    // order. (One core for all of them was a third of the dragon's serial write stage.)
+    // order (the dragon's write stage 59 → 52 ms, with --compress 345 → 272 ms).
     let layouts: Vec<Vec<Relaid>> = scene
         .meshes
         .par_iter()
@@ -627,8 +627,9 @@ fn write_mesh_vertices(
 
 /// The vertices of `triangles` within the range of `count` vertices from `first` (source-local
 /// numbers, in order of first use) and the triangles' corners renumbered onto them; `None` when a
-/// corner is outside the range.
-fn first_use(triangles: &[[u32; 3]], first: u32, count: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+/// corner is outside the range. Also the index stream `bake --compress` settles its triangles'
+/// rotations on (drafter-bake's `reorder.rs`), so that both number vertices the same way.
+pub fn first_use(triangles: &[[u32; 3]], first: u32, count: u32) -> Option<(Vec<u32>, Vec<u32>)> {
     let mut local_of = vec![u32::MAX; count as usize];
     let mut picks = Vec::new();
     let mut local = Vec::with_capacity(3 * triangles.len());
