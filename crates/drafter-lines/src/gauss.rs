@@ -348,8 +348,9 @@ impl Cell {
     }
 
     /// Signed inside-ness: ≥ 0 inside, the larger the deeper.
+    #[inline]
     pub(crate) fn score(&self, p: DVec3) -> f64 {
-        self.planes[0].dot(p).min(self.planes[1].dot(p)).min(self.planes[2].dot(p))
+        min(min(self.planes[0].dot(p), self.planes[1].dot(p)), self.planes[2].dot(p))
     }
 
     pub(crate) fn children(&self) -> [Cell; 4] {
@@ -490,8 +491,17 @@ fn bin_cos(c: &Cell, factor: f64) -> f64 {
     (c.cos_radius.clamp(-1.0, 1.0).acos() * factor.max(1.0)).min(std::f64::consts::PI).cos()
 }
 
+#[inline]
 fn fits_bin(c: &Cell, cos_bin: f64, [n1, n2]: [DVec3; 2]) -> bool {
     c.center.dot(n1) >= cos_bin && c.center.dot(n2) >= cos_bin
+}
+
+/// The smaller of two scores. Scores are never NaN (finite planes and points), and for those this
+/// is `f64::min` up to the sign of a zero, which no comparison of scores sees; it compiles to one
+/// `minsd` where `f64::min` adds a NaN fix-up of four instructions.
+#[inline(always)]
+fn min(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
 }
 
 /// The cell whose inside-ness score of `p` is the largest (the first of equals).
@@ -703,10 +713,65 @@ struct BinCell {
     cos_bin: f64,
 }
 
+/// For each octant of the sphere, the base cells whose circumcap, widened by [`OCTANT_MARGIN`],
+/// reaches into it: the only cells [`most_inside`] can pick for a point there. The root assigns
+/// every arc to a base cell, and scoring all 20 icosahedron faces (60 dot products an arc) was
+/// about 15 % of a one-thread profile of the dragon's assignment; each octant meets 10 of them.
+///
+/// Why skipping the others picks the same cell, bit for bit: the point lies in some cell, whose
+/// computed score is within rounding (about 1e-15) of a non-negative one, and that cell's cap
+/// holds the point, so it is listed. A cell that is not listed is at least the margin (0.01 rad)
+/// away from the point, so one of its edge planes is violated by far more than rounding and its
+/// score is below that cell's. The listed cells are scored in index order with the same
+/// first-of-equals rule.
+#[derive(Debug)]
+struct BaseByOctant {
+    cells: [Vec<u8>; 8],
+}
+
+/// Angle by which [`BaseByOctant`] widens each base cell's circumcap.
+const OCTANT_MARGIN: f64 = 0.01;
+
+impl BaseByOctant {
+    fn new(base: &[Cell]) -> Self {
+        let mut cells: [Vec<u8>; 8] = Default::default();
+        for (o, list) in cells.iter_mut().enumerate() {
+            let sign = |bit: usize| if o >> bit & 1 == 1 { -1.0 } else { 1.0 };
+            let s = DVec3::new(sign(0), sign(1), sign(2));
+            for (k, c) in base.iter().enumerate() {
+                // max c·p over unit p in the closed octant is |c⁺|, c with the components of the
+                // wrong sign zeroed (c·p ≤ c⁺·p there).
+                let reach = (c.center * s).max(DVec3::ZERO).length();
+                let radius = c.cos_radius.clamp(-1.0, 1.0).acos();
+                if reach >= (radius + OCTANT_MARGIN).min(std::f64::consts::PI).cos() - 1e-9 {
+                    list.push(k as u8);
+                }
+            }
+        }
+        BaseByOctant { cells }
+    }
+
+    /// [`most_inside`] over `base` for the unit point `p` (the first of equals).
+    #[inline]
+    fn most_inside(&self, base: &[Cell], p: DVec3) -> usize {
+        let octant = usize::from(p.x < 0.0) | usize::from(p.y < 0.0) << 1 | usize::from(p.z < 0.0) << 2;
+        let mut best = (usize::MAX, f64::NEG_INFINITY);
+        for &k in &self.cells[octant] {
+            let s = base[usize::from(k)].score(p);
+            if s > best.1 {
+                best = (usize::from(k), s);
+            }
+        }
+        best.0
+    }
+}
+
 struct Builder {
     bins: Bins,
     max_depth: u8,
     base: Vec<Cell>,
+    /// The base cells that may hold a point of each octant ([`BaseByOctant`]).
+    by_octant: BaseByOctant,
     /// Compute each node's cap (a build; a reader's guided assignment needs none).
     caps: bool,
     /// Stop descending where collapsing the subtree is provably the cheapest choice of the
@@ -804,6 +869,7 @@ impl Builder {
         BinCell { cell, cos_bin }
     }
 
+    #[inline]
     fn fits(&self, bin: &BinCell, arc: &Arc) -> bool {
         match self.bins {
             Bins::Strict => bin.cell.score(arc.n1) >= 0.0 && bin.cell.score(arc.n2) >= 0.0,
@@ -879,28 +945,32 @@ impl Builder {
         out[index].tried = true;
         // Where each arc goes, then a stable counting scatter: own arcs first, then by child.
         let quad = (children.len() == 4).then(|| Quad::of(&children));
+        let overlapping = matches!(self.bins, Bins::Overlapping { .. });
+        // The general rule (the root's base cells, strict bins); `Quad::targets` for a 4:1 split
+        // under overlapping bins, the bulk of the work.
         let target = |g: &Arc| {
             g.mid()
                 .and_then(|m| {
                     let best = match &quad {
                         Some(q) => q.most_inside(m),
-                        None => {
-                            children
-                                .iter()
-                                .enumerate()
-                                .map(|(k, c)| (k, c.cell.score(m)))
-                                .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
-                                .0
-                        }
+                        None => self.by_octant.most_inside(&self.base, m),
                     };
                     (best < children.len() && self.fits(&children[best], g)).then_some(best as u8)
                 })
                 .unwrap_or(STAY)
         };
-        let targets: Vec<u8> = if arcs.len() > PARALLEL_ARCS {
-            arcs.par_iter().with_min_len(4096).map(target).collect()
-        } else {
-            arcs.iter().map(target).collect()
+        let targets: Vec<u8> = match &quad {
+            Some(q) if overlapping => {
+                let mut t = vec![0u8; arcs.len()];
+                if arcs.len() > PARALLEL_ARCS {
+                    t.par_chunks_mut(4096).zip(arcs.par_chunks(4096)).for_each(|(t, a)| q.targets(&children, a, t));
+                } else {
+                    q.targets(&children, arcs, &mut t);
+                }
+                t
+            }
+            _ if arcs.len() > PARALLEL_ARCS => arcs.par_iter().with_min_len(4096).map(target).collect(),
+            _ => arcs.iter().map(target).collect(),
         };
         let bucket = |t: u8| if t == STAY { 0 } else { usize::from(t) + 1 };
         // At most the 20 base cells, the own arcs and an end: on the stack (one node per cell).
@@ -1012,18 +1082,148 @@ impl Quad {
         let o = self.outer.map(|[a, b]| [a.dot(p), b.dot(p)]);
         // `Cell::score`'s order of minima (a minimum of non-NaN values does not depend on it).
         let scores = [
-            o[0][0].min(-d[2]).min(o[0][1]),
-            o[1][0].min(o[1][1]).min(-d[0]),
-            (-d[1]).min(o[2][0]).min(o[2][1]),
-            d[0].min(d[1]).min(d[2]),
+            min(min(o[0][0], -d[2]), o[0][1]),
+            min(min(o[1][0], o[1][1]), -d[0]),
+            min(min(-d[1], o[2][0]), o[2][1]),
+            min(min(d[0], d[1]), d[2]),
         ];
-        let mut best = (usize::MAX, f64::NEG_INFINITY);
-        for (k, s) in scores.into_iter().enumerate() {
-            if s > best.1 {
-                best = (k, s);
+        // The first of equals, without branches: which child wins is as good as random, and a
+        // mispredicted branch here cost more than the rest of the choice.
+        let (mut best, mut high) = (0, scores[0]);
+        for (k, s) in scores.into_iter().enumerate().skip(1) {
+            let higher = s > high;
+            best = if higher { k } else { best };
+            high = if higher { s } else { high };
+        }
+        best
+    }
+
+    /// The child an arc goes to from this cell under overlapping bins: [`Quad::most_inside`] of its
+    /// midpoint, if both endpoints lie in that child's bin; [`STAY`] otherwise, and for a zero or
+    /// antipodal arc. What the builder's general rule gives (`arc_mid`, `most_inside`, `fits_bin`),
+    /// with every step computed whatever the arc and the outcome selected at the end: the
+    /// outcomes are as good as random from one arc to the next, and their branches, mispredicted,
+    /// cost more than the arithmetic.
+    /// [`Quad::target`] of every arc of `arcs` into `out`: four arcs at a time with AVX where the
+    /// CPU has it (without FMA, so every lane rounds as the scalar code does and the result is
+    /// the same bits on any machine).
+    fn targets(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            return self.targets_avx(bins, arcs, out);
+        }
+        for (a, t) in arcs.iter().zip(out) {
+            *t = self.target(bins, a);
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    fn targets_avx(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
+        // SAFETY: the caller checked that the CPU has AVX.
+        unsafe { self.targets_avx_unchecked(bins, arcs, out) }
+    }
+
+    /// [`Quad::targets`] on 4 lanes: the same operations as [`Quad::target`] in the same order
+    /// (glam's dot product is `(x·x' + y·y') + z·z'`; `_mm256_min_pd(a, b)` is `if a < b { a } else
+    /// { b }`, as is [`min`]; negation flips the sign bit), so each lane gives that arc's target
+    /// bit for bit (tested). Written with `std::arch` because no crate offers `f64` lanes with
+    /// IEEE rounding that stays free of fused multiply-adds; the win is the dragon's level-by-level
+    /// child choice, 8.5 million arc-levels.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[allow(unsafe_code)]
+    fn targets_avx_unchecked(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
+        use std::arch::x86_64::*;
+        let splat = |x: f64| _mm256_set1_pd(x);
+        let dot = |p: DVec3, x: __m256d, y: __m256d, z: __m256d| {
+            _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(splat(p.x), x), _mm256_mul_pd(splat(p.y), y)),
+                _mm256_mul_pd(splat(p.z), z),
+            )
+        };
+        let neg = |x: __m256d| _mm256_xor_pd(x, splat(-0.0));
+        let vmin = |a: __m256d, b: __m256d| _mm256_min_pd(a, b);
+        let zero = _mm256_setzero_pd();
+        let n = arcs.len() / 4 * 4;
+        for (four, t) in arcs[..n].chunks_exact(4).zip(out[..n].chunks_exact_mut(4)) {
+            let lanes = |f: fn(&Arc) -> f64| _mm256_setr_pd(f(&four[0]), f(&four[1]), f(&four[2]), f(&four[3]));
+            let (ax, ay, az) = (lanes(|a| a.n1.x), lanes(|a| a.n1.y), lanes(|a| a.n1.z));
+            let (bx, by, bz) = (lanes(|a| a.n2.x), lanes(|a| a.n2.y), lanes(|a| a.n2.z));
+            let nonzero = |x: __m256d, y: __m256d, z: __m256d| {
+                _mm256_or_pd(
+                    _mm256_or_pd(_mm256_cmp_pd::<_CMP_NEQ_UQ>(x, zero), _mm256_cmp_pd::<_CMP_NEQ_UQ>(y, zero)),
+                    _mm256_cmp_pd::<_CMP_NEQ_UQ>(z, zero),
+                )
+            };
+            let (sx, sy, sz) = (_mm256_add_pd(ax, bx), _mm256_add_pd(ay, by), _mm256_add_pd(az, bz));
+            let length = _mm256_sqrt_pd(_mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(sx, sx), _mm256_mul_pd(sy, sy)),
+                _mm256_mul_pd(sz, sz),
+            ));
+            let real = _mm256_and_pd(
+                _mm256_and_pd(nonzero(ax, ay, az), nonzero(bx, by, bz)),
+                _mm256_cmp_pd::<_CMP_GT_OQ>(length, splat(1e-9)),
+            );
+            let inv = _mm256_div_pd(splat(1.0), length);
+            let (mx, my, mz) = (_mm256_mul_pd(sx, inv), _mm256_mul_pd(sy, inv), _mm256_mul_pd(sz, inv));
+            let d = self.middle.map(|p| dot(p, mx, my, mz));
+            let o = self.outer.map(|[a, b]| [dot(a, mx, my, mz), dot(b, mx, my, mz)]);
+            let scores = [
+                vmin(vmin(o[0][0], neg(d[2])), o[0][1]),
+                vmin(vmin(o[1][0], o[1][1]), neg(d[0])),
+                vmin(vmin(neg(d[1]), o[2][0]), o[2][1]),
+                vmin(vmin(d[0], d[1]), d[2]),
+            ];
+            let (mut best, mut high) = (zero, scores[0]);
+            let (mut cx, mut cy, mut cz, mut cos) = {
+                let c = &bins[0];
+                (splat(c.cell.center.x), splat(c.cell.center.y), splat(c.cell.center.z), splat(c.cos_bin))
+            };
+            for (k, &score) in scores.iter().enumerate().skip(1) {
+                let higher = _mm256_cmp_pd::<_CMP_GT_OQ>(score, high);
+                let pick = |now: __m256d, x: f64| _mm256_blendv_pd(now, splat(x), higher);
+                best = pick(best, k as f64);
+                high = _mm256_blendv_pd(high, score, higher);
+                let c = &bins[k];
+                (cx, cy, cz, cos) = (
+                    pick(cx, c.cell.center.x),
+                    pick(cy, c.cell.center.y),
+                    pick(cz, c.cell.center.z),
+                    pick(cos, c.cos_bin),
+                );
+            }
+            let center_dot = |x: __m256d, y: __m256d, z: __m256d| {
+                _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(cx, x), _mm256_mul_pd(cy, y)), _mm256_mul_pd(cz, z))
+            };
+            let fits = _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_GE_OQ>(center_dot(ax, ay, az), cos),
+                _mm256_cmp_pd::<_CMP_GE_OQ>(center_dot(bx, by, bz), cos),
+            );
+            let stored = _mm256_movemask_pd(_mm256_and_pd(real, fits));
+            let mut k = [0f64; 4];
+            // SAFETY: `k` holds 4 f64s; the store is unaligned.
+            unsafe { _mm256_storeu_pd(k.as_mut_ptr(), best) };
+            for (lane, t) in t.iter_mut().enumerate() {
+                *t = if stored >> lane & 1 == 1 { k[lane] as u8 } else { STAY };
             }
         }
-        best.0
+        for (a, t) in arcs[n..].iter().zip(&mut out[n..]) {
+            *t = self.target(bins, a);
+        }
+    }
+
+    #[inline(always)]
+    fn target(&self, bins: &[BinCell], a: &Arc) -> u8 {
+        let sum = a.n1 + a.n2;
+        let length = sum.length();
+        let real = (a.n1 != DVec3::ZERO) & (a.n2 != DVec3::ZERO) & (length > 1e-9);
+        // `arc_mid`'s midpoint (NaN or infinite where `real` is false; then unused).
+        let m = sum * (1.0 / length);
+        let k = self.most_inside(m);
+        let c = &bins[k];
+        let fits = (c.cell.center.dot(a.n1) >= c.cos_bin) & (c.cell.center.dot(a.n2) >= c.cos_bin);
+        if real & fits { k as u8 } else { STAY }
     }
 }
 
@@ -1546,7 +1746,8 @@ fn assign(
     stop: Option<StopRule>,
 ) -> Option<(Vec<BuildNode>, Vec<Arc>)> {
     let mut arcs = arc_records(normals);
-    let builder = Builder { bins, max_depth, base: base_cells(base), caps: guide.is_none(), stop };
+    let base = base_cells(base);
+    let builder = Builder { bins, max_depth, by_octant: BaseByOctant::new(&base), base, caps: guide.is_none(), stop };
     let mut nodes = Vec::new();
     let mut scratch = drafter_core::filled_in_parallel(arcs.len(), Arc::default());
     let guide = (0, guide.map(|g| (g, 0)));
@@ -1695,16 +1896,113 @@ mod tests {
                 if p == DVec3::ZERO {
                     continue;
                 }
-                let expected = children
-                    .iter()
-                    .enumerate()
-                    .map(|(k, c)| (k, c.score(p)))
-                    .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
-                    .0;
+                let expected = most_inside_reference(&children, p);
                 assert_eq!(quad.most_inside(p), expected, "level {level}, point {p}");
             }
             cell = children[level % 4];
         }
+    }
+
+    /// The cell-choice rule as first written: `f64::min` of the three plane dots, the first of
+    /// equals over `cells`. The fast paths must give what this gives.
+    fn most_inside_reference(cells: &[Cell], p: DVec3) -> usize {
+        cells
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (k, c.planes[0].dot(p).min(c.planes[1].dot(p)).min(c.planes[2].dot(p))))
+            .fold((usize::MAX, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc })
+            .0
+    }
+
+    /// Points on and near the cells' corners, edges and the octants' planes, and random ones.
+    fn awkward_points(cells: &[Cell], rng: &mut crate::measure::ViewRng, random: usize) -> Vec<DVec3> {
+        let mut points = Vec::new();
+        for c in cells {
+            let [a, b, c] = c.v;
+            points.extend([a, b, c, (a + b).normalize(), (b + c).normalize(), (c + a).normalize(), -a]);
+        }
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+            points.extend([axis, -axis, (axis + DVec3::new(-0.0, -0.0, -0.0)).normalize()]);
+        }
+        points.push(DVec3::new(-0.0, 0.6, -0.8));
+        points.push(DVec3::new(0.6, -0.0, 0.8));
+        for _ in 0..random {
+            let p = rng.direction().as_dvec3().normalize();
+            points.push(p);
+            // The same point with one component zeroed: on an octant's plane.
+            let k = points.len() % 3;
+            let mut q = p;
+            q[k] = if k == 1 { -0.0 } else { 0.0 };
+            points.push(q.normalize_or_zero());
+        }
+        points.retain(|p| *p != DVec3::ZERO);
+        points
+    }
+
+    #[test]
+    fn base_by_octant_picks_what_all_cells_pick() {
+        let mut rng = crate::measure::ViewRng::new(5);
+        for solid in [BaseSolid::Icosahedron, BaseSolid::Octahedron] {
+            let base = base_cells(solid);
+            let index = BaseByOctant::new(&base);
+            let listed: usize = index.cells.iter().map(Vec::len).sum();
+            assert!(listed < 8 * base.len(), "{solid:?}: the octants list {listed} cells");
+            for p in awkward_points(&base, &mut rng, 20_000) {
+                assert_eq!(index.most_inside(&base, p), most_inside_reference(&base, p), "{solid:?}, point {p}");
+            }
+        }
+    }
+
+    #[test]
+    fn quad_targets_are_the_bin_rule() {
+        let mut rng = crate::measure::ViewRng::new(13);
+        let mut cell = base_cells(BaseSolid::Icosahedron)[7];
+        let mut checked = 0;
+        for level in 0..10 {
+            let children = cell.children();
+            for factor in [1.0, 1.5, 2.0] {
+                let bins: Vec<BinCell> =
+                    children.iter().map(|&cell| BinCell { cell, cos_bin: bin_cos(&cell, factor) }).collect();
+                let quad = Quad::of(&bins);
+                let mut points = awkward_points(&children, &mut rng, 300);
+                // Points inside the cell, where its arcs' midpoints lie.
+                let [a, b, c] = cell.v;
+                for _ in 0..600 {
+                    let w = [rng.unit().abs(), rng.unit().abs(), rng.unit().abs()].map(f64::from);
+                    points.push((a * w[0] + b * w[1] + c * w[2]).normalize_or_zero());
+                }
+                points.retain(|p| *p != DVec3::ZERO);
+                let mut arcs = Vec::new();
+                let arc = |n1: DVec3, n2: DVec3| Arc { n1, n2, id: 0, p: 0.0 };
+                for (i, &p) in points.iter().enumerate() {
+                    let q = points[(i * 7 + 3) % points.len()];
+                    // A short arc around p, a long one, p alone, antipodal, and degenerate faces.
+                    let near = (p + (q - p) * 0.01).normalize();
+                    arcs.extend([
+                        arc(p, near),
+                        arc(p, q),
+                        arc(p, p),
+                        arc(p, -p),
+                        arc(DVec3::ZERO, p),
+                        arc(p, DVec3::ZERO),
+                    ]);
+                }
+                arcs.push(arc(DVec3::ZERO, DVec3::ZERO));
+                let mut fast = vec![0u8; arcs.len()];
+                quad.targets(&bins, &arcs, &mut fast);
+                for (g, &t) in arcs.iter().zip(&fast) {
+                    let expected = arc_mid([g.n1, g.n2])
+                        .map(|m| most_inside_reference(&children, m))
+                        .filter(|&k| fits_bin(&children[k], bins[k].cos_bin, [g.n1, g.n2]))
+                        .map_or(STAY, |k| k as u8);
+                    assert_eq!(t, expected, "level {level}, factor {factor}, arc {} – {}", g.n1, g.n2);
+                    assert_eq!(quad.target(&bins, g), expected, "scalar, level {level}, arc {} – {}", g.n1, g.n2);
+                    checked += usize::from(expected != STAY);
+                }
+            }
+            cell = children[(level + 1) % 4];
+        }
+        assert!(checked > 10_000, "only {checked} arcs went down");
     }
 
     #[test]
