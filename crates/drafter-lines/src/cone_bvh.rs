@@ -390,7 +390,10 @@ impl PlaneAcc {
         // cos α from the stored sine (which includes the cone margin): rounded down.
         let sin = f64::from(c[3]);
         let cos = (1.0 - sin * sin).max(0.0).sqrt();
-        PlaneBound([round_down(cos), round_down(self.lo), round_up(self.hi), round_up(reach)])
+        // `+ 0.0` turns a zero offset of -0.0 into +0.0: which zero a minimum or maximum keeps
+        // depends on the order it met them in (the four-lane pass meets them in another), and no
+        // comparison of the bound tells them apart.
+        PlaneBound([round_down(cos), round_down(self.lo + 0.0), round_up(self.hi + 0.0), round_up(reach)])
     }
 }
 
@@ -1567,22 +1570,23 @@ fn cone_and_planes(pairs: &[[DVec3; 2]], points: &[Vec3], b: &[f32; 6]) -> ([f32
     let axis32 = sum.normalize().as_vec3();
     let axis = axis32.as_dvec3().normalize();
     let never = ([axis32.x, axis32.y, axis32.z, NEVER_CULL], PlaneBound::NEVER);
-    let mut cos_min = 1.0f64;
-    let mut max_angle = 0.0f64;
+    let mut widest = Widest { cos_min: 1.0, max_angle: 0.0 };
     let mut acc = PlaneAcc::new(b);
-    for (&pair, &point) in pairs.iter().zip(points) {
-        for n in pair {
-            if n == DVec3::ZERO {
-                return never;
-            }
-            let d = axis.dot(n);
-            if d <= cos_min {
-                cos_min = d;
-                max_angle = max_angle.max(axis.cross(n).length().atan2(d));
-            }
+    #[cfg(target_arch = "x86_64")]
+    let done = if std::arch::is_x86_feature_detected!("avx") {
+        match cone_and_planes_avx(axis, pairs, points, &mut widest, &mut acc) {
+            Some(done) => done,
+            None => return never,
         }
-        acc.add(pair, point);
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = 0;
+    if !widest.add_all(axis, &pairs[done..], &points[done..], &mut acc) {
+        return never;
     }
+    let max_angle = widest.max_angle;
     let alpha = max_angle + 1e-9;
     if alpha >= std::f64::consts::FRAC_PI_2 - 1e-3 {
         return never;
@@ -1592,6 +1596,129 @@ fn cone_and_planes(pairs: &[[DVec3; 2]], points: &[Vec3], b: &[f32; 6]) -> ([f32
     let s32 = if f64::from(s32) < s { s32.next_up() } else { s32 };
     let cone = [axis32.x, axis32.y, axis32.z, s32];
     (cone, acc.finish(&cone))
+}
+
+/// The running widest angle of [`cone_and_planes`] from its axis: the smallest dot product so
+/// far and the largest exact angle, evaluated where a normal comes within reach of the smallest.
+#[derive(Clone, Copy, Debug)]
+struct Widest {
+    cos_min: f64,
+    max_angle: f64,
+}
+
+impl Widest {
+    /// Adds the candidates `pairs` (unit normals) at `points` to the widest angle and to `acc`,
+    /// in order; false (and stops) at a zero normal.
+    fn add_all(&mut self, axis: DVec3, pairs: &[[DVec3; 2]], points: &[Vec3], acc: &mut PlaneAcc) -> bool {
+        for (&pair, &point) in pairs.iter().zip(points) {
+            for n in pair {
+                if n == DVec3::ZERO {
+                    return false;
+                }
+                self.add(axis, n);
+            }
+            acc.add(pair, point);
+        }
+        true
+    }
+
+    #[inline(always)]
+    fn add(&mut self, axis: DVec3, n: DVec3) {
+        let d = axis.dot(n);
+        if d <= self.cos_min {
+            self.cos_min = d;
+            self.max_angle = self.max_angle.max(axis.cross(n).length().atan2(d));
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+fn cone_and_planes_avx(
+    axis: DVec3,
+    pairs: &[[DVec3; 2]],
+    points: &[Vec3],
+    widest: &mut Widest,
+    acc: &mut PlaneAcc,
+) -> Option<usize> {
+    // SAFETY: the caller checked that the CPU has AVX.
+    unsafe { cone_and_planes_avx_unchecked(axis, pairs, points, widest, acc) }
+}
+
+/// [`Widest::add_all`] on the candidates in whole groups of 4, with AVX: the candidates processed
+/// (`None` at a zero normal, where the plain loop gives up too). The dot products with the axis
+/// are taken 4 at a time and a group goes through [`Widest::add`] one by one only where one of
+/// them reaches the smallest so far: elsewhere `add` would change nothing, so the widest angle is
+/// the plain loop's bit for bit. The planes' offsets and reach take 4-lane minima and maxima,
+/// joined at the end: the same values in any order, but for the sign of a zero, which
+/// [`PlaneAcc::finish`] makes +0. The products round as glam's, with no fused multiply-add.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[allow(unsafe_code)]
+fn cone_and_planes_avx_unchecked(
+    axis: DVec3,
+    pairs: &[[DVec3; 2]],
+    points: &[Vec3],
+    widest: &mut Widest,
+    acc: &mut PlaneAcc,
+) -> Option<usize> {
+    use std::arch::x86_64::*;
+    let splat = |x: f64| _mm256_set1_pd(x);
+    let dot = |[ax, ay, az]: [__m256d; 3], [bx, by, bz]: [__m256d; 3]| {
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, bx), _mm256_mul_pd(ay, by)), _mm256_mul_pd(az, bz))
+    };
+    let zero = _mm256_setzero_pd();
+    let is_zero = |[x, y, z]: [__m256d; 3]| {
+        _mm256_and_pd(
+            _mm256_and_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(x, zero), _mm256_cmp_pd::<_CMP_EQ_OQ>(y, zero)),
+            _mm256_cmp_pd::<_CMP_EQ_OQ>(z, zero),
+        )
+    };
+    let a = [splat(axis.x), splat(axis.y), splat(axis.z)];
+    let p0 = [splat(acc.p0.x), splat(acc.p0.y), splat(acc.p0.z)];
+    let (mut lo, mut hi, mut reach) = (splat(f64::INFINITY), splat(f64::NEG_INFINITY), zero);
+    let n = pairs.len().min(points.len()) / 4 * 4;
+    for (four, at) in pairs[..n].chunks_exact(4).zip(points[..n].chunks_exact(4)) {
+        let lanes = |f: &dyn Fn(usize) -> f64| _mm256_setr_pd(f(0), f(1), f(2), f(3));
+        let n1 = [lanes(&|k| four[k][0].x), lanes(&|k| four[k][0].y), lanes(&|k| four[k][0].z)];
+        let n2 = [lanes(&|k| four[k][1].x), lanes(&|k| four[k][1].y), lanes(&|k| four[k][1].z)];
+        if _mm256_movemask_pd(_mm256_or_pd(is_zero(n1), is_zero(n2))) != 0 {
+            return None;
+        }
+        let near = splat(widest.cos_min);
+        let close =
+            _mm256_or_pd(_mm256_cmp_pd::<_CMP_LE_OQ>(dot(a, n1), near), _mm256_cmp_pd::<_CMP_LE_OQ>(dot(a, n2), near));
+        if _mm256_movemask_pd(close) != 0 {
+            for pair in four {
+                widest.add(axis, pair[0]);
+                widest.add(axis, pair[1]);
+            }
+        }
+        // `point.as_dvec3() - p0`: the conversion is exact.
+        let d = [
+            _mm256_sub_pd(lanes(&|k| f64::from(at[k].x)), p0[0]),
+            _mm256_sub_pd(lanes(&|k| f64::from(at[k].y)), p0[1]),
+            _mm256_sub_pd(lanes(&|k| f64::from(at[k].z)), p0[2]),
+        ];
+        // Each new value first: `_mm256_min_pd(new, old)` keeps `old` where `new` is NaN, as
+        // `f64::min` ignores a NaN.
+        reach = _mm256_max_pd(dot(d, d), reach);
+        for h in [dot(n1, d), dot(n2, d)] {
+            lo = _mm256_min_pd(h, lo);
+            hi = _mm256_max_pd(h, hi);
+        }
+    }
+    let mut out = [[0f64; 4]; 3];
+    for (v, o) in [lo, hi, reach].into_iter().zip(&mut out) {
+        // SAFETY: `o` holds 4 f64s; the store is unaligned.
+        unsafe { _mm256_storeu_pd(o.as_mut_ptr(), v) };
+    }
+    let [lo, hi, reach] = out;
+    acc.lo = lo.into_iter().fold(acc.lo, f64::min);
+    acc.hi = hi.into_iter().fold(acc.hi, f64::max);
+    acc.reach_squared = reach.into_iter().fold(acc.reach_squared, f64::max);
+    acc.count += n;
+    Some(n)
 }
 
 /// Cone around the normalised mean of the unit normals of `pairs` (both of each, in order):
@@ -1796,6 +1923,27 @@ mod tests {
             }
             if case % 5 == 0 {
                 points[0] = points[n - 1];
+            }
+            if case % 3 == 0 {
+                // Candidates at the anchor: offsets of zero, -0.0 for normals with no positive
+                // component (the four-lane path must keep the plain loop's zero).
+                let centre = anchor(&bounding_box(points.iter().copied()));
+                let at = (case / 3) % (n + 1);
+                points.insert(at, centre);
+                normals
+                    .insert(at, [Vec3::new(-0.6, -0.8, -0.0), (axis + rng.direction() * spread).normalize_or_zero()]);
+                points.push(centre);
+                normals.push([(axis + rng.direction() * spread).normalize_or_zero(), Vec3::new(0.0, 0.6, 0.8)]);
+            }
+            if case % 11 == 0 {
+                // Every candidate at one point: every offset is a zero of either sign.
+                // Normals with no positive component give -0.0, the others +0.0; all within a
+                // narrow cone, so that the planes are used.
+                points.iter_mut().for_each(|p| *p = Vec3::new(1.5, -2.0, 0.25));
+                let (negative, mixed) = (Vec3::new(-0.48, -0.6, -0.64), Vec3::new(0.05, -0.6, -0.8).normalize());
+                for (k, pair) in normals.iter_mut().enumerate() {
+                    *pair = [0, 1].map(|side| if (k * 2 + side + case / 11) % 5 < 2 { negative } else { mixed });
+                }
             }
             let pairs: Vec<[DVec3; 2]> = normals.iter().map(|&n| unit_pair(n)).collect();
             let b = bounding_box(points.iter().copied());
