@@ -1573,8 +1573,10 @@ fn cone_and_planes(pairs: &[[DVec3; 2]], points: &[Vec3], b: &[f32; 6]) -> ([f32
     let mut widest = Widest { cos_min: 1.0, max_angle: 0.0 };
     let mut acc = PlaneAcc::new(b);
     #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
     let done = if std::arch::is_x86_feature_detected!("avx") {
-        match cone_and_planes_avx(axis, pairs, points, &mut widest, &mut acc) {
+        // SAFETY: the CPU has AVX, the one feature the function is compiled with.
+        match unsafe { cone_and_planes_avx(axis, pairs, points, &mut widest, &mut acc) } {
             Some(done) => done,
             None => return never,
         }
@@ -1632,19 +1634,6 @@ impl Widest {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[allow(unsafe_code)]
-fn cone_and_planes_avx(
-    axis: DVec3,
-    pairs: &[[DVec3; 2]],
-    points: &[Vec3],
-    widest: &mut Widest,
-    acc: &mut PlaneAcc,
-) -> Option<usize> {
-    // SAFETY: the caller checked that the CPU has AVX.
-    unsafe { cone_and_planes_avx_unchecked(axis, pairs, points, widest, acc) }
-}
-
 /// [`Widest::add_all`] on the candidates in whole groups of 4, with AVX: the candidates processed
 /// (`None` at a zero normal, where the plain loop gives up too). The dot products with the axis
 /// are taken 4 at a time and a group goes through [`Widest::add`] one by one only where one of
@@ -1655,7 +1644,7 @@ fn cone_and_planes_avx(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[allow(unsafe_code)]
-fn cone_and_planes_avx_unchecked(
+fn cone_and_planes_avx(
     axis: DVec3,
     pairs: &[[DVec3; 2]],
     points: &[Vec3],
