@@ -325,6 +325,32 @@ mod tests {
         best.1
     }
 
+    /// The AVX scoring gives the scalar scoring's cosines bit for bit (so the scalar path, which
+    /// CPUs without AVX take, picks what the tests above check).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    #[allow(unsafe_code)]
+    fn lattice_cosines_avx_are_the_scalar_ones() {
+        if !std::arch::is_x86_feature_detected!("avx") {
+            return;
+        }
+        let mut r = uniform(9);
+        for i in 0..200_000 {
+            let v = Vec3::new(r(), r(), r());
+            let Some(n) = (if i % 7 == 0 { Some(Vec3::new(v.x.round(), v.y, 0.0)) } else { v.try_normalize() })
+                .and_then(Vec3::try_normalize)
+            else {
+                continue;
+            };
+            let n = n.as_dvec3().normalize();
+            let s = n * 127.0;
+            let (lo, hi) = (s.floor(), s.ceil());
+            // SAFETY: the CPU has AVX (checked above).
+            let fast = unsafe { lattice_cosines_avx(lo, hi, n) };
+            assert_eq!(fast.map(f64::to_bits), lattice_cosines(lo, hi, n).map(f64::to_bits), "{n}");
+        }
+    }
+
     #[test]
     fn the_direction_encoder_is_its_rule() {
         let mut r = uniform(5);
