@@ -1098,12 +1098,6 @@ impl Quad {
         best
     }
 
-    /// The child an arc goes to from this cell under overlapping bins: [`Quad::most_inside`] of its
-    /// midpoint, if both endpoints lie in that child's bin; [`STAY`] otherwise, and for a zero or
-    /// antipodal arc. What the builder's general rule gives (`arc_mid`, `most_inside`, `fits_bin`),
-    /// with every step computed whatever the arc and the outcome selected at the end: the
-    /// outcomes are as good as random from one arc to the next, and their branches, mispredicted,
-    /// cost more than the arithmetic.
     /// [`Quad::target`] of every arc of `arcs` into `out`: four arcs at a time with AVX where the
     /// CPU has it (without FMA, so every lane rounds as the scalar code does and the result is
     /// the same bits on any machine).
@@ -1213,6 +1207,12 @@ impl Quad {
         }
     }
 
+    /// The child an arc goes to from this cell under overlapping bins: [`Quad::most_inside`] of its
+    /// midpoint, if both endpoints lie in that child's bin; [`STAY`] otherwise, and for a zero or
+    /// antipodal arc. What the builder's general rule gives (`arc_mid`, `most_inside`, `fits_bin`),
+    /// with every step computed whatever the arc and the outcome selected at the end: the
+    /// outcomes are as good as random from one arc to the next, and their branches, mispredicted,
+    /// cost more than the arithmetic.
     #[inline(always)]
     fn target(&self, bins: &[BinCell], a: &Arc) -> u8 {
         let sum = a.n1 + a.n2;
