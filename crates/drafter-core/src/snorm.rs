@@ -103,7 +103,8 @@ fn lattice_cosines(lo: glam::DVec3, hi: glam::DVec3, n: glam::DVec3) -> [f64; 8]
 /// lane in the same order (glam's dot product `(x·x' + y·y') + z·z'`, the clamp as a maximum then
 /// a minimum, no fused multiply-add), so the same bits; the 8 square roots and divisions take 2
 /// instructions each. The encoder runs once per face of every silhouette candidate (the dragon's
-/// 871k), and these were about half of its time.
+/// 871k faces) and was about half of the edge encoding's time (docs/bench.md); this cut the
+/// dragon's lines stage by about 30 ms.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[allow(unsafe_code)]

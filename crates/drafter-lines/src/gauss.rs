@@ -1087,8 +1087,8 @@ impl Quad {
             min(min(-d[1], o[2][0]), o[2][1]),
             min(min(d[0], d[1]), d[2]),
         ];
-        // The first of equals, without branches: which child wins is as good as random, and a
-        // mispredicted branch here cost more than the rest of the choice.
+        // The first of equals, without branches: which child wins is as good as random from one
+        // arc to the next, so a branch on it would often be mispredicted.
         let (mut best, mut high) = (0, scores[0]);
         for (k, s) in scores.into_iter().enumerate().skip(1) {
             let higher = s > high;
@@ -1211,8 +1211,8 @@ impl Quad {
     /// midpoint, if both endpoints lie in that child's bin; [`STAY`] otherwise, and for a zero or
     /// antipodal arc. What the builder's general rule gives (`arc_mid`, `most_inside`, `fits_bin`),
     /// with every step computed whatever the arc and the outcome selected at the end: the
-    /// outcomes are as good as random from one arc to the next, and their branches, mispredicted,
-    /// cost more than the arithmetic.
+    /// outcomes are as good as random from one arc to the next, so branches on them would often
+    /// be mispredicted.
     #[inline(always)]
     fn target(&self, bins: &[BinCell], a: &Arc) -> u8 {
         let sum = a.n1 + a.n2;
@@ -1279,8 +1279,8 @@ fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Ar
 /// The dot products of 4 arcs' endpoints with each centre in one pass, and [`Widest::add`] on
 /// those arcs only where some endpoint comes within the slack of the smallest dot product so far:
 /// where none does, `add` would change nothing for any of them, so the state after each group is
-/// what the plain loop leaves, bit for bit (the dot products round as glam's, without FMA). The
-/// smallest so far is soon reached, so almost every group is four arcs in a few instructions.
+/// what the plain loop leaves, bit for bit (the dot products round as glam's, without FMA). Once
+/// the smallest so far is near the node's minimum, a group needs only the vector test.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn widest_avx_unchecked<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Arc] {
