@@ -1103,19 +1103,14 @@ impl Quad {
     /// the same bits on any machine).
     fn targets(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
         #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
         if std::arch::is_x86_feature_detected!("avx") {
-            return self.targets_avx(bins, arcs, out);
+            // SAFETY: the CPU has AVX, the one feature the function is compiled with.
+            return unsafe { self.targets_avx(bins, arcs, out) };
         }
         for (a, t) in arcs.iter().zip(out) {
             *t = self.target(bins, a);
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    fn targets_avx(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
-        // SAFETY: the caller checked that the CPU has AVX.
-        unsafe { self.targets_avx_unchecked(bins, arcs, out) }
     }
 
     /// [`Quad::targets`] on 4 lanes: the same operations as [`Quad::target`] in the same order
@@ -1127,7 +1122,7 @@ impl Quad {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[allow(unsafe_code)]
-    fn targets_avx_unchecked(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
+    fn targets_avx(&self, bins: &[BinCell], arcs: &[Arc], out: &mut [u8]) {
         use std::arch::x86_64::*;
         let splat = |x: f64| _mm256_set1_pd(x);
         let dot = |p: DVec3, x: __m256d, y: __m256d, z: __m256d| {
@@ -1247,7 +1242,9 @@ fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
 fn widest_angles_of_arcs(cs: &[DVec3], arcs: &[Arc]) -> [f64; 2] {
     let mut w = [Widest::default(), Widest::default()];
     #[cfg(target_arch = "x86_64")]
-    let arcs = if std::arch::is_x86_feature_detected!("avx") { widest_avx(cs, arcs, &mut w) } else { arcs };
+    #[allow(unsafe_code)]
+    // SAFETY: the CPU has AVX, the one feature the function is compiled with.
+    let arcs = if std::arch::is_x86_feature_detected!("avx") { unsafe { widest_avx(cs, arcs, &mut w) } } else { arcs };
     match *cs {
         [c] => {
             for a in arcs {
@@ -1269,13 +1266,6 @@ fn widest_angles_of_arcs(cs: &[DVec3], arcs: &[Arc]) -> [f64; 2] {
 }
 
 /// [`widest_angles_of_arcs`] on the arcs in whole groups of 4, into `w`; returns the arcs left.
-#[cfg(target_arch = "x86_64")]
-#[allow(unsafe_code)]
-fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Arc] {
-    // SAFETY: the caller checked that the CPU has AVX.
-    unsafe { widest_avx_unchecked(cs, arcs, w) }
-}
-
 /// The dot products of 4 arcs' endpoints with each centre in one pass, and [`Widest::add`] on
 /// those arcs only where some endpoint comes within the slack of the smallest dot product so far:
 /// where none does, `add` would change nothing for any of them, so the state after each group is
@@ -1283,7 +1273,7 @@ fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Ar
 /// the smallest so far is near the node's minimum, a group needs only the vector test.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn widest_avx_unchecked<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Arc] {
+fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Arc] {
     use std::arch::x86_64::*;
     let splat = |x: f64| _mm256_set1_pd(x);
     let groups = arcs.chunks_exact(4);
