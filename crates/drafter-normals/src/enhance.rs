@@ -61,16 +61,36 @@ pub struct EnhancedFaces {
 /// Runs the whole filter on a mesh's welded topology: face geometry, adjacency, low-pass, enhancement.
 pub fn enhance_faces(topology: &Topology, options: &EnhanceOptions) -> EnhancedFaces {
     let geometry = FaceGeometry::compute(topology);
-    let adjacency = FaceAdjacency::build(topology, &geometry, options.neighborhood, options.weighting);
-    let low = low_pass(&adjacency, &geometry.normals, options.iterations);
-    let enhanced = enhance(&geometry.normals, &low, options.strength);
-    EnhancedFaces {
-        face_iterations: geometry.len() as u64 * options.iterations as u64,
-        reference_length: adjacency.reference_length(),
-        geometry,
-        low_pass: low,
-        enhanced,
+    let filtered = filter(topology, &geometry, options);
+    filtered.with_geometry(geometry, options)
+}
+
+/// The filter's results on face geometry computed from `topology`, before [`EnhancedFaces`] takes the
+/// geometry.
+pub(crate) struct Filtered {
+    low_pass: Vec<Vec3>,
+    enhanced: Vec<Vec3>,
+    reference_length: f32,
+}
+
+impl Filtered {
+    pub(crate) fn with_geometry(self, geometry: FaceGeometry, options: &EnhanceOptions) -> EnhancedFaces {
+        EnhancedFaces {
+            face_iterations: geometry.len() as u64 * options.iterations as u64,
+            reference_length: self.reference_length,
+            geometry,
+            low_pass: self.low_pass,
+            enhanced: self.enhanced,
+        }
     }
+}
+
+/// Adjacency, low-pass and enhancement on `geometry`, which must come from `topology`.
+pub(crate) fn filter(topology: &Topology, geometry: &FaceGeometry, options: &EnhanceOptions) -> Filtered {
+    let adjacency = FaceAdjacency::build(topology, geometry, options.neighborhood, options.weighting);
+    let low_pass = low_pass(&adjacency, &geometry.normals, options.iterations);
+    let enhanced = enhance(&geometry.normals, &low_pass, options.strength);
+    Filtered { low_pass, enhanced, reference_length: adjacency.reference_length() }
 }
 
 /// `n_L`: `iterations` Jacobi steps of re-normalised weighted averaging (the paper's Laplacian kernel),

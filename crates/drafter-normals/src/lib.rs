@@ -155,8 +155,14 @@ pub struct MeshNormals {
 /// the original and the enhanced vertex normals. `topology` must have been built from `mesh`.
 /// Recoverable problems (degenerate faces, normals that fell back to `+Z`) are returned as diagnostics.
 pub fn compute_normals(mesh: &Mesh, topology: &Topology, options: &NormalsOptions) -> (MeshNormals, Vec<Diagnostic>) {
-    let faces = enhance_faces(topology, &options.enhance);
-    let layout = VertexLayout::build(mesh, topology, &faces.geometry, &options.crease);
+    // The filter and the layout need only the face geometry; run side by side, each fills the other's
+    // serial stretches (the filter's sweep order, the layout's assembly).
+    let geometry = FaceGeometry::compute(topology);
+    let (layout, filtered) = rayon::join(
+        || VertexLayout::build(mesh, topology, &geometry, &options.crease),
+        || enhance::filter(topology, &geometry, &options.enhance),
+    );
+    let faces = filtered.with_geometry(geometry, &options.enhance);
     let (normals, fallback_original) = layout.vertex_normals(&faces.geometry.normals);
     let (enhanced_normals, _) = layout.vertex_normals(&faces.enhanced);
     let welded_vertices = topology.referenced_vertex_count();
