@@ -603,13 +603,25 @@ pub(crate) struct ArcCells {
 impl ArcCells {
     /// Each arc's cell, by candidate, from the builder's `nodes` and preorder `arcs`.
     fn by_candidate(nodes: &[BuildNode], arcs: &[Arc]) -> Vec<(u32, u8, bool)> {
-        let mut by_id = vec![(0u32, 0u8, false); arcs.len()];
-        for n in nodes {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        // On the thread pool, node by node: every arc is in one node's own range, so each slot is
+        // written once (a relaxed atomic store is a plain store). The scatter by candidate misses
+        // the cache for nearly every arc; done serially, the build's step around it took 17–26 ms
+        // on the dragon's 1.3M arcs at two threads, 10–11 ms this way (temporary timers).
+        let packed: Vec<AtomicU64> = (0..arcs.len()).into_par_iter().map(|_| AtomicU64::new(0)).collect();
+        nodes.par_iter().with_min_len(64).for_each(|n| {
+            let cell = u64::from(n.key) << 16 | u64::from(n.depth) << 8 | u64::from(!n.tried);
             for a in &arcs[n.own.0 as usize..n.own.1 as usize] {
-                by_id[a.id as usize] = (n.key, n.depth, !n.tried);
+                packed[a.id as usize].store(cell, Ordering::Relaxed);
             }
-        }
-        by_id
+        });
+        packed
+            .into_par_iter()
+            .map(|cell| {
+                let cell = cell.into_inner();
+                ((cell >> 16) as u32, (cell >> 8) as u8, cell & 1 == 1)
+            })
+            .collect()
     }
 
     /// The cells `by_id` ([`ArcCells::by_candidate`]) in storage order `order`.

@@ -207,8 +207,12 @@ impl FaceAdjacency {
                     .with_min_len(FACE_CHUNK)
                     .map(|&f| neighbors[f as usize].map(|g| if g == padding { g } else { order.position[g as usize] }))
                     .collect_into_vec(&mut rows);
-                let weights =
-                    order.face.par_iter().with_min_len(FACE_CHUNK).map(|&f| face_weight(geometry.areas[f as usize])).collect();
+                let weights = order
+                    .face
+                    .par_iter()
+                    .with_min_len(FACE_CHUNK)
+                    .map(|&f| face_weight(geometry.areas[f as usize]))
+                    .collect();
                 FaceAdjacency { weights, rows: Rows::Packed { neighbors: rows, dampings }, order, reference_length }
             }
             None => {
