@@ -69,10 +69,11 @@ pub enum Weighting {
 /// [`Weighting::ScaleDependent`]). The iteration therefore keeps `w_g·n_g` premultiplied, and a row
 /// needs only neighbour ids, plus dampings when some pair is damped.
 ///
-/// The packed rows of a large mesh (from [`SWEEP_ORDER_MIN_FACES`] faces) are stored in *sweep
-/// order*, a breadth-first order of the faces ([`SweepOrder`]), so that the neighbours a row reads
-/// lie within a short window around it: in the dragon's input order a
-/// face's neighbours lie up to 98,000 faces away (p90 6,100), in breadth-first order at most 1,670.
+/// The packed rows of a large mesh whose face order scatters neighbours ([`SWEEP_ORDER_MIN_FACES`],
+/// [`scattered`]) are stored in *sweep order*, a breadth-first order of the faces ([`SweepOrder`]),
+/// so that the neighbours a row reads lie within a short window around it: in the dragon's input
+/// order a face's neighbours lie up to 98,000 faces away (p90 6,100), in breadth-first order at
+/// most 1,670.
 /// Each row keeps its neighbours in the sequence of the face's own row, so every sum has the same
 /// terms in the same order as in face order, and the result does not depend on the order.
 #[derive(Clone, Debug, Default)]
@@ -133,17 +134,18 @@ impl FaceAdjacency {
         neighborhood: Neighborhood,
         weighting: Weighting,
     ) -> FaceAdjacency {
-        let sweep_order = topology.faces.len() >= SWEEP_ORDER_MIN_FACES;
-        Self::build_in(topology, geometry, neighborhood, weighting, sweep_order)
+        Self::build_in(topology, geometry, neighborhood, weighting, None)
     }
 
-    /// [`Self::build`], with packed rows in sweep order or (for tests) in face order.
+    /// [`Self::build`]; `force_sweep` `Some(true)` or `Some(false)` stores packed rows in sweep order or
+    /// in face order whatever the mesh (for tests), `None` decides as `build` does
+    /// ([`SWEEP_ORDER_MIN_FACES`], [`scattered`]).
     fn build_in(
         topology: &Topology,
         geometry: &FaceGeometry,
         neighborhood: Neighborhood,
         weighting: Weighting,
-        sweep_order: bool,
+        force_sweep: Option<bool>,
     ) -> FaceAdjacency {
         // Areas are divided by the mean non-degenerate area so weights stay near 1 whatever the units.
         let (area_sum, area_count) =
@@ -175,6 +177,8 @@ impl FaceAdjacency {
                     });
                 };
                 let face_weights = || geometry.areas.par_iter().with_min_len(FACE_CHUNK).map(|&a| face_weight(a));
+                let sweep_order =
+                    force_sweep.unwrap_or_else(|| neighbors.len() >= SWEEP_ORDER_MIN_FACES && scattered(&neighbors));
                 if !sweep_order {
                     let dampings = if damped {
                         to_dampings(&mut distances);
@@ -340,11 +344,36 @@ impl FaceAdjacency {
     }
 }
 
-/// From this many faces, packed rows are stored in sweep order. Below it the filter's arrays (about
-/// 60 bytes a face per step) stay in cache in any order, and ordering would cost more than it
-/// saves: on GearboxAssy (42 meshes, the largest 42k faces) the bake spent 3–6 % more CPU time with
+/// From this many faces, packed rows may be stored in sweep order. Below it the filter's arrays
+/// (about 60 bytes a face per step) stay in cache in any order, and ordering would cost more than it
+/// saves: on GearboxAssy (42 meshes, the largest 42k faces) the bake spent 3–7 % more CPU time with
 /// every mesh ordered.
 const SWEEP_ORDER_MIN_FACES: usize = 1 << 16;
+
+/// Whether the face order scatters neighbours: more than [`SCATTERED_SHARE`] of the neighbour pairs of
+/// every 61st row lie more than [`NEAR_FACES`] faces apart. Ordering costs about 20 bytes a face at
+/// the stage's peak and the serial breadth-first pass; it pays only where the face order is poor.
+/// Measured share beyond 4,096 faces: the dragon's scan order 31 % (its filter 0.15 → 0.07–0.10 s at
+/// two threads with the order), the 4:1 subdivisions of the scaling benchmark 9 % at 136k faces, 5 %
+/// at 546k, 3 % at 2.18M (their filter no faster with the order, and the 2.18M bake's peak
+/// 542 → 591–608 MB).
+fn scattered(rows: &[[u32; 3]]) -> bool {
+    let padding = rows.len() as u32;
+    let (mut far, mut pairs) = (0usize, 0usize);
+    for (f, row) in rows.iter().enumerate().step_by(61) {
+        for &g in row.iter().filter(|&&g| g != padding) {
+            pairs += 1;
+            far += usize::from((g as usize).abs_diff(f) > NEAR_FACES);
+        }
+    }
+    far as f64 > SCATTERED_SHARE * pairs as f64
+}
+
+/// See [`scattered`]: 4,096 faces are 64 KB of the filter's 16-byte vectors.
+const NEAR_FACES: usize = 4096;
+
+/// See [`scattered`].
+const SCATTERED_SHARE: f64 = 0.15;
 
 /// A breadth-first order of the faces over packed rows: each connected piece from its lowest face,
 /// pieces in the order of their lowest faces. Serial, and linear in the faces; neighbours are visited
@@ -607,8 +636,10 @@ mod tests {
             let topology = shuffled_grid(side, seed);
             let geometry = FaceGeometry::compute(&topology);
             for weighting in [Weighting::ScaleDependent, Weighting::Area, Weighting::Uniform] {
-                let adjacency = FaceAdjacency::build_in(&topology, &geometry, Neighborhood::Edge, weighting, true);
-                let reference = FaceAdjacency::build_in(&topology, &geometry, Neighborhood::Edge, weighting, false);
+                let adjacency =
+                    FaceAdjacency::build_in(&topology, &geometry, Neighborhood::Edge, weighting, Some(true));
+                let reference =
+                    FaceAdjacency::build_in(&topology, &geometry, Neighborhood::Edge, weighting, Some(false));
                 assert!(adjacency.order.face.iter().enumerate().any(|(i, &f)| i != f as usize), "not reordered");
                 if weighting == Weighting::ScaleDependent {
                     let Rows::Packed { dampings, .. } = &adjacency.rows else { unreachable!() };
@@ -633,6 +664,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `scattered` on rows whose neighbours lie close, far, or are padding.
+    #[test]
+    fn scattered_tells_near_rows_from_far_ones() {
+        let n = 200_000u32;
+        let near: Vec<[u32; 3]> =
+            (0..n).map(|f| [f.saturating_sub(1), (f + 1).min(n - 1), (f + 300).min(n - 1)]).collect();
+        assert!(!scattered(&near));
+        // One neighbour in three far away: a third of the pairs, above the share.
+        let far: Vec<[u32; 3]> = (0..n).map(|f| [f.saturating_sub(1), (f + 1).min(n - 1), (f + n / 2) % n]).collect();
+        assert!(scattered(&far));
+        // One in ten far: below it.
+        let some: Vec<[u32; 3]> = (0..n)
+            .map(|f| [f.saturating_sub(1), if f % 10 == 0 { (f + n / 2) % n } else { n }, (f + 1).min(n - 1)])
+            .collect();
+        assert!(!scattered(&some));
+        let padded: Vec<[u32; 3]> = (0..n).map(|_| [n; 3]).collect();
+        assert!(!scattered(&padded));
     }
 
     /// Every face appears once in the order, and each piece's faces are contiguous.
