@@ -6,8 +6,9 @@
 //! them. Edge neighbourhoods (at most three neighbours per face: only manifold edges count) are stored as
 //! three padded face ids per face (plus three dampings only if some pair is damped); anything else as
 //! CSR. The low-pass is memory-bound, so bytes per face and where they lie are what set its speed:
-//! packed rows are stored and iterated in a breadth-first order of the faces, which keeps every row's
-//! neighbours close to it in memory (see [`FaceAdjacency`]).
+//! where a large mesh's face order scatters neighbours, its packed rows are stored and iterated in a
+//! breadth-first order of the faces, which keeps every row's neighbours close to it in memory (see
+//! [`FaceAdjacency`]).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -224,7 +225,6 @@ impl FaceAdjacency {
             None => {
                 let (rows, reference_length) = build_general(topology, geometry, neighborhood, weighting);
                 let weights = geometry.areas.par_iter().with_min_len(FACE_CHUNK).map(|&a| face_weight(a)).collect();
-
                 FaceAdjacency { weights, rows, order: SweepOrder::default(), reference_length }
             }
         }
@@ -356,7 +356,7 @@ const SWEEP_ORDER_MIN_FACES: usize = 1 << 16;
 /// Measured share beyond 4,096 faces: the dragon's scan order 31 % (its filter 0.15 → 0.07–0.10 s at
 /// two threads with the order), the 4:1 subdivisions of the scaling benchmark 9 % at 136k faces, 5 %
 /// at 546k, 3 % at 2.18M (their filter no faster with the order, and the 2.18M bake's peak
-/// 542 → 591–608 MB).
+/// 542 → 592 MB with the order alone).
 fn scattered(rows: &[[u32; 3]]) -> bool {
     let padding = rows.len() as u32;
     let (mut far, mut pairs) = (0usize, 0usize);
