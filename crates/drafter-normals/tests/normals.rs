@@ -545,3 +545,166 @@ fn low_pass_matches_a_reference_jacobi() {
         }
     }
 }
+
+/// A small deterministic generator (SplitMix64) for the random meshes below.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// A random height field with holes, fins on random edges (non-manifold), a separate fan touching
+/// one grid vertex (a bowtie vertex), split and shuffled input vertices and shuffled faces; no
+/// degenerate face.
+fn random_relief(seed: u64) -> Mesh {
+    let mut rng = Rng(seed);
+    let side = 3 + rng.below(10) as u32;
+    let height = rng.unit() * 1.5;
+    let mut positions: Vec<Vec3> = (0..side * side)
+        .map(|i| Vec3::new((i % side) as f32, (i / side) as f32, (rng.unit() - 0.5) * height))
+        .collect();
+    let mut triangles = Vec::new();
+    for y in 0..side - 1 {
+        for x in 0..side - 1 {
+            let v = y * side + x;
+            for t in [[v, v + 1, v + side + 1], [v, v + side + 1, v + side]] {
+                if rng.below(10) != 0 {
+                    triangles.push(t);
+                }
+            }
+        }
+    }
+    // Fins: a third face on a random grid edge.
+    for _ in 0..rng.below(4) {
+        let Some(&[a, b, _]) = triangles.get(rng.below(triangles.len().max(1) as u64) as usize) else { break };
+        let apex = (positions[a as usize] + positions[b as usize]) * 0.5 + Vec3::new(0.1, -0.2, 0.7 + rng.unit());
+        positions.push(apex);
+        triangles.push([a, b, positions.len() as u32 - 1]);
+    }
+    // A bowtie: a closed fan of its own around a copy of a grid vertex's position (welded to it).
+    let centre = positions[rng.below(u64::from(side * side)) as usize];
+    let first = positions.len() as u32;
+    positions.push(centre);
+    let ring = 3 + rng.below(4) as u32;
+    for k in 0..ring {
+        let angle = k as f32 / ring as f32 * std::f32::consts::TAU;
+        positions.push(centre + Vec3::new(0.3 * angle.cos(), 0.3 * angle.sin(), 0.5 + 0.2 * rng.unit()));
+    }
+    for k in 0..ring {
+        triangles.push([first, first + 1 + k, first + 1 + (k + 1) % ring]);
+    }
+    // Split some input vertices (the copies weld back) and shuffle the faces.
+    for t in triangles.iter_mut() {
+        for v in t.iter_mut() {
+            if rng.below(4) == 0 {
+                positions.push(positions[*v as usize]);
+                *v = positions.len() as u32 - 1;
+            }
+        }
+    }
+    for i in (1..triangles.len()).rev() {
+        triangles.swap(i, rng.below(i as u64 + 1) as usize);
+    }
+    mesh(&format!("relief {seed}"), positions, triangles)
+}
+
+/// The layout's grouping rule, written out directly for meshes without degenerate faces: around each
+/// welded vertex, faces joined through edges at the vertex with exactly two faces whose normals are
+/// within the crease angle; groups in order of their first face, corners ascending, the source the
+/// lowest input vertex of the group.
+fn reference_groups(mesh: &Mesh, topology: &Topology, normals: &[Vec3], crease_deg: f32) -> Vec<(u32, u32, Vec<u32>)> {
+    let cos_crease = (crease_deg as f64).to_radians().cos() as f32;
+    let mut groups = Vec::new();
+    for v in 0..topology.welded_positions.len() {
+        let faces = topology.faces_of_vertex(v);
+        let mut label: Vec<usize> = (0..faces.len()).collect();
+        // Relabel to the smallest label until nothing changes: connected components, independently
+        // of the library's union-find.
+        loop {
+            let mut changed = false;
+            for (e, &[a, b]) in topology.edges.iter().enumerate() {
+                if a as usize != v && b as usize != v {
+                    continue;
+                }
+                let [f, g] = match topology.faces_of_edge(e) {
+                    &[f, g] => [f, g],
+                    _ => continue,
+                };
+                if normals[f as usize].dot(normals[g as usize]) < cos_crease {
+                    continue;
+                }
+                let i = faces.binary_search(&f).expect("a face of an edge at v is a face of v");
+                let j = faces.binary_search(&g).expect("a face of an edge at v is a face of v");
+                let low = label[i].min(label[j]);
+                if label[i] != low || label[j] != low {
+                    (label[i], label[j]) = (low, low);
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        let mut roots: Vec<usize> = label.clone();
+        roots.sort_unstable();
+        roots.dedup();
+        for root in roots {
+            let mut corners = Vec::new();
+            let mut source = u32::MAX;
+            for (i, &f) in faces.iter().enumerate() {
+                if label[i] != root {
+                    continue;
+                }
+                let k = topology.faces[f as usize].iter().position(|&w| w as usize == v).expect("a face of v holds v");
+                corners.push(f * 3 + k as u32);
+                source = source.min(mesh.triangles[f as usize][k]);
+            }
+            groups.push((v as u32, source, corners));
+        }
+    }
+    groups
+}
+
+#[test]
+fn layout_matches_the_grouping_rule_on_random_reliefs() {
+    let mut splits = 0;
+    for seed in 0..300u64 {
+        let relief = random_relief(seed);
+        let crease = [0.0, 10.0, 30.0, 60.0, 120.0, 180.0][seed as usize % 6];
+        let options = NormalsOptions {
+            crease: CreaseOptions { crease_angle_deg: crease, ..Default::default() },
+            ..Default::default()
+        };
+        let topology = Topology::build(&relief, Weld::Exact);
+        let result = compute_normals(&relief, &topology, &options).0;
+        assert_eq!(result.report.degenerate_faces, 0, "{}", relief.name);
+        let expected = reference_groups(&relief, &topology, &result.faces.geometry.normals, crease);
+        let layout = &result.layout;
+        assert_eq!(layout.vertex_count(), expected.len(), "{}, crease {crease}", relief.name);
+        for (v, (welded, source, corners)) in expected.iter().enumerate() {
+            assert_eq!(layout.welded_vertex[v], *welded, "{} vertex {v}", relief.name);
+            assert_eq!(layout.source_vertex[v], *source, "{} vertex {v}", relief.name);
+            assert_eq!(layout.corners_of(v), corners.as_slice(), "{} vertex {v}", relief.name);
+            for &c in corners {
+                assert_eq!(layout.triangles[c as usize / 3][c as usize % 3], v as u32);
+            }
+        }
+        splits += result.report.split_vertices;
+    }
+    // The sample holds both kinds of vertex: one smooth fan, and several groups.
+    assert!(splits > 1000, "only {splits} split vertices over the sample");
+}
