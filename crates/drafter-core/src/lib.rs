@@ -40,8 +40,8 @@ pub use topology::{DEFAULT_SNAP_FRACTION, EDGE_NONE, Topology, Weld, robust_diag
 /// Asks the CPU to start loading the cache line that holds `item`, so that a loop overlaps the
 /// memory latency of data it will read soon with its work on the current data. A hint only: no
 /// effect on results, and nothing on targets without one. Hand-written because std has no safe
-/// prefetch; the workspace's only prefetch, used by the topology's walk and the silhouette
-/// queries' block streams.
+/// prefetch; the workspace's only prefetch (the topology's walk, the normals' vertex layout and
+/// sweep order, [`gather`], the silhouette queries' block streams).
 #[inline(always)]
 #[allow(unsafe_code)]
 pub fn prefetch<T>(item: &T) {
@@ -66,6 +66,30 @@ pub fn filled_in_parallel<T: Copy + Send + Sync>(len: usize, value: T) -> Vec<T>
     (0..len).into_par_iter().map(|_| value).collect_into_vec(&mut items);
     items
 }
+
+/// `items[order[k]]` for every `k`, on the thread pool, each read prefetched [`GATHER_AHEAD`]
+/// items ahead: where `order` scatters its reads over arrays far larger than the cache, every
+/// read is a miss, and the prefetches keep several in flight. Panics where `order` holds an index
+/// out of `items`.
+pub fn gather<T: Copy + Send + Sync>(items: &[T], order: &[u32]) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut out = Vec::new();
+    order
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .map(|(k, &i)| {
+            if let Some(&ahead) = order.get(k + GATHER_AHEAD) {
+                prefetch(&items[ahead as usize]);
+            }
+            items[i as usize]
+        })
+        .collect_into_vec(&mut out);
+    out
+}
+
+/// How many items ahead [`gather`] prefetches.
+const GATHER_AHEAD: usize = 16;
 
 /// The slices `items[r]` for every range `r` of `ranges`, as mutable slices that can go to
 /// different threads; `None` unless the ranges are in increasing order, disjoint and within
@@ -147,6 +171,24 @@ mod tests {
         let r = |start: usize, end: usize| start..end;
         for bad in [vec![r(3, 5), r(0, 2)], vec![r(0, 5), r(4, 6)], vec![r(8, 11)], vec![r(5, 4)]] {
             assert!(super::disjoint_slices_mut(&mut items, &bad).is_none(), "{bad:?}");
+        }
+    }
+
+    /// The prefetched gather is the plain one: empty, shorter and longer than the prefetch
+    /// distance, with repeats, over chunk boundaries of the thread pool.
+    #[test]
+    fn gather_is_the_indexed_map() {
+        let items: Vec<[u32; 3]> = (0..50_000u32).map(|i| [i, i.wrapping_mul(2_654_435_761), !i]).collect();
+        let mut state = 7u64;
+        for len in [0usize, 1, 15, 16, 17, 4095, 4097, 100_000] {
+            let order: Vec<u32> = (0..len)
+                .map(|_| {
+                    state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                    (state >> 33) as u32 % items.len() as u32
+                })
+                .collect();
+            let expected: Vec<[u32; 3]> = order.iter().map(|&i| items[i as usize]).collect();
+            assert_eq!(super::gather(&items, &order), expected, "length {len}");
         }
     }
 }

@@ -515,8 +515,8 @@ impl ConeBvh {
         };
         // The candidates in tree order, so that every node's bounds read one contiguous range
         // (gathering through `order` per node and level missed the cache on every candidate).
-        let (tree_points, tree_unit): (Vec<Vec3>, Vec<[DVec3; 2]>) =
-            tree.order.par_iter().map(|&i| (points[i as usize], unit[i as usize])).unzip();
+        let (tree_points, tree_unit) =
+            (drafter_core::gather(points, &tree.order), drafter_core::gather(&unit, &tree.order));
         drop(unit);
         let range = |start: u32, end: u32| start as usize..end as usize;
         // Boxes bottom-up: a leaf's from its points, an inner node's the union of its children's

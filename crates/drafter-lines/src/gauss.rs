@@ -626,7 +626,7 @@ impl ArcCells {
 
     /// The cells `by_id` ([`ArcCells::by_candidate`]) in storage order `order`.
     fn new(base: BaseSolid, bins: Bins, by_id: &[(u32, u8, bool)], order: &[u32]) -> Self {
-        ArcCells { base, bins, cells: order.par_iter().map(|&i| by_id[i as usize]).collect() }
+        ArcCells { base, bins, cells: drafter_core::gather(by_id, order) }
     }
 
     /// The paths [`arc_paths`] gives for `unit` (the arcs in this order) at `level` and bin radius

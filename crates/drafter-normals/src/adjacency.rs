@@ -204,7 +204,7 @@ impl FaceAdjacency {
                         }
                     },
                 );
-                let dampings = if damped { gather(&distances, &order.face) } else { Vec::new() };
+                let dampings = if damped { drafter_core::gather(&distances, &order.face) } else { Vec::new() };
                 drop(distances);
                 let padding = neighbors.len() as u32;
                 let mut rows = Vec::new();
@@ -410,13 +410,6 @@ fn breadth_first_order(rows: &[[u32; 3]]) -> SweepOrder {
 /// temporary example: 60–71 ms for the order with a separate visited array and no prefetch, 22–26 ms
 /// with the position array as the visited flag and this prefetch.
 const BFS_PREFETCH_AHEAD: usize = 8;
-
-/// `items[order[i]]` for every `i`.
-fn gather<T: Copy + Send + Sync>(items: &[T], order: &[u32]) -> Vec<T> {
-    let mut out = Vec::new();
-    order.par_iter().with_min_len(FACE_CHUNK).map(|&f| items[f as usize]).collect_into_vec(&mut out);
-    out
-}
 
 /// How many rows (or entries) the median of [`Weighting::ScaleDependent`] samples, evenly strided.
 const SAMPLE_SIZE: usize = 1 << 16;
