@@ -1407,9 +1407,9 @@ fn left_of(bounds: &DualBox, c: f32, a: usize, bin: usize) -> bool {
 /// profile of the dragon's whole bake). The lanes are clamped to the bins as floats, NaN to 0
 /// (on x86-64 the vector maximum returns its second operand there; the test
 /// `bins_of_is_bin_of_on_each_axis` holds NaN lanes to the rule), so each conversion is a 32-bit
-/// one rather than `as usize`'s longer 64-bit sequence. With [`left_of`] in the partition,
-/// the dragon's dual-space trees took 147–175 ms instead of 164–194 (temporary timers, bakes
-/// alternating with the build before).
+/// one rather than `as usize`'s longer 64-bit sequence. With [`left_of`] in the partition, the
+/// dragon's dual-space trees took 147–175 ms (one run 202) instead of 164–194 (temporary timers,
+/// bakes alternating with the build before).
 #[inline(always)]
 fn bins_of(bounds: &DualBox, c: [f32; 4]) -> [usize; 4] {
     let lo = Vec4::from_array(bounds[0]);
