@@ -191,6 +191,9 @@ const PREFETCH_LINES: usize = 8;
 /// How many blocks ahead of the one being tested [`Stream::perspective`] prefetches.
 const PREFETCH_BLOCKS: usize = 8;
 
+/// Quads (16 bytes) per block of a cone BVH's [`Stream`].
+const BLOCK_QUADS: usize = 10;
+
 /// How many cache lines ahead of the block being tested [`OrthoBlocks::test_ranges`] requests.
 const STREAM_AHEAD_LINES: usize = 48;
 
@@ -537,9 +540,111 @@ impl Quantized {
 /// candidate indices stored as `f32` bits (moved, never computed with). A leaf's candidates thus
 /// sit in a few cache lines and take one SIMD pass per block. Unused lanes have zero normals,
 /// which never pass the predicate, and index 0.
+///
+/// A stream built for queries ([`Stream::from_ranges`]) also holds the same blocks in 16 bits
+/// ([`FixedBlock`], half the bytes), which a leaf's test reads first (see
+/// [`Stream::perspective_leaf`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Stream {
     quads: Vec<[f32; 4]>,
+    /// Block for block the same candidates as `quads` (empty where the pretest is not compiled,
+    /// or for a stream built block by block).
+    fixed: Vec<FixedBlock>,
+}
+
+/// A block of the perspective pretest: per lane, each face normal `n` as `round(S·n)` (`S` =
+/// [`FixedBlock::SCALE`]) and its plane's offset from the leaf's anchor `p₀`, `h = n·(v − p₀)`,
+/// as `round(S·h/R)` (`R` the leaf's reach, `|v − p₀| ≤ R`), so that one `pmaddwd` pairs
+/// `(x, y)` with the view's `(u_x, u_y)` and another `(z, h)` with `(u_z, −c)`; then the candidate
+/// indices. 80 bytes where the `f32` block has 160: the walk's block tests read half the bytes,
+/// and do integer multiply-adds instead of subtractions and products in `f32` (an earlier copy
+/// with 16-bit points, decoded to `f32`, was slower than the `f32` blocks; docs/bench.md).
+///
+/// # Why a decided lane is exact
+///
+/// For an eye `e` with `w₀ = e − p₀`, `u = w₀/|w₀|` and `c = R/|w₀| ≤ 1`, the predicate's value
+/// is `n·(e − v) = n·w₀ − h = |w₀|·(n·u − c·h/R)`, and the integers give
+/// `D = n_q·u_q − h_q·c_q ≈ S²·(n·u − c·h/R)` with every factor rounded to the nearest integer
+/// (`u_q = round(S·u)`, `c_q = round(S·c)`). The roundings move `D` by at most
+/// `(√3/2)(|u_q| + S|n|) ≤ 1.7407·S + 0.75` (as in [`Quantized`], `|n| ≤ 1.01`) plus
+/// `½c_q + ½S·|h|/R + ¼ ≤ 1.005·S + 0.25`: 87,863 in all. The brute force's `f32` value of
+/// `n·(e − v)` errs by at most `4.01·2⁻²⁴·|n|·|e − v|` (a rounded subtraction per coordinate,
+/// then a 3-term dot product), and `|e − v| ≤ |w₀| + R ≤ 2|w₀|`: at most 496 in units of `D`.
+/// So where `|D| > T` = [`FixedBlock::SURE`] `= 90,000`, the brute force's value is non-zero
+/// with the sign of `D`.
+///
+/// A block with a lane that is not decided on both normals is tested again in `f32` (the result
+/// of [`Stream::perspective`]): 0.4 % of the blocks a dragon view tests (214 of 54,149 on average
+/// over 300 eyes), since the candidates a walk reaches lie near the silhouette. A leaf the eye is
+/// within `R` of, or with a non-finite point, is tested in `f32` alone. Normals that are not
+/// finite, longer than 1.01, or whose components all round to zero are stored as zero with a
+/// zero offset, so `D = 0` and their block always takes the exact path. Unused lanes store the
+/// same normal twice, so they are decided equal or sent to the exact path, which rejects them.
+/// The answer is therefore identical to the brute force's, bit for bit. The test
+/// `leaf_test_matches_predicate_near_the_planes` fails with `T` at 30,000 (and passes at 45,000:
+/// the bound is for the worst case).
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct FixedBlock {
+    /// `(x₁, y₁)`, `(z₁, h₁)`, `(x₂, y₂)`, `(z₂, h₂)` pairs, lane after lane.
+    rows: [Lanes; 4],
+    ids: [u32; 4],
+}
+
+impl FixedBlock {
+    /// `S`: as [`Quantized::SCALE`], so that `|D| ≤ 2.07·10⁹` stays within `i32`.
+    const SCALE: f64 = 32000.0;
+    /// `T` (see the type's docs).
+    const SURE: i32 = 90_000;
+
+    /// The blocks of candidates `ids` around the anchor `p0`, and the leaf's reach `R` (`NaN`
+    /// where a point is not finite: such a leaf is always tested in `f32`).
+    fn leaf(ids: &[u32], p0: Vec3, normals: &[[Vec3; 2]], points: &[Vec3], out: &mut Vec<FixedBlock>) -> f32 {
+        let anchor = p0.as_dvec3();
+        let mut reach_squared = 0f64;
+        for &i in ids {
+            let d = points[i as usize].as_dvec3() - anchor;
+            reach_squared = if d.is_finite() { reach_squared.max(d.length_squared()) } else { f64::NAN };
+            if reach_squared.is_nan() {
+                break;
+            }
+        }
+        // Rounded up, with room for the offsets' own rounding: |h| ≤ |n|·R.
+        let reach = {
+            let r = reach_squared.sqrt() * (1.0 + 1e-12);
+            let y = r as f32;
+            if f64::from(y) < r { y.next_up() } else { y }
+        };
+        let r = f64::from(reach);
+        let lane = |n: Vec3, d: glam::DVec3| -> ([i16; 3], i16) {
+            let q = Quantized::quantize(n);
+            if q == [0; 3] || r == 0.0 || r.is_nan() {
+                return (q, 0);
+            }
+            (q, (Self::SCALE * n.as_dvec3().dot(d) / r).round() as i16)
+        };
+        // Unused lanes: the same normal twice (see the type's docs).
+        let unused = ([Self::SCALE as i16, 0, 0], 0);
+        for chunk in ids.chunks(4) {
+            let mut block = FixedBlock::default();
+            for l in 0..4 {
+                let (([x1, y1, z1], h1), ([x2, y2, z2], h2)) = match chunk.get(l) {
+                    Some(&i) => {
+                        let [n1, n2] = normals[i as usize];
+                        let d = points[i as usize].as_dvec3() - anchor;
+                        block.ids[l] = i;
+                        (lane(n1, d), lane(n2, d))
+                    }
+                    None => (unused, unused),
+                };
+                for (row, pair) in block.rows.iter_mut().zip([[x1, y1], [z1, h1], [x2, y2], [z2, h2]]) {
+                    row.0[2 * l..2 * l + 2].copy_from_slice(&pair);
+                }
+            }
+            out.push(block);
+        }
+        reach
+    }
 }
 
 impl Stream {
@@ -554,29 +659,43 @@ impl Stream {
     }
 
     /// The blocks of each of `ranges` of `ids`, one range after the other (what
-    /// [`Stream::push_blocks`] gives range by range), built on the thread pool; also each
-    /// range's first quad and block count.
+    /// [`Stream::push_blocks`] gives range by range), with their 16-bit copy around each range's
+    /// anchor in `anchors`, built on the thread pool; also each range's first quad and block
+    /// count, and its reach from its anchor (see [`FixedBlock`]; 0 where no copy is built).
     pub fn from_ranges(
         ranges: &[(usize, usize)],
+        anchors: &[Vec3],
         ids: &[u32],
         normals: &[[Vec3; 2]],
         points: &[Vec3],
-    ) -> (Self, Vec<(u32, u32)>) {
+    ) -> (Self, Vec<(u32, u32)>, Vec<f32>) {
         let at = Self::layout(ranges);
-        let quads = at.last().map_or(0, |&(q, b)| q as usize + 10 * b as usize);
-        let parts: Vec<Stream> = ranges
+        let quads = at.last().map_or(0, |&(q, b)| q as usize + BLOCK_QUADS * b as usize);
+        let parts: Vec<(Stream, f32)> = ranges
             .par_iter()
-            .map(|&(start, end)| {
+            .zip(anchors)
+            .map(|(&(start, end), &p0)| {
                 let mut part = Stream::new();
                 part.push_blocks(&ids[start..end], normals, points);
-                part
+                let reach = if cfg!(target_arch = "x86_64") {
+                    FixedBlock::leaf(&ids[start..end], p0, normals, points, &mut part.fixed)
+                } else {
+                    0.0
+                };
+                (part, reach)
             })
             .collect();
-        let mut stream = Stream { quads: Vec::with_capacity(quads) };
-        for part in parts {
-            stream.quads.extend_from_slice(&part.quads);
+        let mut stream = Stream { quads: Vec::with_capacity(quads), fixed: Vec::new() };
+        if cfg!(target_arch = "x86_64") {
+            stream.fixed.reserve_exact(quads / BLOCK_QUADS);
         }
-        (stream, at)
+        let mut reaches = Vec::with_capacity(ranges.len());
+        for (part, reach) in parts {
+            stream.quads.extend_from_slice(&part.quads);
+            stream.fixed.extend_from_slice(&part.fixed);
+            reaches.push(reach);
+        }
+        (stream, at, reaches)
     }
 
     /// Where [`Stream::from_ranges`] puts each range: its first quad and its number of blocks.
@@ -586,15 +705,16 @@ impl Stream {
         for &(start, end) in ranges {
             let blocks = (end - start).div_ceil(4);
             at.push((quads as u32, blocks as u32));
-            quads += 10 * blocks;
+            quads += BLOCK_QUADS * blocks;
         }
         at
     }
 
-    /// Appends candidates `ids` as whole blocks; returns the number of blocks.
+    /// Appends candidates `ids` as whole blocks (without their 16-bit copy); returns the number
+    /// of blocks.
     pub fn push_blocks(&mut self, ids: &[u32], normals: &[[Vec3; 2]], points: &[Vec3]) -> u32 {
         for chunk in ids.chunks(4) {
-            let mut rows = [[0f32; 4]; 10];
+            let mut rows = [[0f32; 4]; BLOCK_QUADS];
             let mut slots = [0u32; 4];
             for (lane, &i) in chunk.iter().enumerate() {
                 let [n1, n2] = normals[i as usize];
@@ -613,46 +733,164 @@ impl Stream {
         ids.len().div_ceil(4) as u32
     }
 
-    /// Starts loading the first cache lines of `count` blocks at quad `q` (see [`prefetch`]).
+    /// Starts loading the first cache lines of `count` blocks at quad `q` (see [`prefetch`]): of
+    /// the 16-bit copy where there is one.
     #[inline(always)]
     pub fn prefetch(&self, q: usize, count: u32) {
-        if let Some(range) = self.quads.get(q..q + count as usize * 10) {
+        let b = q / BLOCK_QUADS;
+        if let Some(blocks) = self.fixed.get(b..b + count as usize) {
+            // 80-byte blocks: each block's start and its indices (64 bytes in) cover its lines.
+            for block in blocks.iter().take(PREFETCH_LINES * 4 / 5) {
+                drafter_core::prefetch(&block.rows[0]);
+                drafter_core::prefetch(&block.ids);
+            }
+        } else if let Some(range) = self.quads.get(q..q + count as usize * BLOCK_QUADS) {
             prefetch(range, PREFETCH_LINES);
         }
     }
 
-    /// Perspective predicate over `count` blocks starting at quad `q` (blocks with points).
+    /// Perspective predicate over `count` blocks starting at quad `q` (blocks with points), in
+    /// `f32`: the brute force's arithmetic.
     #[inline]
     pub fn perspective(&self, q: usize, count: u32, e: Vec3, out: &mut [u64]) {
         let (ex, ey, ez) = (Vec4::splat(e.x), Vec4::splat(e.y), Vec4::splat(e.z));
-        let Some(all) = self.quads.get(q..q + count as usize * 10) else { return };
-        for (k, r) in all.chunks_exact(10).enumerate() {
+        let Some(all) = self.quads.get(q..q + count as usize * BLOCK_QUADS) else { return };
+        for (k, r) in all.as_chunks::<BLOCK_QUADS>().0.iter().enumerate() {
             // A block is 2.5 cache lines; blocks with points stream slower than the hardware
             // prefetcher follows them (see `prefetch`).
-            let ahead = q + (k + PREFETCH_BLOCKS) * 10;
-            if let Some(next) = self.quads.get(ahead..ahead + 10) {
+            let ahead = q + (k + PREFETCH_BLOCKS) * BLOCK_QUADS;
+            if let Some(next) = self.quads.get(ahead..ahead + BLOCK_QUADS) {
                 prefetch(next, 3);
             }
-            let (wx, wy, wz) = (ex - Vec4::from(r[6]), ey - Vec4::from(r[7]), ez - Vec4::from(r[8]));
-            let a = Vec4::from(r[0]) * wx + Vec4::from(r[1]) * wy + Vec4::from(r[2]) * wz;
-            let c = Vec4::from(r[3]) * wx + Vec4::from(r[4]) * wy + Vec4::from(r[5]) * wz;
-            emit_block(a, c, r[9], out);
+            emit_mask(perspective_mask(r, ex, ey, ez), r[9].map(f32::to_bits), out);
+        }
+    }
+
+    /// [`Stream::perspective`] over a leaf's blocks whose anchor is `p0` and reach `reach` (as
+    /// [`Stream::from_ranges`] gave it): through the 16-bit pretest where there is one and the
+    /// eye is farther than the reach from the anchor (see [`FixedBlock`]). Same answer.
+    ///
+    /// Blocks whose pretest leaves a lane open get their decided lanes' hits now, and their first
+    /// quad in `pending`: [`Stream::perspective_pending`] tests them in `f32` later, together, so
+    /// that their loads overlap.
+    #[inline]
+    pub fn perspective_leaf(
+        &self,
+        q: usize,
+        count: u32,
+        (p0, reach): (Vec3, f32),
+        e: Vec3,
+        out: &mut [u64],
+        pending: &mut Vec<u32>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let b = q / BLOCK_QUADS;
+            let w = e.as_dvec3() - p0.as_dvec3();
+            let len = w.length();
+            let r = f64::from(reach);
+            if let Some(blocks) = self.fixed.get(b..b + count as usize)
+                && len.is_finite()
+                && r <= len
+                && len > 0.0
+            {
+                let u = w / len;
+                let q16 = |x: f64| (FixedBlock::SCALE * x).round() as i16;
+                let view = [q16(u.x), q16(u.y), q16(u.z), -q16(r / len)];
+                #[allow(unsafe_code)]
+                // SAFETY: SSE2 is part of the x86_64 baseline, so the feature the kernel is
+                // compiled with is present on every machine this code runs on.
+                unsafe {
+                    self.perspective_fixed_sse2(blocks, q, view, out, pending)
+                };
+                return;
+            }
+        }
+        let _ = (p0, reach, &pending);
+        self.perspective(q, count, e, out);
+    }
+
+    /// The 16-bit pretest on `blocks` (the blocks from quad `q` on), the view as
+    /// `[u_x, u_y, u_z, −c]` rounded (see [`FixedBlock`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse2")]
+    fn perspective_fixed_sse2(
+        &self,
+        blocks: &[FixedBlock],
+        q: usize,
+        [ux, uy, uz, c]: [i16; 4],
+        out: &mut [u64],
+        pending: &mut Vec<u32>,
+    ) {
+        use std::arch::x86_64::*;
+        let load = |v: &Lanes| {
+            let [a, b, c, d, e, f, g, h] = v.0;
+            _mm_setr_epi16(a, b, c, d, e, f, g, h)
+        };
+        let uxy = _mm_setr_epi16(ux, uy, ux, uy, ux, uy, ux, uy);
+        let uzc = _mm_setr_epi16(uz, c, uz, c, uz, c, uz, c);
+        // |d| ≤ T as one unsigned compare, as in `Quantized`.
+        let shift = _mm_set1_epi32(FixedBlock::SURE);
+        let flip = _mm_set1_epi32(i32::MIN);
+        let limit = _mm_set1_epi32((2 * FixedBlock::SURE + 1) ^ i32::MIN);
+        let undecided_lanes = |d: __m128i| _mm_cmpgt_epi32(limit, _mm_xor_si128(_mm_add_epi32(d, shift), flip));
+        for (k, block) in blocks.iter().enumerate() {
+            if let Some(next) = blocks.get(k + PREFETCH_BLOCKS) {
+                drafter_core::prefetch(&next.rows[0]);
+                drafter_core::prefetch(&next.ids);
+            }
+            let [xy1, zh1, xy2, zh2] = block.rows.each_ref().map(load);
+            let d1 = _mm_add_epi32(_mm_madd_epi16(xy1, uxy), _mm_madd_epi16(zh1, uzc));
+            let d2 = _mm_add_epi32(_mm_madd_epi16(xy2, uxy), _mm_madd_epi16(zh2, uzc));
+            let open = _mm_movemask_ps(_mm_castsi128_ps(_mm_or_si128(undecided_lanes(d1), undecided_lanes(d2))));
+            let mask = (_mm_movemask_ps(_mm_castsi128_ps(_mm_xor_si128(d1, d2))) & !open) as u32;
+            if open != 0 {
+                pending.push((q + k * BLOCK_QUADS) as u32);
+            }
+            emit_mask(mask, block.ids, out);
         }
     }
 }
 
-/// The tie rule on 4 lanes, then the hits' candidates (indices stored as bits in `slots`).
+impl Stream {
+    /// The `f32` test of the blocks at the quads `pending` (see [`Stream::perspective_leaf`]), their
+    /// data requested first so that the misses overlap. ORing in each block's whole mask is enough:
+    /// its decided lanes agree with it.
+    pub fn perspective_pending(&self, pending: &[u32], e: Vec3, out: &mut [u64]) {
+        for &q in pending {
+            if let Some(r) = self.quads.get(q as usize..q as usize + BLOCK_QUADS) {
+                prefetch(r, 3);
+            }
+        }
+        let (ex, ey, ez) = (Vec4::splat(e.x), Vec4::splat(e.y), Vec4::splat(e.z));
+        for &q in pending {
+            if let Some(r) = self.quads.get(q as usize..q as usize + BLOCK_QUADS).and_then(|r| r.as_array()) {
+                emit_mask(perspective_mask(r, ex, ey, ez), r[9].map(f32::to_bits), out);
+            }
+        }
+    }
+}
+
+/// The perspective predicate on the 4 lanes of a block (see [`Stream`]), as a 4-bit mask.
 #[inline(always)]
-fn emit_block(a: Vec4, c: Vec4, slots: [f32; 4], out: &mut [u64]) {
+fn perspective_mask(r: &[[f32; 4]; BLOCK_QUADS], ex: Vec4, ey: Vec4, ez: Vec4) -> u32 {
+    let (wx, wy, wz) = (ex - Vec4::from(r[6]), ey - Vec4::from(r[7]), ez - Vec4::from(r[8]));
+    let a = Vec4::from(r[0]) * wx + Vec4::from(r[1]) * wy + Vec4::from(r[2]) * wz;
+    let c = Vec4::from(r[3]) * wx + Vec4::from(r[4]) * wy + Vec4::from(r[5]) * wz;
     let hit = (a.cmplt(Vec4::ZERO) & c.cmpgt(Vec4::ZERO)) | (a.cmpgt(Vec4::ZERO) & c.cmplt(Vec4::ZERO));
-    let mask = hit.bitmask();
+    hit.bitmask()
+}
+
+/// Sets the bits of a block's hits (`mask`) at their candidates `slots`.
+#[inline(always)]
+fn emit_mask(mask: u32, slots: [u32; 4], out: &mut [u64]) {
     if mask == 0 {
         return;
     }
     // Branch-free within a block: every lane ORs its bit (0 for a miss; padding lanes point at
     // candidate 0 and never hit), cheaper than mispredicting per hit.
-    for (lane, slot) in slots.iter().enumerate() {
-        let i = slot.to_bits() as usize;
+    for (lane, &i) in slots.iter().enumerate() {
+        let i = i as usize;
         if let Some(w) = out.get_mut(i / 64) {
             *w |= u64::from((mask >> lane) & 1) << (i % 64);
         }
@@ -810,6 +1048,78 @@ mod tests {
             assert!(words.iter().enumerate().all(|(w, &x)| x == 0 || dirty.contains(&(w as u32))));
         }
         assert!(checked > 40_000);
+    }
+
+    /// A cone BVH leaf's test (the 16-bit pretest on x86-64, then the pending blocks in `f32`)
+    /// against the scalar predicate: normals placed at distances from the plane through the eye
+    /// around the pretest's threshold (`|D| ≤ T`, about 8.8·10⁻⁵ of the eye's distance), exactly
+    /// on it, and normals the pretest must refuse (too long, too short, NaN, zero); leaves far
+    /// from the origin (10⁶), small and large, eyes near and far (some within the leaf's reach,
+    /// which the pretest leaves to `f32`), a leaf with a non-finite point.
+    #[test]
+    fn leaf_test_matches_predicate_near_the_planes() {
+        let mut r = rng(0xface);
+        let offsets = [0.0, 1e-9, 1e-7, 1e-6, 1e-5, 5e-5, 8e-5, 8.8e-5, 9e-5, 1e-4, 3e-4, 1e-3, 0.3];
+        let (mut checked, mut pretested, mut pending_blocks) = (0usize, 0usize, 0usize);
+        for trial in 0..300 {
+            let centre = Vec3::new(r(), r(), r()) * if trial % 3 == 0 { 1e6 } else { 10.0 };
+            let size = 10f32.powf(r() * 3.0);
+            let distance = size * 10f32.powf(r() * 2.0 + 0.5) * if trial % 7 == 0 { 0.1 } else { 1.0 };
+            let eye = centre + Vec3::new(r(), r(), r()).normalize_or(Vec3::X) * distance;
+            let n = 64 + ((r() * 0.5 + 0.5) * 200.0) as usize;
+            let mut points: Vec<Vec3> = (0..n).map(|_| centre + Vec3::new(r(), r(), r()) * size).collect();
+            if trial % 11 == 5 {
+                points[n / 2].y = f32::NAN;
+            }
+            let normal = |v: Vec3, r: &mut dyn FnMut() -> f32| -> Vec3 {
+                let w = (eye - v).normalize_or(Vec3::Z);
+                let side = Quat::from_axis_angle(w, r() * std::f32::consts::PI) * w.any_orthonormal_vector();
+                let k = ((r() * 0.5 + 0.5) * 16.0) as usize;
+                match k {
+                    0..=12 => {
+                        let e: f32 = offsets[k] * if r() < 0.0 { -1.0 } else { 1.0 };
+                        side * (1.0 - e * e).sqrt() + w * e
+                    }
+                    13 => (side + w * r() * 1e-4) * [1.01, 1.02, 1e-6][((r() * 0.5 + 0.5) * 2.99) as usize],
+                    _ => [Vec3::ZERO, Vec3::NAN, Vec3::new(r(), r(), r())][((r() * 0.5 + 0.5) * 2.99) as usize],
+                }
+            };
+            let normals: Vec<[Vec3; 2]> = points.iter().map(|&v| [normal(v, &mut r), normal(v, &mut r)]).collect();
+            // Up to three leaves, each anchored at the centre of its points' box.
+            let ids: Vec<u32> = (0..n as u32).rev().collect();
+            let cut = |r: &mut dyn FnMut() -> f32| ((r() * 0.5 + 0.5) * n as f32) as usize;
+            let (a, b) = (cut(&mut r), cut(&mut r));
+            let ranges = [(0, a.min(b)), (a.min(b), a.max(b)), (a.max(b), n)];
+            let anchors: Vec<Vec3> = ranges
+                .iter()
+                .map(|&(s, e)| {
+                    let (lo, hi) = ids[s..e].iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+                        (lo.min(points[i as usize]), hi.max(points[i as usize]))
+                    });
+                    (lo + hi) * 0.5
+                })
+                .collect();
+            let (stream, at, reaches) = Stream::from_ranges(&ranges, &anchors, &ids, &normals, &points);
+            let mut words = vec![0u64; n.div_ceil(64)];
+            let mut pending = Vec::new();
+            for (k, &(q, count)) in at.iter().enumerate() {
+                let far = (eye.as_dvec3() - anchors[k].as_dvec3()).length() >= f64::from(reaches[k]);
+                pretested += usize::from(cfg!(target_arch = "x86_64") && far && count > 0);
+                stream.perspective_leaf(q as usize, count, (anchors[k], reaches[k]), eye, &mut words, &mut pending);
+            }
+            pending_blocks += pending.len();
+            stream.perspective_pending(&pending, eye, &mut words);
+            for (i, [n1, n2]) in normals.iter().enumerate() {
+                let got = words[i / 64] >> (i % 64) & 1 == 1;
+                let expected = is_silhouette_perspective(*n1, *n2, points[i], eye);
+                assert_eq!(got, expected, "trial {trial}, candidate {i}: {n1} {n2} at {} eye {eye}", points[i]);
+                checked += 1;
+            }
+        }
+        assert!(checked > 40_000);
+        if cfg!(target_arch = "x86_64") {
+            assert!(pretested > 300 && pending_blocks > 1000, "{pretested} leaves pretested, {pending_blocks} pending");
+        }
     }
 
     #[test]

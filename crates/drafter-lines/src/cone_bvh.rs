@@ -65,8 +65,10 @@
 //! has both `f32` values strictly of one sign and the predicate rejects it. NaN or infinite values
 //! (eyes at infinity, overflow of `|w|²`) fail the comparisons and the node is entered; nodes
 //! whose cone reaches 90° or that hold a zero normal are never culled. Entered leaves are tested
-//! in blocks of 4 with the brute-force arithmetic (`w = e − v`, same operations, same order):
-//! results are bit-identical to [`crate::BruteForce`].
+//! in blocks of 4, first by a 16-bit pretest with a proven error bound that decides a lane only
+//! where the sign is certain, then, for blocks with an undecided lane, with the brute-force
+//! arithmetic (`w = e − v`, same operations, same order; see `brute::FixedBlock`): results are
+//! bit-identical to [`crate::BruteForce`].
 //!
 //! # How deep
 //!
@@ -87,7 +89,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::Stream;
 use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
-use crate::tree::{Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels};
+use crate::tree::{
+    Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_pending,
+};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cone's half-angle.
@@ -223,7 +227,8 @@ struct BvhNode {
     anchor_sin: Vec4,
     /// Cone axis x, y, z and `cos α`.
     axis_cos: Vec4,
-    /// `h_lo`, `h_hi`, reach, 0 (see [`PlaneBound`]).
+    /// `h_lo`, `h_hi`, reach (see [`PlaneBound`]), and the reach of the own candidates' points
+    /// from the anchor for the stream's 16-bit pretest (see [`Stream::perspective_leaf`]).
     offsets: Vec4,
     first_child: u32,
     child_count: u32,
@@ -250,9 +255,12 @@ fn assemble(
     candidates: Option<(&[[Vec3; 2]], &[Vec3])>,
 ) -> Assembled {
     let ranges: Vec<(usize, usize)> = flat.iter().map(|&[_, _, start, end]| (start as usize, end as usize)).collect();
-    let (stream, at) = match candidates {
-        Some((normals, points)) => Stream::from_ranges(&ranges, order, normals, points),
-        None => (Stream::new(), Stream::layout(&ranges)),
+    let (stream, at, reaches) = match candidates {
+        Some((normals, points)) => {
+            let anchors: Vec<Vec3> = boxes.iter().map(anchor).collect();
+            Stream::from_ranges(&ranges, &anchors, order, normals, points)
+        }
+        None => (Stream::new(), Stream::layout(&ranges), vec![0.0; ranges.len()]),
     };
     let mut nodes: Vec<BvhNode> = flat
         .iter()
@@ -263,7 +271,7 @@ fn assemble(
             BvhNode {
                 anchor_sin: p0.extend(c[3]),
                 axis_cos: Vec4::new(c[0], c[1], c[2], cos),
-                offsets: Vec4::new(lo, hi, reach, 0.0),
+                offsets: Vec4::new(lo, hi, reach, reaches[i]),
                 first_child,
                 child_count,
                 quad,
@@ -703,42 +711,48 @@ impl ConeBvh {
             return counts;
         }
         let words = out.words_mut();
-        with_levels(self.widest + 4, |level, next| {
-            level[0] = 0;
-            let mut width = 1;
-            counts.bounds_tested = usize::from(COUNT);
-            while width > 0 {
-                let mut next_width = 0;
-                for &i in &level[..width] {
-                    let n = &self.nodes[i as usize];
-                    let (first, end) = (n.first_child as usize, (n.first_child + n.child_count) as usize);
-                    push_children(next, &mut next_width, first, end, |f| !self.culls4(f, eye));
-                    if COUNT {
-                        counts.nodes_entered += 1;
-                        counts.bounds_tested += end - first;
-                    }
-                }
-                for (j, &i) in level[..width].iter().enumerate() {
-                    // Start loading a later leaf while this one is tested (see `brute::prefetch`).
-                    if TEST && let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
-                        let a = &self.nodes[ahead as usize];
-                        self.stream.prefetch(a.quad as usize, a.blocks);
-                    }
-                    let n = &self.nodes[i as usize];
-                    if n.blocks > 0 {
-                        if TEST {
-                            self.stream.perspective(n.quad as usize, n.blocks, eye, words);
-                        }
+        with_pending(|pending| {
+            with_levels(self.widest + 4, |level, next| {
+                level[0] = 0;
+                let mut width = 1;
+                counts.bounds_tested = usize::from(COUNT);
+                while width > 0 {
+                    let mut next_width = 0;
+                    for &i in &level[..width] {
+                        let n = &self.nodes[i as usize];
+                        let (first, end) = (n.first_child as usize, (n.first_child + n.child_count) as usize);
+                        push_children(next, &mut next_width, first, end, |f| !self.culls4(f, eye));
                         if COUNT {
-                            let [_, _, start, end] = self.flat[i as usize];
-                            counts.ranges += 1;
-                            counts.blocks_tested += n.blocks as usize;
-                            counts.arcs_tested += (end - start) as usize;
+                            counts.nodes_entered += 1;
+                            counts.bounds_tested += end - first;
                         }
                     }
+                    for (j, &i) in level[..width].iter().enumerate() {
+                        // Start loading a later leaf while this one is tested (see `brute::prefetch`).
+                        if TEST && let Some(&ahead) = level[..width].get(j + PREFETCH_AHEAD) {
+                            let a = &self.nodes[ahead as usize];
+                            self.stream.prefetch(a.quad as usize, a.blocks);
+                        }
+                        let n = &self.nodes[i as usize];
+                        if n.blocks > 0 {
+                            if TEST {
+                                let frame = (n.anchor_sin.truncate(), n.offsets.w);
+                                self.stream.perspective_leaf(n.quad as usize, n.blocks, frame, eye, words, pending);
+                            }
+                            if COUNT {
+                                let [_, _, start, end] = self.flat[i as usize];
+                                counts.ranges += 1;
+                                counts.blocks_tested += n.blocks as usize;
+                                counts.arcs_tested += (end - start) as usize;
+                            }
+                        }
+                    }
+                    std::mem::swap(level, next);
+                    width = next_width;
                 }
-                std::mem::swap(level, next);
-                width = next_width;
+            });
+            if TEST {
+                self.stream.perspective_pending(pending, eye, words);
             }
         });
         counts

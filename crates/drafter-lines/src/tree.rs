@@ -65,6 +65,23 @@ pub(crate) fn with_ranges<R>(walk: impl FnOnce(&mut Vec<[u32; 2]>) -> R) -> R {
     })
 }
 
+thread_local! {
+    /// The blocks a perspective walk tests again in `f32` (reused between queries).
+    static PENDING: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Runs `walk` with an empty list for the blocks a cone BVH's walk tests again in `f32` (see
+/// `Stream::perspective_leaf`), reusing this thread's allocation.
+pub(crate) fn with_pending<R>(walk: impl FnOnce(&mut Vec<u32>) -> R) -> R {
+    PENDING.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut pending) => {
+            pending.clear();
+            walk(&mut pending)
+        }
+        Err(_) => walk(&mut Vec::new()),
+    })
+}
+
 /// Appends to `next[*width..]` those of the children `first..end` whose bit is set in
 /// `mask4(f)`, the 4-lane mask of children `f..f + 4` (lanes past `end` are ignored): the step
 /// both hierarchy walks take from one level to the next, branch-free per child.
