@@ -599,7 +599,7 @@ impl FixedBlock {
 
     /// The blocks of candidates `ids` around the anchor `p0`, and the leaf's reach `R` (`NaN`
     /// where a point is not finite: such a leaf is always tested in `f32`).
-    fn leaf(ids: &[u32], p0: Vec3, normals: &[[Vec3; 2]], points: &[Vec3], out: &mut Vec<FixedBlock>) -> f32 {
+    fn leaf(ids: &[u32], p0: Vec3, normals: &[[Vec3; 2]], points: &[Vec3], out: &mut [FixedBlock]) -> f32 {
         let anchor = p0.as_dvec3();
         let mut reach_squared = 0f64;
         for &i in ids {
@@ -625,8 +625,7 @@ impl FixedBlock {
         };
         // Unused lanes: the same normal twice (see the type's docs).
         let unused = ([Self::SCALE as i16, 0, 0], 0);
-        for chunk in ids.chunks(4) {
-            let mut block = FixedBlock::default();
+        for (chunk, block) in ids.chunks(4).zip(out) {
             for l in 0..4 {
                 let (([x1, y1, z1], h1), ([x2, y2, z2], h2)) = match chunk.get(l) {
                     Some(&i) => {
@@ -641,7 +640,6 @@ impl FixedBlock {
                     row.0[2 * l..2 * l + 2].copy_from_slice(&pair);
                 }
             }
-            out.push(block);
         }
         reach
     }
@@ -670,32 +668,34 @@ impl Stream {
         points: &[Vec3],
     ) -> (Self, Vec<(u32, u32)>, Vec<f32>) {
         let at = Self::layout(ranges);
-        let quads = at.last().map_or(0, |&(q, b)| q as usize + BLOCK_QUADS * b as usize);
-        let parts: Vec<(Stream, f32)> = ranges
-            .par_iter()
+        let blocks = at.last().map_or(0, |&(q, b)| q as usize / BLOCK_QUADS + b as usize);
+        // Filled in place, range by range on the pool: no second copy at the peak.
+        let mut quads = vec![[0f32; 4]; BLOCK_QUADS * blocks];
+        let mut fixed = if cfg!(target_arch = "x86_64") {
+            drafter_core::filled_in_parallel(blocks, FixedBlock::default())
+        } else {
+            Vec::new()
+        };
+        let per_block = usize::from(!fixed.is_empty());
+        let mut jobs = Vec::with_capacity(ranges.len());
+        let (mut quads_left, mut fixed_left) = (&mut quads[..], &mut fixed[..]);
+        for (&range, &(_, count)) in ranges.iter().zip(&at) {
+            let count = count as usize;
+            let (q, rest) = std::mem::take(&mut quads_left).split_at_mut(BLOCK_QUADS * count);
+            quads_left = rest;
+            let (f, rest) = std::mem::take(&mut fixed_left).split_at_mut(per_block * count);
+            fixed_left = rest;
+            jobs.push((range, q, f));
+        }
+        let reaches: Vec<f32> = jobs
+            .into_par_iter()
             .zip(anchors)
-            .map(|(&(start, end), &p0)| {
-                let mut part = Stream::new();
-                part.push_blocks(&ids[start..end], normals, points);
-                let reach = if cfg!(target_arch = "x86_64") {
-                    FixedBlock::leaf(&ids[start..end], p0, normals, points, &mut part.fixed)
-                } else {
-                    0.0
-                };
-                (part, reach)
+            .map(|(((start, end), q, f), &p0)| {
+                write_blocks(&ids[start..end], normals, points, q);
+                if f.is_empty() { 0.0 } else { FixedBlock::leaf(&ids[start..end], p0, normals, points, f) }
             })
             .collect();
-        let mut stream = Stream { quads: Vec::with_capacity(quads), fixed: Vec::new() };
-        if cfg!(target_arch = "x86_64") {
-            stream.fixed.reserve_exact(quads / BLOCK_QUADS);
-        }
-        let mut reaches = Vec::with_capacity(ranges.len());
-        for (part, reach) in parts {
-            stream.quads.extend_from_slice(&part.quads);
-            stream.fixed.extend_from_slice(&part.fixed);
-            reaches.push(reach);
-        }
-        (stream, at, reaches)
+        (Stream { quads, fixed }, at, reaches)
     }
 
     /// Where [`Stream::from_ranges`] puts each range: its first quad and its number of blocks.
@@ -712,25 +712,13 @@ impl Stream {
 
     /// Appends candidates `ids` as whole blocks (without their 16-bit copy); returns the number
     /// of blocks.
+    #[cfg(test)]
     pub fn push_blocks(&mut self, ids: &[u32], normals: &[[Vec3; 2]], points: &[Vec3]) -> u32 {
-        for chunk in ids.chunks(4) {
-            let mut rows = [[0f32; 4]; BLOCK_QUADS];
-            let mut slots = [0u32; 4];
-            for (lane, &i) in chunk.iter().enumerate() {
-                let [n1, n2] = normals[i as usize];
-                for (r, x) in [n1.x, n1.y, n1.z, n2.x, n2.y, n2.z].into_iter().enumerate() {
-                    rows[r][lane] = x;
-                }
-                let p = points[i as usize];
-                rows[6][lane] = p.x;
-                rows[7][lane] = p.y;
-                rows[8][lane] = p.z;
-                slots[lane] = i;
-            }
-            rows[9] = slots.map(f32::from_bits);
-            self.quads.extend_from_slice(&rows);
-        }
-        ids.len().div_ceil(4) as u32
+        let blocks = ids.len().div_ceil(4);
+        let start = self.quads.len();
+        self.quads.resize(start + BLOCK_QUADS * blocks, [0.0; 4]);
+        write_blocks(ids, normals, points, &mut self.quads[start..]);
+        blocks as u32
     }
 
     /// Starts loading the first cache lines of `count` blocks at quad `q` (see [`prefetch`]): of
@@ -868,6 +856,25 @@ impl Stream {
                 emit_mask(perspective_mask(r, ex, ey, ez), r[9].map(f32::to_bits), out);
             }
         }
+    }
+}
+
+/// Writes candidates `ids` as blocks of [`Stream`] into `out` (zeros, one block per 4 candidates).
+fn write_blocks(ids: &[u32], normals: &[[Vec3; 2]], points: &[Vec3], out: &mut [[f32; 4]]) {
+    for (chunk, rows) in ids.chunks(4).zip(out.as_chunks_mut::<BLOCK_QUADS>().0) {
+        let mut slots = [0u32; 4];
+        for (lane, &i) in chunk.iter().enumerate() {
+            let [n1, n2] = normals[i as usize];
+            for (r, x) in [n1.x, n1.y, n1.z, n2.x, n2.y, n2.z].into_iter().enumerate() {
+                rows[r][lane] = x;
+            }
+            let p = points[i as usize];
+            rows[6][lane] = p.x;
+            rows[7][lane] = p.y;
+            rows[8][lane] = p.z;
+            slots[lane] = i;
+        }
+        rows[9] = slots.map(f32::from_bits);
     }
 }
 
