@@ -191,6 +191,26 @@ const PREFETCH_LINES: usize = 8;
 /// How many blocks ahead of the one being tested [`Stream::perspective`] prefetches.
 const PREFETCH_BLOCKS: usize = 8;
 
+/// The fewest candidates for which a cone BVH's [`Stream`] keeps the 16-bit copy of its blocks
+/// ([`FixedBlock`]). The pretest halves the bytes a leaf's test reads, which pays where a view
+/// tests many blocks streamed from beyond the caches, and costs a little where it tests few.
+/// `silhouette_bench`, perspective ns a view without → with the pretest, two interleaved runs
+/// each (2-core Xeon VM, 2026-11-27):
+///
+/// | mesh | candidates | blocks a view | without | with |
+/// |---|---|---|---|---|
+/// | dragon | 1.3M | 54,149 | 734k, 778k | 638k, 626k |
+/// | UV sphere 1400 | 2.0M | 8,260 | 114k, 105k | 96k, 120k |
+/// | UV sphere 1000 | 1.0M | 6,063 | 73.4k, 63.9k | 70.7k, 70.6k |
+/// | UV sphere 700 | 489k | 4,218 | 39.0k, 47.9k | 39.6k, 43.9k |
+/// | bunny | 103k | 6,615 | 61.6k, 61.8k | 49.6k, 63.4k |
+/// | rocker-arm | 29k | 2,884 | 17.5k, 16.6k | 18.0k, 18.3k |
+/// | fandisk | 11.6k | 147 | 1.30k, 1.08k | 1.35k, 1.29k |
+///
+/// So the copy is built for the largest meshes only, where views are likeliest to test many
+/// blocks.
+pub(crate) const PRETEST_MIN_CANDIDATES: usize = 1 << 20;
+
 /// Quads (16 bytes) per block of a cone BVH's [`Stream`].
 const BLOCK_QUADS: usize = 10;
 
@@ -562,16 +582,18 @@ pub(crate) struct Stream {
 ///
 /// # Why a decided lane is exact
 ///
-/// For an eye `e` with `w₀ = e − p₀`, `u = w₀/|w₀|` and `c = R/|w₀| ≤ 1`, the predicate's value
-/// is `n·(e − v) = n·w₀ − h = |w₀|·(n·u − c·h/R)`, and the integers give
-/// `D = n_q·u_q − h_q·c_q ≈ S²·(n·u − c·h/R)` with every factor rounded to the nearest integer
-/// (`u_q = round(S·u)`, `c_q = round(S·c)`). The roundings move `D` by at most
-/// `(√3/2)(|u_q| + S|n|) ≤ 1.7407·S + 0.75` (as in [`Quantized`], `|n| ≤ 1.01`) plus
-/// `½c_q + ½S·|h|/R + ¼ ≤ 1.005·S + 0.25`: 87,863 in all. The brute force's `f32` value of
-/// `n·(e − v)` errs by at most `4.01·2⁻²⁴·|n|·|e − v|` (a rounded subtraction per coordinate,
-/// then a 3-term dot product), and `|e − v| ≤ |w₀| + R ≤ 2|w₀|`: at most 496 in units of `D`.
-/// So where `|D| > T` = [`FixedBlock::SURE`] `= 90,000`, the brute force's value is non-zero
-/// with the sign of `D`.
+/// For an eye `e` with `w₀ = e − p₀`, take any `L` within a factor `1 ± 2⁻¹⁰` of `|w₀|` (the
+/// query uses the reciprocal square root estimate) with `R ≤ L`, and let `u = w₀/L`, `c = R/L
+/// ≤ 1`. The predicate's value is `n·(e − v) = n·w₀ − h = L·(n·u − c·h/R)`, and the integers
+/// give `D = n_q·u_q − h_q·c_q ≈ S²·(n·u − c·h/R)`, a positive multiple of it, with every factor
+/// rounded to the nearest integer (`u_q = round(S·u)`, `c_q = round(S·c)`, each computed in
+/// `f32` from `w₀` rounded once per coordinate: within 0.506 of its target). The roundings move
+/// `D` by at most `(√3/2)·|u_q| + (√3/2)·0.506·S·|n|` = 56,066 (`|u_q| ≤ 1.001·S`, `|n| ≤
+/// 1.01`) plus `½c_q + 0.506·S·|h|/R + ¼` ≤ 32,291: 88,357 in all. The brute force's `f32`
+/// value of `n·(e − v)` errs by at most `4.01·2⁻²⁴·|n|·|e − v|` (a rounded subtraction per
+/// coordinate, then a 3-term dot product), and `|e − v| ≤ |w₀| + R ≤ 2.001·L`: at most 497 in
+/// units of `D`. So where `|D| > T` = [`FixedBlock::SURE`] `= 90,000`, the brute force's value is
+/// non-zero with the sign of `D`.
 ///
 /// A block with a lane that is not decided on both normals is tested again in `f32` (the result
 /// of [`Stream::perspective`]): 0.4 % of the blocks a dragon view tests (214 of 54,149 on average
@@ -581,7 +603,7 @@ pub(crate) struct Stream {
 /// zero offset, so `D = 0` and their block always takes the exact path. Unused lanes store the
 /// same normal twice, so they are decided equal or sent to the exact path, which rejects them.
 /// The answer is therefore identical to the brute force's, bit for bit. The test
-/// `leaf_test_matches_predicate_near_the_planes` fails with `T` at 30,000 (and passes at 45,000:
+/// `leaf_test_matches_predicate_near_the_planes` fails with `T` at 45,000 (and passes at 60,000:
 /// the bound is for the worst case).
 #[repr(C, align(16))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -596,6 +618,14 @@ impl FixedBlock {
     const SCALE: f64 = 32000.0;
     /// `T` (see the type's docs).
     const SURE: i32 = 90_000;
+
+    /// `x` rounded to the nearest integer, ties away from zero, for `|x| ≤ 32767`. `f64::round` is
+    /// a library call without SSE4.1, and a conversion truncates: so ½ is added with the value's
+    /// sign first (exact at these magnitudes).
+    #[inline(always)]
+    fn nearest(x: f64) -> i16 {
+        (x + 0.5f64.copysign(x)) as i16
+    }
 
     /// The blocks of candidates `ids` around the anchor `p0`, and the leaf's reach `R` (`NaN`
     /// where a point is not finite: such a leaf is always tested in `f32`).
@@ -621,7 +651,7 @@ impl FixedBlock {
             if q == [0; 3] || r == 0.0 || r.is_nan() {
                 return (q, 0);
             }
-            (q, (Self::SCALE * n.as_dvec3().dot(d) / r).round() as i16)
+            (q, Self::nearest(Self::SCALE * n.as_dvec3().dot(d) / r))
         };
         // Unused lanes: the same normal twice (see the type's docs).
         let unused = ([Self::SCALE as i16, 0, 0], 0);
@@ -658,20 +688,21 @@ impl Stream {
 
     /// The blocks of each of `ranges` of `ids`, one range after the other (what
     /// [`Stream::push_blocks`] gives range by range), with their 16-bit copy around each range's
-    /// anchor in `anchors`, built on the thread pool; also each range's first quad and block
-    /// count, and its reach from its anchor (see [`FixedBlock`]; 0 where no copy is built).
+    /// anchor in `anchors` where `pretest` asks for it, built on the thread pool; also each
+    /// range's first quad and block count, and its reach from its anchor (see [`FixedBlock`]; 0
+    /// where no copy is built).
     pub fn from_ranges(
         ranges: &[(usize, usize)],
         anchors: &[Vec3],
         ids: &[u32],
-        normals: &[[Vec3; 2]],
-        points: &[Vec3],
+        (normals, points): (&[[Vec3; 2]], &[Vec3]),
+        pretest: bool,
     ) -> (Self, Vec<(u32, u32)>, Vec<f32>) {
         let at = Self::layout(ranges);
         let blocks = at.last().map_or(0, |&(q, b)| q as usize / BLOCK_QUADS + b as usize);
         // Filled in place, range by range on the pool: no second copy at the peak.
         let mut quads = vec![[0f32; 4]; BLOCK_QUADS * blocks];
-        let mut fixed = if cfg!(target_arch = "x86_64") {
+        let mut fixed = if pretest && cfg!(target_arch = "x86_64") {
             drafter_core::filled_in_parallel(blocks, FixedBlock::default())
         } else {
             Vec::new()
@@ -774,23 +805,12 @@ impl Stream {
         #[cfg(target_arch = "x86_64")]
         {
             let b = q / BLOCK_QUADS;
-            let w = e.as_dvec3() - p0.as_dvec3();
-            let len = w.length();
-            let r = f64::from(reach);
+            #[allow(unsafe_code)]
             if let Some(blocks) = self.fixed.get(b..b + count as usize)
-                && len.is_finite()
-                && r <= len
-                && len > 0.0
-            {
-                let u = w / len;
-                let q16 = |x: f64| (FixedBlock::SCALE * x).round() as i16;
-                let view = [q16(u.x), q16(u.y), q16(u.z), -q16(r / len)];
-                #[allow(unsafe_code)]
                 // SAFETY: SSE2 is part of the x86_64 baseline, so the feature the kernel is
                 // compiled with is present on every machine this code runs on.
-                unsafe {
-                    self.perspective_fixed_sse2(blocks, q, view, out, pending)
-                };
+                && unsafe { self.perspective_fixed_sse2(blocks, q, (p0, reach), e, out, pending) }
+            {
                 return;
             }
         }
@@ -798,25 +818,45 @@ impl Stream {
         self.perspective(q, count, e, out);
     }
 
-    /// The 16-bit pretest on `blocks` (the blocks from quad `q` on), the view as
-    /// `[u_x, u_y, u_z, −c]` rounded (see [`FixedBlock`]).
+    /// The 16-bit pretest on `blocks` (the blocks from quad `q` on) of a leaf with anchor `p0`
+    /// and reach `reach`, for the eye `e` (see [`FixedBlock`]); `false`, having done nothing,
+    /// where the eye is within the reach (or the distance is not a normal `f32`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "sse2")]
     fn perspective_fixed_sse2(
         &self,
         blocks: &[FixedBlock],
         q: usize,
-        [ux, uy, uz, c]: [i16; 4],
+        (p0, reach): (Vec3, f32),
+        e: Vec3,
         out: &mut [u64],
         pending: &mut Vec<u32>,
-    ) {
+    ) -> bool {
         use std::arch::x86_64::*;
+        // The view: `w₀ = e − p₀` (each coordinate rounded once) times `S·r`, `r` ≈ 1/|w₀| from
+        // the reciprocal square root estimate: any `r` within 2⁻¹⁰ of it keeps the bound (see
+        // `FixedBlock`), so no square root or division sits between the leaves.
+        let w = e - p0;
+        let len2 = w.length_squared();
+        if len2.is_nan() || len2.is_infinite() || len2 < f32::MIN_POSITIVE {
+            return false;
+        }
+        let r = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(len2)));
+        if reach.is_nan() || reach * r > 1.0 {
+            return false;
+        }
+        let v = _mm_mul_ps(_mm_setr_ps(w.x, w.y, w.z, -reach), _mm_set1_ps(FixedBlock::SCALE as f32 * r));
+        // To the nearest integer, ties away from zero: ±½ (exact below 2¹⁵), then truncation.
+        let half = _mm_or_ps(_mm_and_ps(v, _mm_set1_ps(-0.0)), _mm_set1_ps(0.5));
+        let view = _mm_cvttps_epi32(_mm_add_ps(v, half));
+        // 16-bit lanes u_x, u_y, u_z, −c: pairs (u_x, u_y) and (u_z, −c) repeated.
+        let view = _mm_packs_epi32(view, view);
+        let uxy = _mm_shuffle_epi32::<0b00_00_00_00>(view);
+        let uzc = _mm_shuffle_epi32::<0b01_01_01_01>(view);
         let load = |v: &Lanes| {
             let [a, b, c, d, e, f, g, h] = v.0;
             _mm_setr_epi16(a, b, c, d, e, f, g, h)
         };
-        let uxy = _mm_setr_epi16(ux, uy, ux, uy, ux, uy, ux, uy);
-        let uzc = _mm_setr_epi16(uz, c, uz, c, uz, c, uz, c);
         // |d| ≤ T as one unsigned compare, as in `Quantized`.
         let shift = _mm_set1_epi32(FixedBlock::SURE);
         let flip = _mm_set1_epi32(i32::MIN);
@@ -837,6 +877,7 @@ impl Stream {
             }
             emit_mask(mask, block.ids, out);
         }
+        true
     }
 }
 
@@ -1106,7 +1147,7 @@ mod tests {
                     (lo + hi) * 0.5
                 })
                 .collect();
-            let (stream, at, reaches) = Stream::from_ranges(&ranges, &anchors, &ids, &normals, &points);
+            let (stream, at, reaches) = Stream::from_ranges(&ranges, &anchors, &ids, (&normals, &points), true);
             let mut words = vec![0u64; n.div_ceil(64)];
             let mut pending = Vec::new();
             for (k, &(q, count)) in at.iter().enumerate() {

@@ -87,7 +87,7 @@ use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::brute::Stream;
+use crate::brute::{PRETEST_MIN_CANDIDATES, Stream};
 use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
 use crate::tree::{
     Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_pending,
@@ -258,7 +258,7 @@ fn assemble(
     let (stream, at, reaches) = match candidates {
         Some((normals, points)) => {
             let anchors: Vec<Vec3> = boxes.iter().map(anchor).collect();
-            Stream::from_ranges(&ranges, &anchors, order, normals, points)
+            Stream::from_ranges(&ranges, &anchors, order, (normals, points), order.len() >= PRETEST_MIN_CANDIDATES)
         }
         None => (Stream::new(), Stream::layout(&ranges), vec![0.0; ranges.len()]),
     };
