@@ -211,6 +211,21 @@ const PREFETCH_BLOCKS: usize = 8;
 /// blocks.
 pub(crate) const PRETEST_MIN_CANDIDATES: usize = 1 << 20;
 
+#[cfg(test)]
+thread_local! {
+    /// Builds the 16-bit copy whatever the size (tests of the whole walk on small meshes).
+    pub(crate) static FORCE_PRETEST: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether a cone BVH over `candidates` keeps the 16-bit copy (see [`PRETEST_MIN_CANDIDATES`]).
+pub(crate) fn keeps_pretest(candidates: usize) -> bool {
+    #[cfg(test)]
+    if FORCE_PRETEST.with(std::cell::Cell::get) {
+        return true;
+    }
+    candidates >= PRETEST_MIN_CANDIDATES
+}
+
 /// Quads (16 bytes) per block of a cone BVH's [`Stream`].
 const BLOCK_QUADS: usize = 10;
 
@@ -678,6 +693,12 @@ impl FixedBlock {
 impl Stream {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Whether the stream has no 16-bit copy.
+    #[cfg(test)]
+    pub fn fixed_is_empty(&self) -> bool {
+        self.fixed.is_empty()
     }
 
     /// Length in quads.

@@ -87,7 +87,7 @@ use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::brute::{PRETEST_MIN_CANDIDATES, Stream};
+use crate::brute::{Stream, keeps_pretest};
 use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
 use crate::tree::{
     Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_pending,
@@ -258,7 +258,7 @@ fn assemble(
     let (stream, at, reaches) = match candidates {
         Some((normals, points)) => {
             let anchors: Vec<Vec3> = boxes.iter().map(anchor).collect();
-            Stream::from_ranges(&ranges, &anchors, order, (normals, points), order.len() >= PRETEST_MIN_CANDIDATES)
+            Stream::from_ranges(&ranges, &anchors, order, (normals, points), keeps_pretest(order.len()))
         }
         None => (Stream::new(), Stream::layout(&ranges), vec![0.0; ranges.len()]),
     };
@@ -1831,6 +1831,38 @@ mod tests {
             entered += counted.nodes_entered;
         }
         assert!(entered > 500, "the walks entered {entered} nodes");
+    }
+
+    /// Queries through the 16-bit pretest (forced on for this small tree) give the brute force's
+    /// answer, from eyes far away, near, and within leaves' reach (where the pretest leaves the
+    /// leaf to `f32`); the normals are close to radial, so many are close to tangent to a view.
+    #[test]
+    fn pretest_queries_match_brute_force() {
+        let mut rng = crate::measure::ViewRng::new(7);
+        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction() * 3.0 + Vec3::new(1e4, 0.0, 0.0)).collect();
+        let normals: Vec<[Vec3; 2]> = points
+            .iter()
+            .map(|&p| {
+                let n = (p - Vec3::new(1e4, 0.0, 0.0)).normalize();
+                [(n + rng.direction() * 0.05).normalize(), (n + rng.direction() * 0.05).normalize()]
+            })
+            .collect();
+        crate::brute::FORCE_PRETEST.with(|f| f.set(true));
+        let bvh = ConeBvh::build(&normals, &points, &ConeBvhOptions::default(), &CostModel::default());
+        crate::brute::FORCE_PRETEST.with(|f| f.set(false));
+        assert!(!bvh.stream.fixed_is_empty());
+        let brute = crate::BruteForce::new(&normals, &points);
+        let (mut got, mut expected) = (EdgeSet::default(), EdgeSet::default());
+        let mut silhouettes = 0;
+        for k in 0..2000 {
+            let distance = [3.01, 3.5, 6.0, 30.0, 3000.0][k % 5];
+            let eye = Vec3::new(1e4, 0.0, 0.0) + rng.direction() * distance;
+            bvh.query(eye, &mut got);
+            brute.query(crate::View::Perspective { eye }, &mut expected);
+            assert_eq!(got.to_vec(), expected.to_vec(), "eye {eye}");
+            silhouettes += expected.to_vec().len();
+        }
+        assert!(silhouettes > 100_000, "{silhouettes} silhouettes");
     }
 
     /// The corner test agrees with dense sampling of the box and the cone.
