@@ -707,8 +707,8 @@ impl Stream {
         self.quads.len()
     }
 
-    /// The blocks of each of `ranges` of `ids`, one range after the other (what
-    /// [`Stream::push_blocks`] gives range by range), with their 16-bit copy around each range's
+    /// The blocks of each of `ranges` of `ids`, one range after the other (each range padded to
+    /// whole blocks), with their 16-bit copy around each range's
     /// anchor in `anchors` where `pretest` asks for it, built on the thread pool; also each
     /// range's first quad and block count, and its reach from its anchor (see [`FixedBlock`]; 0
     /// where no copy is built).

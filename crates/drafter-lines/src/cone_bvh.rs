@@ -182,7 +182,7 @@ pub struct ConeBvhArrays {
     /// The leaf size the binary tree was cut at ([`ConeBvhOptions::leaf_size`]).
     pub leaf_size: u32,
     /// One byte per inner node of each dual-space tree, in preorder: `axis · 32 + bin`, the split
-    /// between bins `bin − 1` and `bin` of [`DUAL_BINS`] on that axis, or [`MEDIAN_SPLIT`].
+    /// between bins `bin − 1` and `bin` of `DUAL_BINS` (32) on that axis, or `MEDIAN_SPLIT`.
     pub splits: Vec<u8>,
     /// Where each dual-space tree's bytes start in `splits`, one per tree in the order the normal
     /// split emits them.
@@ -316,7 +316,7 @@ fn box_culls(b: &[f32; 6], c: &[f32; 4], e: Vec3) -> bool {
 /// Relative margin of the plane-offset test (see the module docs).
 pub const PLANE_MARGIN: f32 = 1e-5;
 
-/// Weight of the normal against the plane offset in the dual space of [`dual_node`], in
+/// Weight of the normal against the plane offset in the dual space of `dual_node`, in
 /// half-diagonals of the bounding box. Over a box of dual points, `n̂·(e − v)` for an eye at
 /// distance `D` from the centre in direction `u` varies by `D·Σ|u_i|·Δn_i + Δh`, and `|u_i|`
 /// averages ½: so the normal's extents count about `D/2`, and the sampled eyes lie 1.2 to 4
