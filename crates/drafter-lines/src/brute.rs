@@ -423,8 +423,17 @@ struct Quantized {
     blocks: Vec<Lanes>,
 }
 
+/// `round(scale·n)` per coordinate, or zero for a normal that is not finite or longer than 1.01
+/// (what the 16-bit pretests send to their exact path).
+fn quantize_normal(n: Vec3, scale: f32) -> [i16; 3] {
+    if !n.is_finite() || n.length() > 1.01 {
+        return [0; 3];
+    }
+    let q = |x: f32| (x * scale).round() as i16;
+    [q(n.x), q(n.y), q(n.z)]
+}
+
 /// One SSE register's worth of `i16`, aligned so that it loads in one instruction.
-#[cfg(target_arch = "x86_64")]
 #[repr(C, align(16))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Lanes([i16; 8]);
@@ -438,11 +447,7 @@ impl Quantized {
     const SURE: i32 = 57_000;
 
     fn quantize(n: Vec3) -> [i16; 3] {
-        if !n.is_finite() || n.length() > 1.01 {
-            return [0; 3];
-        }
-        let q = |x: f32| (x * Self::SCALE).round() as i16;
-        [q(n.x), q(n.y), q(n.z)]
+        quantize_normal(n, Self::SCALE)
     }
 
     /// From the `f32` blocks (6 quads per block).
@@ -628,8 +633,10 @@ struct FixedBlock {
     ids: [u32; 4],
 }
 
+// Defined on every target (a stream elsewhere holds no copy); built and read on x86_64 only.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 impl FixedBlock {
-    /// `S`: as [`Quantized::SCALE`], so that `|D| ≤ 2.07·10⁹` stays within `i32`.
+    /// `S`: as `Quantized::SCALE`, so that `|D| ≤ 2.07·10⁹` stays within `i32`.
     const SCALE: f64 = 32000.0;
     /// `T` (see the type's docs).
     const SURE: i32 = 90_000;
@@ -662,7 +669,7 @@ impl FixedBlock {
         };
         let r = f64::from(reach);
         let lane = |n: Vec3, d: glam::DVec3| -> ([i16; 3], i16) {
-            let q = Quantized::quantize(n);
+            let q = quantize_normal(n, Self::SCALE as f32);
             if q == [0; 3] || r == 0.0 || r.is_nan() {
                 return (q, 0);
             }
