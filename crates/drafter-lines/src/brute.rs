@@ -817,9 +817,9 @@ impl Stream {
     /// [`Stream::from_ranges`] gave it): through the 16-bit pretest where there is one and the
     /// eye is farther than the reach from the anchor (see [`FixedBlock`]). Same answer.
     ///
-    /// Blocks whose pretest leaves a lane open get their decided lanes' hits now, and their first
-    /// quad in `pending`: [`Stream::perspective_pending`] tests them in `f32` later, together, so
-    /// that their loads overlap.
+    /// Blocks whose pretest leaves a lane open get their decided lanes' hits now, and their range
+    /// of quads `[first, end)` in `pending`: [`Stream::perspective_pending`] tests them in `f32`
+    /// later, together, so that their loads overlap.
     #[inline]
     pub fn perspective_leaf(
         &self,
@@ -828,7 +828,7 @@ impl Stream {
         (p0, reach): (Vec3, f32),
         e: Vec3,
         out: &mut [u64],
-        pending: &mut Vec<u32>,
+        pending: &mut Vec<[u32; 2]>,
     ) {
         #[cfg(target_arch = "x86_64")]
         {
@@ -858,7 +858,7 @@ impl Stream {
         (p0, reach): (Vec3, f32),
         e: Vec3,
         out: &mut [u64],
-        pending: &mut Vec<u32>,
+        pending: &mut Vec<[u32; 2]>,
     ) -> bool {
         use std::arch::x86_64::*;
         // The view: `w₀ = e − p₀` (each coordinate rounded once) times `S·r`, `r` ≈ 1/|w₀| from
@@ -901,7 +901,8 @@ impl Stream {
             let open = _mm_movemask_ps(_mm_castsi128_ps(_mm_or_si128(undecided_lanes(d1), undecided_lanes(d2))));
             let mask = (_mm_movemask_ps(_mm_castsi128_ps(_mm_xor_si128(d1, d2))) & !open) as u32;
             if open != 0 {
-                pending.push((q + k * BLOCK_QUADS) as u32);
+                let at = (q + k * BLOCK_QUADS) as u32;
+                pending.push([at, at + BLOCK_QUADS as u32]);
             }
             emit_mask(mask, block.ids, out);
         }
@@ -910,18 +911,18 @@ impl Stream {
 }
 
 impl Stream {
-    /// The `f32` test of the blocks at the quads `pending` (see [`Stream::perspective_leaf`]), their
+    /// The `f32` test of the blocks at the quad ranges `pending` (see [`Stream::perspective_leaf`]), their
     /// data requested first so that the misses overlap. ORing in each block's whole mask is enough:
     /// its decided lanes agree with it.
-    pub fn perspective_pending(&self, pending: &[u32], e: Vec3, out: &mut [u64]) {
-        for &q in pending {
-            if let Some(r) = self.quads.get(q as usize..q as usize + BLOCK_QUADS) {
+    pub fn perspective_pending(&self, pending: &[[u32; 2]], e: Vec3, out: &mut [u64]) {
+        for &[q0, q1] in pending {
+            if let Some(r) = self.quads.get(q0 as usize..q1 as usize) {
                 prefetch(r, 3);
             }
         }
         let (ex, ey, ez) = (Vec4::splat(e.x), Vec4::splat(e.y), Vec4::splat(e.z));
-        for &q in pending {
-            if let Some(r) = self.quads.get(q as usize..q as usize + BLOCK_QUADS).and_then(|r| r.as_array()) {
+        for &[q0, q1] in pending {
+            if let Some(r) = self.quads.get(q0 as usize..q1 as usize).and_then(|r| r.as_array()) {
                 emit_mask(perspective_mask(r, ex, ey, ez), r[9].map(f32::to_bits), out);
             }
         }

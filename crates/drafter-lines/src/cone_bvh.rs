@@ -89,9 +89,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brute::{Stream, keeps_pretest};
 use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
-use crate::tree::{
-    Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_pending,
-};
+use crate::tree::{Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_ranges};
 use crate::{ArraysError, CostModel, EdgeSet};
 
 /// Margin added to the sine of every cone's half-angle.
@@ -711,7 +709,7 @@ impl ConeBvh {
             return counts;
         }
         let words = out.words_mut();
-        with_pending(|pending| {
+        with_ranges(|pending| {
             with_levels(self.widest + 4, |level, next| {
                 level[0] = 0;
                 let mut width = 1;

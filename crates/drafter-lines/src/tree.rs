@@ -49,7 +49,8 @@ pub(crate) fn with_levels<R>(len: usize, walk: impl FnOnce(&mut Vec<u32>, &mut V
 }
 
 thread_local! {
-    /// The block ranges a walk collects before testing them (reused between queries).
+    /// The block ranges a walk collects before testing them, or the blocks a perspective walk
+    /// tests again in `f32` (reused between queries).
     static RANGES: RefCell<Vec<[u32; 2]>> = const { RefCell::new(Vec::new()) };
 }
 
@@ -60,23 +61,6 @@ pub(crate) fn with_ranges<R>(walk: impl FnOnce(&mut Vec<[u32; 2]>) -> R) -> R {
         Ok(mut ranges) => {
             ranges.clear();
             walk(&mut ranges)
-        }
-        Err(_) => walk(&mut Vec::new()),
-    })
-}
-
-thread_local! {
-    /// The blocks a perspective walk tests again in `f32` (reused between queries).
-    static PENDING: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
-}
-
-/// Runs `walk` with an empty list for the blocks a cone BVH's walk tests again in `f32` (see
-/// `Stream::perspective_leaf`), reusing this thread's allocation.
-pub(crate) fn with_pending<R>(walk: impl FnOnce(&mut Vec<u32>) -> R) -> R {
-    PENDING.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut pending) => {
-            pending.clear();
-            walk(&mut pending)
         }
         Err(_) => walk(&mut Vec::new()),
     })
