@@ -22,6 +22,21 @@ use crate::raw::drop_nonfinite_faces;
 pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -> Result<Scene, ImportError> {
     let folder = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ..Default::default() };
+    // tobj reads lines as UTF-8 and fails on any other byte with "read error". CAD tools still
+    // write OBJ comments and group names in an 8-bit code page (`g Gehäuse` in Latin-1), so such a
+    // file is read as Latin-1, byte for character: names keep their letters, numbers are ASCII.
+    let transcoded: String;
+    let bytes = match std::str::from_utf8(bytes) {
+        Ok(_) => bytes,
+        Err(e) => {
+            let line = 1 + bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
+            diagnostics.push(DiagnosticKind::Other, 1, || {
+                format!("line {line}: not UTF-8; the file was read as Latin-1 (ISO 8859-1)")
+            });
+            transcoded = bytes.iter().map(|&b| char::from(b)).collect();
+            transcoded.as_bytes()
+        }
+    };
     let mut reader = std::io::BufReader::new(bytes);
     let (models, materials) =
         tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| load_material_library(&folder, mtl))
@@ -125,6 +140,13 @@ fn locate_error(bytes: &[u8], message: &str) -> ParseError {
                 if !floats_ok(3) {
                     return ParseError::at_line(line_no, format!("{message}: a vertex needs 3 numbers"));
                 }
+                // `x y z`, `x y z w`, or `x y z r g b` (a colour per vertex): tobj takes no other count.
+                if ![3, 4, 6].contains(&rest.len()) {
+                    return ParseError::at_line(
+                        line_no,
+                        format!("{message}: a vertex has 3, 4 or 6 numbers, not {}", rest.len()),
+                    );
+                }
                 positions += 1;
             }
             "vt" => {
@@ -180,6 +202,24 @@ mod tests {
 
     fn import_text(text: &str) -> Result<Scene, ImportError> {
         import(Path::new("test.obj"), text.as_bytes(), &mut Diagnostics::new())
+    }
+
+    #[test]
+    fn latin1_text_is_read_with_a_note() {
+        let mut d = Diagnostics::new();
+        let bytes = b"# Erstellt f\xfcr\nv 0 0 0\nv 1 0 0\nv 0 1 0\ng Geh\xe4use\nf 1 2 3\n";
+        let scene = import(Path::new("l.obj"), bytes, &mut d).unwrap();
+        assert_eq!(scene.instances[0].name, "Geh\u{e4}use");
+        assert_eq!(scene.meshes[0].triangles.len(), 1);
+        let notes = d.into_vec();
+        assert!(notes.iter().any(|n| n.first_example.starts_with("line 1: not UTF-8")), "{notes:?}");
+    }
+
+    #[test]
+    fn a_vertex_with_five_numbers_is_named_by_line() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0 1 1\nf 1 2 3\n";
+        let e = import_text(text).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("3, 4 or 6 numbers, not 5"), "{e}");
     }
 
     #[test]
