@@ -48,10 +48,12 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
     if is_binary(bytes) {
         return read_binary(bytes);
     }
-    if starts_with_solid(bytes) {
-        match read_ascii(bytes) {
+    // Some exporters pad an ASCII file with NUL bytes up to a block size: not part of the text.
+    let text = bytes.iter().rposition(|&b| b != 0).map_or(&bytes[..0], |end| &bytes[..=end]);
+    if starts_with_solid(text) {
+        match read_ascii(text) {
             Ok(mesh) => return Ok(mesh),
-            Err(error) if !looks_binary(bytes) => return Err(error),
+            Err(error) if !looks_binary(text) => return Err(error),
             Err(_) => {} // a binary file whose header starts with "solid" and whose count is wrong
         }
     }
@@ -302,6 +304,15 @@ endsolid two facets\r
         assert!(!is_binary(ASCII.as_bytes()));
         let binary = read(&binary_stl(b"", &TWO_FACETS)).expect("binary STL");
         assert_eq!(mesh, binary);
+    }
+
+    #[test]
+    fn ascii_padded_with_nul_bytes() {
+        for pad in [1, 3, 4096] {
+            let mut bytes = ASCII.as_bytes().to_vec();
+            bytes.resize(bytes.len() + pad, 0);
+            assert_eq!(read(&bytes).expect("padded ASCII STL"), read(ASCII.as_bytes()).expect("ASCII STL"), "{pad}");
+        }
     }
 
     #[test]
