@@ -70,6 +70,44 @@ fn only_regular_files_are_written_and_failed_writes_exit_3() {
     assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// A bake writes its main file, a .gltf's .bin, the report and the textures together: where one
+/// of them cannot be written, the command fails (exit 3, or 2 for a folder named as the report)
+/// and every target is as it was, with no temporary file left.
+#[test]
+fn a_failed_secondary_output_leaves_every_output_as_it_was() {
+    let dir = common::scratch("outputs-together");
+    let gltf = dir.join("a.gltf");
+    let out = common::drafter().arg("bake").arg("-o").arg(&gltf).arg("--quiet").output().expect("runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (before_gltf, before_bin) =
+        (std::fs::read(&gltf).expect("gltf"), std::fs::read(dir.join("a.bin")).expect("bin"));
+    // A different scene into the same .gltf, with a report in a missing folder.
+    let input = common::shared_models().join("obj/common-3d-test-models/fandisk.obj");
+    let report = dir.join("missing").join("r.json");
+    let out = common::drafter()
+        .args(["bake", "--quiet", "--report"])
+        .arg(&report)
+        .arg(&input)
+        .arg("-o")
+        .arg(&gltf)
+        .output()
+        .expect("runs");
+    assert_eq!(code(&out), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read(&gltf).expect("gltf"), before_gltf, "the .gltf changed");
+    assert_eq!(std::fs::read(dir.join("a.bin")).expect("bin"), before_bin, "the .bin changed");
+    // Textures into a path that is a file: nothing written either.
+    let glb = dir.join("b.glb");
+    let out =
+        common::drafter().arg("bake").arg("--textures-out").arg(&gltf).arg("-o").arg(&glb).output().expect("runs");
+    assert_eq!(code(&out), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!glb.exists(), "the .glb was written although the textures were not");
+    // A report path that is a folder is refused before the bake.
+    let out = common::drafter().arg("bake").arg("--report").arg(&dir).arg("-o").arg(&glb).output().expect("runs");
+    assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!glb.exists());
+    assert_eq!(leftovers(&dir), Vec::<String>::new());
+}
+
 fn leftovers(dir: &Path) -> Vec<String> {
     std::fs::read_dir(dir)
         .expect("list")

@@ -66,7 +66,7 @@ pub struct Args {
     /// that plain glTF viewers show the enhancement.
     #[arg(long)]
     pub enhanced_in_normal: bool,
-    /// Worker threads (default: all cores). The output is identical at any count.
+    /// Worker threads, 1 to 1024 (default: all cores). The output is identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
     /// Overwrite the output even when it is the input file (or one of a .gltf input's files).
@@ -97,10 +97,15 @@ pub enum ObbArg {
     Optimal,
 }
 
+/// The largest `--threads` accepted.
+const MAX_THREADS: usize = 1024;
+
 pub fn run(args: Args) -> Result<()> {
     if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(BadInput("--threads must be at least 1".into()).into());
+        // A thread per core is all the bake can use; thousands only cost their start-up (2,000
+        // took 34 s on a 2-core machine) and past that their stacks exhaust memory.
+        if !(1..=MAX_THREADS).contains(&n) {
+            return Err(BadInput(format!("--threads must be between 1 and {MAX_THREADS}, not {n}")).into());
         }
         rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("configuring the thread pool")?;
     }
@@ -153,6 +158,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     config.container = container_for(&output)?;
     check_output(&output, &config.container, args.input.as_deref(), &bytes, args.force)?;
+    if let Some(report) = &args.report {
+        refuse_non_file(report)?;
+    }
 
     progress.step(1, "importing");
     // The input's digest (for the report) beside the import: 9 ms of one core on the dragon's 16 MB.
@@ -177,17 +185,20 @@ pub fn run(args: Args) -> Result<()> {
     })?;
     baked.report.diagnostics.extend(imported.diagnostics.iter().cloned());
 
-    write_outputs(&output, &baked.written, &config.container)?;
-    if let Some(report_path) = &args.report {
-        let json = serde_json::to_vec_pretty(&baked.report)?;
-        write_atomically(report_path, &json)?;
+    // Every file the command writes is staged first and renamed into place together, so a failure
+    // in any of them leaves all of them as they were.
+    let report_json = args.report.as_ref().map(|_| serde_json::to_vec_pretty(&baked.report)).transpose()?;
+    let mut extra: Vec<(PathBuf, &[u8])> = Vec::new();
+    if let (Some(path), Some(json)) = (&args.report, &report_json) {
+        extra.push((path.clone(), json));
     }
     if let Some(dir) = &args.textures_out {
-        std::fs::create_dir_all(dir).map_err(|e| BadInput(format!("{}: cannot create: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir).map_err(|e| IoFailure(format!("{}: cannot create: {e}", dir.display())))?;
         for image in &baked.textures {
-            write_atomically(&dir.join(format!("{}.png", image.name)), &image.png)?;
+            extra.push((dir.join(format!("{}.png", image.name)), &image.png));
         }
     }
+    write_outputs(&output, &baked.written, &config.container, &extra)?;
     progress.finish();
     if args.json {
         out!("{}", serde_json::to_string_pretty(&baked.report)?);
@@ -274,6 +285,20 @@ fn container_for(output: &Path) -> Result<Container> {
 
 /// Refuses an output that would replace the input (unless `force`) or something other than a
 /// regular file, before any work is done.
+/// An output path that names something other than a regular file (a folder, a device) is refused
+/// before the bake rather than failing at the rename after it.
+fn refuse_non_file(target: &Path) -> Result<()> {
+    let named_as_folder = target.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR);
+    if named_as_folder || std::fs::metadata(target).is_ok_and(|m| !m.is_file()) {
+        return Err(BadInput(format!(
+            "{}: is a folder or another file that is not a regular one; refusing to write it",
+            target.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 fn check_output(
     output: &Path,
     container: &Container,
@@ -286,15 +311,7 @@ fn check_output(
         targets.push(output.with_file_name(bin_uri));
     }
     for target in &targets {
-        if let Ok(meta) = std::fs::metadata(target)
-            && !meta.is_file()
-        {
-            return Err(BadInput(format!(
-                "{}: exists and is not a regular file; refusing to replace it",
-                target.display()
-            ))
-            .into());
-        }
+        refuse_non_file(target)?;
     }
     let Some(input) = input else { return Ok(()) };
     // The input and, for a .gltf, the files its buffers and images name (beside it).
@@ -329,31 +346,70 @@ fn check_output(
     Ok(())
 }
 
-fn write_outputs(output: &Path, written: &drafter_format::Written, container: &Container) -> Result<()> {
-    if let (Container::Gltf { bin_uri }, Some(bin)) = (container, &written.bin) {
-        let bin_path = output.with_file_name(bin_uri);
-        write_atomically(&bin_path, bin)?;
+/// The bake's files, each staged as a temporary file beside its target and synced, then renamed
+/// into place together: a failure in any of them (a full disk, a report path in a missing folder)
+/// leaves every target as it was. The .bin of a .gltf is renamed before the .gltf that names it,
+/// and the main file last.
+fn write_outputs(
+    output: &Path,
+    written: &drafter_format::Written,
+    container: &Container,
+    extra: &[(PathBuf, &[u8])],
+) -> Result<()> {
+    let mut staged = Vec::new();
+    for (path, bytes) in extra {
+        staged.push(Staged::new(path, bytes)?);
     }
-    write_atomically(output, &written.main)
+    if let (Container::Gltf { bin_uri }, Some(bin)) = (container, &written.bin) {
+        staged.push(Staged::new(&output.with_file_name(bin_uri), bin)?);
+    }
+    staged.push(Staged::new(output, &written.main)?);
+    commit(staged)
 }
 
 /// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over `path`, so a
 /// reader never sees a partial file and a failure leaves none behind.
 pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let temp = folder.join(format!(".{name}.{}.tmp", std::process::id()));
-    // A signal from here on removes the temporary file before the process exits.
-    let _guard = crate::interrupt::TempFileGuard::new(&temp);
-    let result = (|| -> std::io::Result<()> {
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&temp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&temp);
-        return Err(IoFailure(format!("{}: cannot write: {e}", path.display())).into());
+    commit(vec![Staged::new(path, bytes)?])
+}
+
+/// A file written in full beside its target, not yet renamed over it. Dropped before
+/// [`commit`], it removes its temporary file (and a signal removes it too, see `interrupt`).
+struct Staged {
+    temp: PathBuf,
+    target: PathBuf,
+    _guard: crate::interrupt::TempFileGuard,
+}
+
+impl Staged {
+    fn new(path: &Path, bytes: &[u8]) -> Result<Self> {
+        let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let temp = folder.join(format!(".{name}.{}.tmp", std::process::id()));
+        // A signal from here on removes the temporary file before the process exits.
+        let staged = Self { _guard: crate::interrupt::TempFileGuard::new(&temp), temp, target: path.to_path_buf() };
+        let written = (|| -> std::io::Result<()> {
+            let mut file = std::fs::File::create(&staged.temp)?;
+            file.write_all(bytes)?;
+            file.sync_all()
+        })();
+        written.map_err(|e| IoFailure(format!("{}: cannot write: {e}", path.display())))?;
+        Ok(staged)
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        // After a successful rename there is nothing left to remove.
+        let _ = std::fs::remove_file(&self.temp);
+    }
+}
+
+/// Renames every staged file over its target, in order; the ones not reached are removed.
+fn commit(staged: Vec<Staged>) -> Result<()> {
+    for file in staged {
+        std::fs::rename(&file.temp, &file.target)
+            .map_err(|e| IoFailure(format!("{}: cannot write: {e}", file.target.display())))?;
     }
     Ok(())
 }
