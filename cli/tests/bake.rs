@@ -178,6 +178,7 @@ fn failures_leave_no_output_and_exit_2() {
         vec!["--config", config.to_str().expect("utf-8")],
         vec!["--config", "missing.toml"],
         vec!["--segment", "nodes", "--threads", "0"],
+        vec!["--threads", "100000"],
     ] {
         let out = common::drafter()
             .arg("bake")

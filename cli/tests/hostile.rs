@@ -131,6 +131,20 @@ fn the_valid_baselines_import() {
     }
 }
 
+/// A weld tolerance that is not a fraction in [0, 1] is refused, not read as "weld nothing" (NaN,
+/// infinity) or "weld everything" (negative).
+#[test]
+fn nonsense_weld_tolerances_are_refused() {
+    let dir = common::scratch("hostile-weld");
+    let file = write(&dir, "ok.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    for value in ["-1", "nan", "inf", "2"] {
+        let o = inspect(&file, &[&format!("--weld-tolerance={value}")]);
+        assert_eq!(o.code, 2, "{value}: {}", o.stderr);
+        assert!(o.stderr.lines().count() == 1 && o.stderr.contains("--weld-tolerance"), "{value}: {}", o.stderr);
+    }
+    assert_eq!(inspect(&file, &["--weld-tolerance=1e-6"]).code, 0);
+}
+
 #[test]
 fn empty_files() {
     let dir = common::scratch("hostile-empty");

@@ -153,6 +153,12 @@ pub fn run(args: Args) -> Result<()> {
         std::fs::read(&args.file).map_err(|source| drafter_io::ImportError::Io { path: args.file.clone(), source })?;
     let imported = drafter_io::import_bytes(&args.file, &bytes)?;
     let weld = match (args.weld_tolerance, args.weld) {
+        (Some(fraction), _) if !(fraction.is_finite() && (0.0..=1.0).contains(&fraction)) => {
+            return Err(BadInput(format!(
+                "--weld-tolerance must be a fraction of the bounding diagonal in [0, 1], not {fraction}"
+            ))
+            .into());
+        }
         (Some(fraction), _) => Weld::Relative(fraction),
         (None, WeldMode::Snap) => Weld::default(),
         (None, WeldMode::Exact) => Weld::Exact,
