@@ -168,6 +168,53 @@ fn gltf_output_writes_a_bin_beside_it() {
     khronos_validate(&[output]);
 }
 
+/// Node graphs glTF forbids (a node its own child, a node with two parents, a scene root that is
+/// also a child) are baked as the importer walks them, with a note, and the written file keeps
+/// only the links that walk followed: it passes the Khronos validator. Inputs whose only fault is
+/// an empty accessor are refused (exit 2) instead of written out invalid.
+#[test]
+fn forbidden_node_graphs_bake_into_valid_files() {
+    let dir = common::scratch("bake-node-graphs");
+    let graphs: [(&str, serde_json::Value, serde_json::Value); 3] = [
+        ("self-child", serde_json::json!([{"mesh": 0, "children": [0]}]), serde_json::json!([0])),
+        (
+            "two-parents",
+            serde_json::json!([{"mesh": 0, "children": [1, 2]}, {"children": [2]}, {"mesh": 0}]),
+            serde_json::json!([0]),
+        ),
+        (
+            "root-and-child",
+            serde_json::json!([{"mesh": 0, "children": [1]}, {"mesh": 0, "children": [0]}]),
+            serde_json::json!([0, 1]),
+        ),
+    ];
+    let mut outputs = Vec::new();
+    for (name, nodes, roots) in graphs {
+        let input = dir.join(format!("{name}.gltf"));
+        std::fs::write(
+            &input,
+            common::gltf_triangle(|j| {
+                j["nodes"] = nodes;
+                j["scenes"][0]["nodes"] = roots;
+            }),
+        )
+        .expect("input");
+        let output = dir.join(format!("{name}.glb"));
+        let out = common::run(&["bake", input.to_str().expect("utf-8"), "-o", output.to_str().expect("utf-8")]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("node cycles"), "{name}: no note");
+        outputs.push(output);
+    }
+    khronos_validate(&outputs);
+    let empty = dir.join("empty-accessor.gltf");
+    std::fs::write(&empty, common::gltf_triangle(|j| j["accessors"][1]["count"] = 0.into())).expect("input");
+    let out =
+        common::run(&["bake", empty.to_str().expect("utf-8"), "-o", dir.join("never.glb").to_str().expect("utf-8")]);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/accessors/1/count"));
+    assert!(!dir.join("never.glb").exists());
+}
+
 #[test]
 fn failures_leave_no_output_and_exit_2() {
     let dir = common::scratch("bake-failures");

@@ -71,37 +71,6 @@ fn assert_rejected(file: &Path, needle: &str) {
     assert!(o.stdout.is_empty(), "{name}: wrote to stdout on failure");
 }
 
-/// A valid one-triangle glTF with an embedded buffer; `edit` mutates its JSON before writing.
-fn gltf_triangle(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
-    let mut bin = Vec::new();
-    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
-        bin.extend_from_slice(&v.to_le_bytes());
-    }
-    for i in [0u16, 1, 2, 0] {
-        bin.extend_from_slice(&i.to_le_bytes());
-    }
-    let uri =
-        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
-    let mut json = serde_json::json!({
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-        "buffers": [{"byteLength": bin.len(), "uri": uri}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
-            {"buffer": 0, "byteOffset": 36, "byteLength": 6}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
-            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}
-        ]
-    });
-    edit(&mut json);
-    serde_json::to_vec_pretty(&json).expect("json")
-}
-
 fn binary_stl(claimed: u32, facets: usize, first_vertex: [f32; 3]) -> Vec<u8> {
     let mut b = vec![0u8; 80];
     b[..5].copy_from_slice(b"solid");
@@ -122,7 +91,7 @@ fn binary_stl(claimed: u32, facets: usize, first_vertex: [f32; 3]) -> Vec<u8> {
 fn the_valid_baselines_import() {
     let dir = common::scratch("hostile-baseline");
     for (name, bytes) in [
-        ("ok.gltf", gltf_triangle(|_| {})),
+        ("ok.gltf", common::gltf_triangle(|_| {})),
         ("ok.stl", binary_stl(2, 2, [0.0; 3])),
         ("ok.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec()),
     ] {
@@ -162,7 +131,7 @@ fn unknown_format_lists_the_supported_ones() {
 #[test]
 fn truncated_files() {
     let dir = common::scratch("hostile-truncated");
-    let gltf = gltf_triangle(|_| {});
+    let gltf = common::gltf_triangle(|_| {});
     assert_rejected(&write(&dir, "cut.gltf", &gltf[..gltf.len() / 2]), "line");
     // A GLB whose header claims more bytes than the file has: a valid container (drafter-core's
     // writer) with its total length field overwritten.
@@ -190,15 +159,19 @@ fn headers_claiming_more_than_the_file_holds() {
         "byte",
     );
     assert_rejected(
-        &write(&dir, "liar.gltf", &gltf_triangle(|j| j["accessors"][0]["count"] = 1_000_000_000.into())),
+        &write(&dir, "liar.gltf", &common::gltf_triangle(|j| j["accessors"][0]["count"] = 1_000_000_000.into())),
         "/accessors/0",
     );
     assert_rejected(
-        &write(&dir, "liar-buffer.gltf", &gltf_triangle(|j| j["buffers"][0]["byteLength"] = 1_000_000.into())),
+        &write(&dir, "liar-buffer.gltf", &common::gltf_triangle(|j| j["buffers"][0]["byteLength"] = 1_000_000.into())),
         "/buffers/0",
     );
     assert_rejected(
-        &write(&dir, "liar-view.gltf", &gltf_triangle(|j| j["bufferViews"][0]["byteOffset"] = 4_000_000_000u64.into())),
+        &write(
+            &dir,
+            "liar-view.gltf",
+            &common::gltf_triangle(|j| j["bufferViews"][0]["byteOffset"] = 4_000_000_000u64.into()),
+        ),
         "/bufferViews/0",
     );
 }
@@ -206,7 +179,7 @@ fn headers_claiming_more_than_the_file_holds() {
 #[test]
 fn out_of_range_indices() {
     let dir = common::scratch("hostile-indices");
-    let mut bad_index = gltf_triangle(|_| {});
+    let mut bad_index = common::gltf_triangle(|_| {});
     // Rewrite the index buffer (inside the data URI) so it points at vertex 7.
     let text = String::from_utf8(bad_index.clone()).expect("utf8");
     let json: serde_json::Value = serde_json::from_str(&text).expect("json");
@@ -214,7 +187,7 @@ fn out_of_range_indices() {
     let mut bin =
         base64::engine::general_purpose::STANDARD.decode(&uri[uri.find(',').expect("comma") + 1..]).expect("b64");
     bin[38..40].copy_from_slice(&7u16.to_le_bytes());
-    bad_index = gltf_triangle(|j| {
+    bad_index = common::gltf_triangle(|j| {
         j["buffers"][0]["uri"] =
             format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin))
                 .into()
@@ -223,12 +196,15 @@ fn out_of_range_indices() {
     assert_rejected(&write(&dir, "index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "line 4");
     assert_rejected(&write(&dir, "index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"), "line");
     assert_rejected(&write(&dir, "index.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "line");
-    assert_rejected(&write(&dir, "node.gltf", &gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())), "/nodes/0/mesh");
+    assert_rejected(
+        &write(&dir, "node.gltf", &common::gltf_triangle(|j| j["nodes"][0]["mesh"] = 5.into())),
+        "/nodes/0/mesh",
+    );
     // gltf-json 1.4 indexes a POSITION accessor unchecked while validating: it must be refused
     // before that (it was a panic in the dependency and exit 1).
-    let position = gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 5.into());
+    let position = common::gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 5.into());
     assert_rejected(&write(&dir, "position.gltf", &position), "/meshes/0/primitives/0/attributes/POSITION");
-    let huge = gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = u32::MAX.into());
+    let huge = common::gltf_triangle(|j| j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = u32::MAX.into());
     assert_rejected(&write(&dir, "position-huge.gltf", &huge), "does not exist");
 }
 
@@ -260,7 +236,7 @@ fn uris_outside_the_folder_are_refused() {
         ("scheme.gltf", "http://example.invalid/x.bin"),
         ("file.gltf", "file:///etc/hostname"),
     ] {
-        let bytes = gltf_triangle(|j| j["buffers"][0]["uri"] = uri.into());
+        let bytes = common::gltf_triangle(|j| j["buffers"][0]["uri"] = uri.into());
         assert_rejected(&write(&dir, name, &bytes), "/buffers/0");
     }
 }
@@ -268,7 +244,7 @@ fn uris_outside_the_folder_are_refused() {
 #[test]
 fn required_extensions_we_cannot_decode_are_named() {
     let dir = common::scratch("hostile-ext");
-    let bytes = gltf_triangle(|j| {
+    let bytes = common::gltf_triangle(|j| {
         j["extensionsUsed"] = serde_json::json!(["EXT_meshopt_compression"]);
         j["extensionsRequired"] = serde_json::json!(["EXT_meshopt_compression"]);
     });
@@ -283,7 +259,7 @@ fn malformed_json_names_the_line() {
         "line 3",
     );
     assert_rejected(
-        &write(&dir, "wrongtype.gltf", &gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())),
+        &write(&dir, "wrongtype.gltf", &common::gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())),
         "/accessors/0",
     );
 }
@@ -306,7 +282,7 @@ fn accepted_inputs_bake_or_are_refused_as_input() {
             .expect("runs");
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
-    let lines_node = gltf_triangle(|j| {
+    let lines_node = common::gltf_triangle(|j| {
         j["meshes"].as_array_mut().expect("meshes").push(serde_json::json!({
             "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 1}]
         }));
@@ -316,16 +292,17 @@ fn accepted_inputs_bake_or_are_refused_as_input() {
     let (code, stderr) = bake("lines.gltf", lines_node);
     assert_eq!(code, Some(0), "{stderr}");
 
-    let huge_number = String::from_utf8(gltf_triangle(|j| j["extras"] = serde_json::json!({"n": 1.0})))
+    let huge_number = String::from_utf8(common::gltf_triangle(|j| j["extras"] = serde_json::json!({"n": 1.0})))
         .expect("utf-8")
         .replace("\"n\": 1.0", "\"n\": 1e309");
     let mut deep = serde_json::json!(0);
     for _ in 0..200 {
         deep = serde_json::json!({ "a": deep });
     }
-    for (name, bytes) in
-        [("number.gltf", huge_number.into_bytes()), ("deep.gltf", gltf_triangle(|j| j["extras"] = deep.clone()))]
-    {
+    for (name, bytes) in [
+        ("number.gltf", huge_number.into_bytes()),
+        ("deep.gltf", common::gltf_triangle(|j| j["extras"] = deep.clone())),
+    ] {
         let (code, stderr) = bake(name, bytes);
         assert_eq!(code, Some(2), "{name}: {stderr}");
         assert_eq!(stderr.lines().count(), 1, "{name}: {stderr}");

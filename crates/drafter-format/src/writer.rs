@@ -288,6 +288,9 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
         Some(source) => Doc::from_source(&source.json, &source.buffers)?,
         None => synthesize(scene),
     };
+    if from_source {
+        keep_node_tree(&mut doc);
+    }
     let mut notes = Vec::new();
     // Node index of each instance: the source node, or the synthesized node i.
     let node_of = |i: usize| scene.instances[i].node.map_or(i, |n| n.index());
@@ -822,6 +825,93 @@ fn rewrite_if_faces_dropped(
         map.remove("mode");
     }
     Ok(())
+}
+
+/// Makes the source's node graph a forest again where it is not (a cycle, a node listed as the
+/// child of two nodes, a scene root that is also some node's child): glTF forbids all three, and
+/// the importer reports them and skips every repeat (`drafter_io`'s walk). The same walk here, from
+/// the default scene's roots first (each in order, children in order, a node taken where it is
+/// first reached), keeps the links the importer followed and drops the others from `children`
+/// and from the scenes' `nodes`, so the written file describes the scene that was baked. A graph
+/// that is already a forest is left untouched.
+fn keep_node_tree(doc: &mut Doc) {
+    let node_count = doc.array("nodes").len();
+    let indices = |v: &Value| -> Vec<Option<usize>> {
+        v.as_array().map_or(Vec::new(), |a| a.iter().map(|i| i.as_u64().map(|i| i as usize)).collect())
+    };
+    let children: Vec<Vec<Option<usize>>> = doc.array("nodes").iter().map(|n| indices(&n["children"])).collect();
+    let scenes: Vec<Vec<Option<usize>>> = doc.array("scenes").iter().map(|s| indices(&s["nodes"])).collect();
+    let default = doc.json.get("scene").and_then(Value::as_u64).map_or(0, |s| s as usize);
+    let scene_order = std::iter::once(default).chain((0..scenes.len()).filter(|&s| s != default));
+    // Which entries of each `children` and scene `nodes` list lead to a node's first visit.
+    let mut keep_child: Vec<Vec<bool>> = children.iter().map(|c| vec![false; c.len()]).collect();
+    let mut keep_root: Vec<Vec<bool>> = scenes.iter().map(|r| vec![false; r.len()]).collect();
+    let mut visited = vec![false; node_count];
+    // Nodes to visit and where each was listed, popped in preorder.
+    let mut stack: Vec<(usize, Listed)> = Vec::new();
+    let starts = scene_order
+        .filter(|&s| s < scenes.len())
+        .flat_map(|s| scenes[s].iter().enumerate().map(move |(slot, &n)| (n, Listed::Root { scene: s, slot })))
+        .chain((0..node_count).map(|n| (Some(n), Listed::Unlisted)))
+        .collect::<Vec<_>>();
+    for (start, listed) in starts {
+        let Some(start) = start.filter(|&n| n < node_count) else { continue };
+        if visited[start] {
+            continue;
+        }
+        stack.push((start, listed));
+        while let Some((id, listed)) = stack.pop() {
+            if std::mem::replace(&mut visited[id], true) {
+                continue;
+            }
+            match listed {
+                Listed::Root { scene, slot } => keep_root[scene][slot] = true,
+                Listed::Child { parent, slot } => keep_child[parent][slot] = true,
+                Listed::Unlisted => {}
+            }
+            for (slot, &c) in children[id].iter().enumerate().rev() {
+                if let Some(c) = c.filter(|&c| c < node_count) {
+                    stack.push((c, Listed::Child { parent: id, slot }));
+                }
+            }
+        }
+    }
+    let filtered = |list: &[Option<usize>], keep: &[bool]| -> Value {
+        list.iter().zip(keep).filter(|&(_, &k)| k).map(|(&i, _)| json!(i)).collect()
+    };
+    for (n, node) in doc.array_mut("nodes").iter_mut().enumerate() {
+        if keep_child[n].iter().any(|k| !k)
+            && let Value::Object(map) = node
+        {
+            let kept = filtered(&children[n], &keep_child[n]);
+            if kept.as_array().is_some_and(Vec::is_empty) {
+                map.remove("children");
+            } else {
+                map.insert("children".into(), kept);
+            }
+        }
+    }
+    for (s, scene) in doc.array_mut("scenes").iter_mut().enumerate() {
+        if keep_root[s].iter().any(|k| !k)
+            && let Value::Object(map) = scene
+        {
+            let kept = filtered(&scenes[s], &keep_root[s]);
+            if kept.as_array().is_some_and(Vec::is_empty) {
+                map.remove("nodes");
+            } else {
+                map.insert("nodes".into(), kept);
+            }
+        }
+    }
+}
+
+/// Where [`keep_node_tree`]'s walk found a node: in a scene's `nodes`, in a parent's `children`,
+/// or nowhere (a node outside every scene, walked last).
+#[derive(Clone, Copy)]
+enum Listed {
+    Root { scene: usize, slot: usize },
+    Child { parent: usize, slot: usize },
+    Unlisted,
 }
 
 /// The material given to primitives of a mesh input (OBJ without `usemtl`, STL, OFF, PLY) that

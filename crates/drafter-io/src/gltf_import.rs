@@ -151,6 +151,11 @@ fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
             }
         }
     }
+    // glTF requires every accessor to hold at least one element; the writer passes the source's
+    // accessors through, so an empty one would make the baked file invalid as well.
+    if let Some(a) = root.accessors.iter().position(|a| a.count.0 == 0) {
+        return Err(ParseError::at_json(format!("/accessors/{a}/count"), "count is 0 (glTF requires at least 1)"));
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path();
