@@ -215,6 +215,34 @@ fn forbidden_node_graphs_bake_into_valid_files() {
     assert!(!dir.join("never.glb").exists());
 }
 
+/// An image the source names by a file beside it is taken into the baked file (which is written
+/// elsewhere), so the output does not point at a file its folder lacks.
+#[test]
+fn image_files_beside_a_gltf_are_embedded() {
+    use base64::Engine as _;
+    let dir = common::scratch("bake-image-files");
+    let png = base64::engine::general_purpose::STANDARD
+        .decode("iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNkYPhfDwAChwGA60e6kgAAAABJRU5ErkJggg==")
+        .expect("png");
+    std::fs::write(dir.join("tex.png"), &png).expect("image");
+    let input = dir.join("textured.gltf");
+    let gltf = common::gltf_triangle(|j| {
+        j["images"] = serde_json::json!([{"uri": "tex.png"}]);
+        j["textures"] = serde_json::json!([{"source": 0}]);
+    });
+    std::fs::write(&input, gltf).expect("input");
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).expect("dir");
+    let outputs = [out_dir.join("t.glb"), out_dir.join("t.gltf")];
+    for output in &outputs {
+        common::bake(&input, output, &[]);
+    }
+    khronos_validate(&outputs);
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&outputs[1]).expect("gltf")).expect("json");
+    assert_eq!(json["images"][0]["mimeType"], "image/png", "{}", json["images"]);
+    assert!(json["images"][0].get("uri").is_none());
+}
+
 #[test]
 fn failures_leave_no_output_and_exit_2() {
     let dir = common::scratch("bake-failures");

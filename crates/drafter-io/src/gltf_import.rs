@@ -53,10 +53,12 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     check_required_extensions(doc.as_json()).map_err(|e| e.in_path(path))?;
     validate(doc.as_json()).map_err(|e| e.in_path(path))?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(doc, blob, folder).map_err(|e| e.in_path(path))?;
+    let mut buffers = load_buffers(doc, blob, folder).map_err(|e| e.in_path(path))?;
     let mut scene = build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))?;
-    // Keep the JSON text as written (not re-serialised), so nothing the gltf crate does not model is lost.
+    // Keep the JSON text as written (not re-serialised), so nothing the gltf crate does not model is
+    // lost; only image files beside it are taken in (`embed_image_files`).
     let json = String::from_utf8_lossy(json_bytes).into_owned();
+    let json = embed_image_files(json, &mut buffers, folder, diagnostics);
     scene.source = Some(std::sync::Arc::new(SourceDocument { json, buffers }));
     Ok(scene)
 }
@@ -166,6 +168,64 @@ fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
         }
     });
     if errors.is_empty() { Ok(()) } else { Err(validation_error(&errors)) }
+}
+
+/// Images the source names by a file URI, moved into buffers of their own (a buffer view and a
+/// MIME type instead of the URI), so that the baked file, which is written elsewhere and passes
+/// the source's images through, does not point at files that are not beside it. An image file
+/// that cannot be read (the same rules as buffers: inside the folder) or is neither PNG nor JPEG
+/// keeps its URI, with a note. The text is returned unchanged where no image names a file.
+fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, diagnostics: &mut Diagnostics) -> String {
+    let is_file_uri = |image: &serde_json::Value| image["uri"].as_str().is_some_and(|u| !u.starts_with("data:"));
+    let Ok(mut root) = serde_json::from_str::<serde_json::Value>(&json) else { return json };
+    let count = root["images"].as_array().map_or(0, |images| images.iter().filter(|i| is_file_uri(i)).count());
+    if count == 0 {
+        return json;
+    }
+    let mut kept = Vec::new();
+    for i in 0..root["images"].as_array().map_or(0, Vec::len) {
+        if !is_file_uri(&root["images"][i]) {
+            continue;
+        }
+        let uri = root["images"][i]["uri"].as_str().unwrap_or_default().to_owned();
+        let mime = match read_buffer_uri(folder, &uri) {
+            Ok(bytes) if bytes.starts_with(b"\x89PNG\r\n\x1a\n") => Ok(("image/png", bytes)),
+            Ok(bytes) if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) => Ok(("image/jpeg", bytes)),
+            Ok(_) => Err("neither PNG nor JPEG".to_owned()),
+            Err(e) => Err(e),
+        };
+        let (mime, bytes) = match mime {
+            Ok(found) => found,
+            Err(why) => {
+                kept.push(format!("/images/{i} ({uri}): {why}"));
+                continue;
+            }
+        };
+        let buffer = buffers.len();
+        let length = bytes.len();
+        buffers.push(bytes);
+        let push = |root: &mut serde_json::Value, key: &str, item: serde_json::Value| -> usize {
+            if !root[key].is_array() {
+                root[key] = serde_json::Value::Array(Vec::new());
+            }
+            let list = root[key].as_array_mut().expect("an array");
+            list.push(item);
+            list.len() - 1
+        };
+        push(&mut root, "buffers", serde_json::json!({"byteLength": length}));
+        let view = push(&mut root, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": length}));
+        if let Some(image) = root["images"][i].as_object_mut() {
+            image.remove("uri");
+            image.insert("bufferView".into(), view.into());
+            image.insert("mimeType".into(), mime.into());
+        }
+    }
+    if let Some(first) = kept.first() {
+        diagnostics.push(DiagnosticKind::Output, kept.len(), || {
+            format!("{first}; the image keeps its URI, which the baked file's folder may not have")
+        });
+    }
+    root.to_string()
 }
 
 fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Result<Vec<Vec<u8>>, ParseError> {
