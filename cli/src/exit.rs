@@ -32,14 +32,15 @@ impl std::fmt::Display for IoFailure {
 impl std::error::Error for IoFailure {}
 
 /// The exit code of `err`: 3 for I/O failures (an unreadable input counts, except one that does
-/// not exist, which is the user's to fix: 2), 2 for bad input, 1 otherwise.
+/// not exist or is a folder, which is the user's to fix: 2), 2 for bad input, 1 otherwise.
 pub fn code_of(err: &anyhow::Error) -> u8 {
     for e in err.chain() {
         if e.is::<IoFailure>() {
             return IO_FAILURE;
         }
         if let Some(drafter_io::ImportError::Io { source, .. }) = e.downcast_ref::<drafter_io::ImportError>() {
-            return if source.kind() == std::io::ErrorKind::NotFound { BAD_INPUT } else { IO_FAILURE };
+            let users = matches!(source.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::IsADirectory);
+            return if users { BAD_INPUT } else { IO_FAILURE };
         }
         if e.is::<drafter_io::ImportError>() || e.is::<BadInput>() {
             return BAD_INPUT;

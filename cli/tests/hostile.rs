@@ -239,6 +239,9 @@ fn uris_outside_the_folder_are_refused() {
         let bytes = common::gltf_triangle(|j| j["buffers"][0]["uri"] = uri.into());
         assert_rejected(&write(&dir, name, &bytes), "/buffers/0");
     }
+    // The folder itself is not a file, and the message says so.
+    let bytes = common::gltf_triangle(|j| j["buffers"][0]["uri"] = ".".into());
+    assert_rejected(&write(&dir, "dot.gltf", &bytes), "names a folder");
 }
 
 #[test]

@@ -65,9 +65,11 @@ fn only_regular_files_are_written_and_failed_writes_exit_3() {
     std::fs::write(&file, b"x").expect("write");
     let out = common::drafter().arg("bake").arg("-o").arg(file.join("out.glb")).output().expect("runs");
     assert_eq!(code(&out), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
-    // A missing input is the user's to fix (2), not an I/O failure.
-    let out = common::drafter().arg("bake").arg(dir.join("missing.obj")).output().expect("runs");
-    assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    // A missing input, or a folder given as the input, is the user's to fix (2), not an I/O failure.
+    for input in [dir.join("missing.obj"), dir.clone()] {
+        let out = common::drafter().arg("bake").arg(&input).arg("-o").arg(dir.join("x.glb")).output().expect("runs");
+        assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    }
 }
 
 /// A bake writes its main file, a .gltf's .bin, the report and the textures together: where one

@@ -89,12 +89,24 @@ fn chunk_at(bytes: &[u8], at: usize, index: usize) -> Result<([u8; 4], &[u8], us
             at,
             format!(
                 "chunk {index} ({}) declares {length} bytes but {} remain in the container",
-                String::from_utf8_lossy(&ty).trim_end_matches('\0'),
+                type_name(ty),
                 bytes.len() - start
             ),
         )
     })?;
     Ok((ty, &bytes[start..end], end))
+}
+
+/// A chunk type as a message shows it: its letters where it is one of the spec's or another
+/// alphanumeric name (`JSON`, `BIN`), else its bytes in hex (a chunk read from the middle of
+/// another, where a previous length was wrong, has a type of arbitrary bytes).
+fn type_name(ty: [u8; 4]) -> String {
+    let letters = ty.iter().rev().skip_while(|&&b| b == 0).all(u8::is_ascii_alphanumeric);
+    if letters && ty[0] != 0 {
+        String::from_utf8_lossy(&ty).trim_end_matches('\0').to_owned()
+    } else {
+        format!("type 0x{:08X}", u32::from_le_bytes(ty))
+    }
 }
 
 /// Splits a GLB into its JSON and BIN chunks. Checks the magic, the version, that the header's
@@ -169,6 +181,14 @@ pub fn write(json: &[u8], bin: &[u8]) -> Result<Vec<u8>, GlbError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn chunk_types_are_named_or_shown_in_hex() {
+        assert_eq!(type_name(*b"JSON"), "JSON");
+        assert_eq!(type_name(*b"BIN\0"), "BIN");
+        assert_eq!(type_name(*b"ene\""), "type 0x22656E65");
+        assert_eq!(type_name([0, 0, 0, 0]), "type 0x00000000");
+    }
 
     fn offset_of(e: GlbError) -> usize {
         match e {

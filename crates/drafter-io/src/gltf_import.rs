@@ -262,10 +262,13 @@ pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
         UriTarget::Data(bytes) => return Ok(bytes),
         UriTarget::Relative(relative) => relative,
     };
-    let unreadable = |e: std::io::Error| format!("cannot read buffer file {}: {e}", relative.display());
+    let unreadable = |e: std::io::Error| format!("cannot read file {}: {e}", relative.display());
     let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
     let canonical_folder = folder.canonicalize().map_err(unreadable)?;
     let canonical = folder.join(&relative).canonicalize().map_err(unreadable)?;
+    if canonical.is_dir() {
+        return Err(format!("URI {uri:?} names a folder, not a file"));
+    }
     if !uri::inside(&canonical_folder, &canonical) {
         return Err(format!("URI {uri:?} leads out of the file's folder (through a symbolic link)"));
     }
