@@ -215,6 +215,39 @@ fn forbidden_node_graphs_bake_into_valid_files() {
     assert!(!dir.join("never.glb").exists());
 }
 
+/// A source mesh whose every position is NaN loses all its faces on import: the baked file leaves
+/// it out (and its accessors), where it used to keep them with an empty index accessor, both
+/// invalid glTF.
+#[test]
+fn a_mesh_without_finite_positions_is_left_out_of_a_valid_file() {
+    use base64::Engine as _;
+    let dir = common::scratch("bake-nan-mesh");
+    let nan: Vec<u8> = (0..9).flat_map(|_| f32::NAN.to_le_bytes()).collect();
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&nan));
+    let input = dir.join("nan.gltf");
+    let gltf = common::gltf_triangle(|j| {
+        j["buffers"].as_array_mut().expect("buffers").push(serde_json::json!({"byteLength": 36, "uri": uri}));
+        j["bufferViews"].as_array_mut().expect("views").push(serde_json::json!({"buffer": 1, "byteLength": 36}));
+        j["accessors"].as_array_mut().expect("accessors").push(
+            serde_json::json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}),
+        );
+        j["meshes"] = serde_json::json!([
+            {"primitives": [{"attributes": {"POSITION": 2}, "indices": 1}]},
+            {"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}
+        ]);
+        j["nodes"] = serde_json::json!([{"mesh": 0}, {"mesh": 1}]);
+        j["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    });
+    std::fs::write(&input, gltf).expect("input");
+    let output = dir.join("nan.glb");
+    common::bake(&input, &output, &[]);
+    khronos_validate(std::slice::from_ref(&output));
+    let out = common::run(&["inspect", "--json", output.to_str().expect("utf-8")]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!((report["meshes"].as_u64(), report["triangles"].as_u64()), (Some(1), Some(1)), "{report}");
+}
+
 /// An image the source names by a file beside it is taken into the baked file (which is written
 /// elsewhere), so the output does not point at a file its folder lacks.
 #[test]

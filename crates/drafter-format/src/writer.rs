@@ -316,10 +316,16 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             None => Vec::new(),
         })
         .collect();
+    // Source primitives that lost every face (all their positions non-finite), per mesh.
+    let mut emptied: Vec<Vec<usize>> = vec![Vec::new(); scene.meshes.len()];
     for (m, mesh) in scene.meshes.iter().enumerate() {
         let primitive_of = arrange_primitives(&mut doc, mesh, m, from_source)?;
         for (g, group) in mesh.groups.iter().enumerate() {
             let primitive = primitive_of[g];
+            if from_source && group.count == 0 {
+                emptied[m].push(primitive);
+                continue;
+            }
             let mut enhanced_normal = None;
             let relaid = match layouts[m].get(g) {
                 Some(relaid) => match write_vertex_data(&mut doc, (m, primitive), relaid, from_source) {
@@ -410,6 +416,9 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
         map.insert(EXTENSION.into(), root_ext);
     }
     doc.use_extension(EXTENSION);
+    if emptied.iter().any(|e| !e.is_empty()) {
+        drop_emptied(&mut doc, &emptied, &mut notes);
+    }
     if from_source && let Err(why) = doc.compact(EXTENSION) {
         notes.push(format!("{why}; replaced vertex data is kept in the buffer"));
     }
@@ -903,6 +912,52 @@ fn keep_node_tree(doc: &mut Doc) {
             }
         }
     }
+}
+
+/// Removes source primitives that lost every face on import (each position NaN or infinite), and
+/// meshes left with none (nodes then keep no `mesh`, later meshes are renumbered): written as they
+/// were, they would keep their non-finite positions and an empty index accessor, both invalid glTF.
+/// Their accessors become unreferenced, so the compaction that follows drops them. An empty
+/// primitive holds no triangles, so the triangle order the edges and hierarchies refer to, which
+/// runs over a mesh's primitives in order, is unchanged.
+fn drop_emptied(doc: &mut Doc, emptied: &[Vec<usize>], notes: &mut Vec<String>) {
+    let mut removed_meshes = Vec::new();
+    for (m, primitives) in emptied.iter().enumerate().filter(|(_, p)| !p.is_empty()) {
+        let Some(list) = doc.array_mut("meshes").get_mut(m).and_then(|mesh| mesh["primitives"].as_array_mut()) else {
+            continue;
+        };
+        let mut drop: Vec<usize> = primitives.iter().copied().filter(|&p| p < list.len()).collect();
+        drop.sort_unstable();
+        drop.dedup();
+        for &p in drop.iter().rev() {
+            list.remove(p);
+        }
+        notes.push(format!("mesh {m}: {} primitive(s) without a finite face left out", drop.len()));
+        if list.is_empty() {
+            removed_meshes.push(m);
+        }
+    }
+    if removed_meshes.is_empty() {
+        return;
+    }
+    for node in doc.existing_mut("nodes") {
+        let Some(mesh) = node.get("mesh").and_then(Value::as_u64).map(|m| m as usize) else { continue };
+        if removed_meshes.binary_search(&mesh).is_ok() {
+            if let Value::Object(map) = node {
+                map.remove("mesh");
+            }
+        } else {
+            node["mesh"] = (mesh - removed_meshes.partition_point(|&r| r < mesh)).into();
+        }
+    }
+    let meshes = doc.array_mut("meshes");
+    for &m in removed_meshes.iter().rev() {
+        meshes.remove(m);
+    }
+    if meshes.is_empty() {
+        doc.json.remove("meshes");
+    }
+    notes.push(format!("{} mesh(es) without a finite face left out", removed_meshes.len()));
 }
 
 /// Where [`keep_node_tree`]'s walk found a node: in a scene's `nodes`, in a parent's `children`,
