@@ -885,32 +885,25 @@ fn keep_node_tree(doc: &mut Doc) {
             }
         }
     }
-    let filtered = |list: &[Option<usize>], keep: &[bool]| -> Value {
-        list.iter().zip(keep).filter(|&(_, &k)| k).map(|(&i, _)| json!(i)).collect()
+    // The list at `key` of `object` without its dropped entries; the key goes where none is left
+    // (glTF forbids empty lists). Untouched where every entry is kept.
+    let keep_listed = |object: &mut Value, key: &str, list: &[Option<usize>], keep: &[bool]| {
+        if keep.iter().all(|&k| k) {
+            return;
+        }
+        let Value::Object(map) = object else { return };
+        let kept: Vec<Value> = list.iter().zip(keep).filter(|&(_, &k)| k).map(|(&i, _)| json!(i)).collect();
+        if kept.is_empty() {
+            map.remove(key);
+        } else {
+            map.insert(key.into(), Value::Array(kept));
+        }
     };
     for (n, node) in doc.array_mut("nodes").iter_mut().enumerate() {
-        if keep_child[n].iter().any(|k| !k)
-            && let Value::Object(map) = node
-        {
-            let kept = filtered(&children[n], &keep_child[n]);
-            if kept.as_array().is_some_and(Vec::is_empty) {
-                map.remove("children");
-            } else {
-                map.insert("children".into(), kept);
-            }
-        }
+        keep_listed(node, "children", &children[n], &keep_child[n]);
     }
     for (s, scene) in doc.array_mut("scenes").iter_mut().enumerate() {
-        if keep_root[s].iter().any(|k| !k)
-            && let Value::Object(map) = scene
-        {
-            let kept = filtered(&scenes[s], &keep_root[s]);
-            if kept.as_array().is_some_and(Vec::is_empty) {
-                map.remove("nodes");
-            } else {
-                map.insert("nodes".into(), kept);
-            }
-        }
+        keep_listed(scene, "nodes", &scenes[s], &keep_root[s]);
     }
 }
 
