@@ -103,10 +103,12 @@ fn a_failed_secondary_output_leaves_every_output_as_it_was() {
         common::drafter().arg("bake").arg("--textures-out").arg(&gltf).arg("-o").arg(&glb).output().expect("runs");
     assert_eq!(code(&out), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!glb.exists(), "the .glb was written although the textures were not");
-    // A report path that is a folder is refused before the bake.
-    let out = common::drafter().arg("bake").arg("--report").arg(&dir).arg("-o").arg(&glb).output().expect("runs");
-    assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(!glb.exists());
+    // A report path that is a folder, or the output itself, is refused before the bake.
+    for report in [&dir, &glb] {
+        let out = common::drafter().arg("bake").arg("--report").arg(report).arg("-o").arg(&glb).output().expect("runs");
+        assert_eq!(code(&out), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(!glb.exists());
+    }
     assert_eq!(leftovers(&dir), Vec::<String>::new());
 }
 

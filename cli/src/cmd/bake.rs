@@ -160,6 +160,9 @@ pub fn run(args: Args) -> Result<()> {
     check_output(&output, &config.container, args.input.as_deref(), &bytes, args.force)?;
     if let Some(report) = &args.report {
         refuse_non_file(report)?;
+        if report == &output {
+            return Err(BadInput(format!("{}: is both the output and the report", report.display())).into());
+        }
     }
 
     progress.step(1, "importing");
@@ -283,8 +286,6 @@ fn container_for(output: &Path) -> Result<Container> {
     }
 }
 
-/// Refuses an output that would replace the input (unless `force`) or something other than a
-/// regular file, before any work is done.
 /// An output path that names something other than a regular file (a folder, a device) is refused
 /// before the bake rather than failing at the rename after it.
 fn refuse_non_file(target: &Path) -> Result<()> {
@@ -299,6 +300,8 @@ fn refuse_non_file(target: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Refuses an output that would replace the input (unless `force`) or something other than a
+/// regular file, before any work is done.
 fn check_output(
     output: &Path,
     container: &Container,
