@@ -58,7 +58,9 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     // Keep the JSON text as written (not re-serialised), so nothing the gltf crate does not model is
     // lost; only image files beside it are taken in (`embed_image_files`).
     let json = String::from_utf8_lossy(json_bytes).into_owned();
-    let json = embed_image_files(json, &mut buffers, folder, diagnostics);
+    let names_files =
+        doc.images().any(|i| matches!(i.source(), gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:")));
+    let json = if names_files { embed_image_files(json, &mut buffers, folder, diagnostics) } else { json };
     scene.source = Some(std::sync::Arc::new(SourceDocument { json, buffers }));
     Ok(scene)
 }
@@ -174,14 +176,11 @@ fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
 /// MIME type instead of the URI), so that the baked file, which is written elsewhere and passes
 /// the source's images through, does not point at files that are not beside it. An image file
 /// that cannot be read (the same rules as buffers: inside the folder) or is neither PNG nor JPEG
-/// keeps its URI, with a note. The text is returned unchanged where no image names a file.
+/// keeps its URI, with a note. Called only where some image names a file (the text is parsed
+/// again here, so most inputs skip it).
 fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, diagnostics: &mut Diagnostics) -> String {
     let is_file_uri = |image: &serde_json::Value| image["uri"].as_str().is_some_and(|u| !u.starts_with("data:"));
     let Ok(mut root) = serde_json::from_str::<serde_json::Value>(&json) else { return json };
-    let count = root["images"].as_array().map_or(0, |images| images.iter().filter(|i| is_file_uri(i)).count());
-    if count == 0 {
-        return json;
-    }
     let mut kept = Vec::new();
     for i in 0..root["images"].as_array().map_or(0, Vec::len) {
         if !is_file_uri(&root["images"][i]) {
