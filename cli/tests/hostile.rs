@@ -176,6 +176,53 @@ fn headers_claiming_more_than_the_file_holds() {
     );
 }
 
+/// One 10,000-triangle strip listed in 2,001 primitives: 20,010,000 triangles from a 100 KB file,
+/// over the default limit of 20 million. Refused from the accessors' counts, before any triangle
+/// is built (building them took 2.8 GB before the process aborted under a 4 GB limit); `bake`
+/// writes nothing. Raising the limit is what the message says to do.
+#[test]
+fn geometry_listed_again_and_again_is_refused_before_it_is_built() {
+    let dir = common::scratch("hostile-listed-again");
+    let mut bin = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    for i in 0..10_002u16 {
+        bin.extend_from_slice(&(i % 4).to_le_bytes());
+    }
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let primitive = serde_json::json!({"attributes": {"POSITION": 0}, "indices": 1, "mode": 5});
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": vec![primitive; 2001]}],
+        "buffers": [{"byteLength": bin.len(), "uri": uri}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 20_004}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
+            {"bufferView": 1, "componentType": 5123, "count": 10_002, "type": "SCALAR"}
+        ]
+    });
+    let file = write(&dir, "listed-again.gltf", &serde_json::to_vec(&doc).expect("json"));
+    assert_rejected(
+        &file,
+        "/meshes/0/primitives/2000: the meshes list 20,010,000 triangles up to here, more than the limit of 20,000,000 (--max-triangles",
+    );
+    let out = dir.join("listed-again.baked.glb");
+    let o = common::run(&["bake", &file.to_string_lossy(), "-o", &out.to_string_lossy()]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.exists(), "no output for a refused input");
+    // A lower limit refuses earlier; `inspect` takes the flag too.
+    let o = inspect(&file, &["--max-triangles", "25000"]);
+    assert_eq!(o.code, 2);
+    assert!(o.stderr.contains("/meshes/0/primitives/2: the meshes list 30,000 triangles"), "{}", o.stderr);
+}
+
 #[test]
 fn out_of_range_indices() {
     let dir = common::scratch("hostile-indices");

@@ -131,19 +131,29 @@ pub struct Model {
 impl Model {
     /// Reads `path` (any format drafter-io imports) and its `DRAFTER_illustration` data, if any.
     pub fn load(path: &Path) -> Result<Model, LoadError> {
+        Self::load_within(path, &drafter_io::Limits::default())
+    }
+
+    /// As [`Self::load`], refusing a file that lists more than `limits` allows.
+    pub fn load_within(path: &Path, limits: &drafter_io::Limits) -> Result<Model, LoadError> {
         let bytes =
             std::fs::read(path).map_err(|source| drafter_io::ImportError::Io { path: path.to_path_buf(), source })?;
-        Self::load_bytes(path, &bytes)
+        Self::load_bytes_within(path, &bytes, limits)
     }
 
     /// As [`Self::load`], for bytes already read from `path` (which names the file and resolves a
     /// glTF's external buffers).
     pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Model, LoadError> {
+        Self::load_bytes_within(path, bytes, &drafter_io::Limits::default())
+    }
+
+    /// As [`Self::load_bytes`], refusing a file that lists more than `limits` allows.
+    pub fn load_bytes_within(path: &Path, bytes: &[u8], limits: &drafter_io::Limits) -> Result<Model, LoadError> {
         // A compressed GLB (EXT_meshopt_compression) is decoded once, and everything below reads
         // the plain bytes; a stream that does not decode is reported by the import.
         let plain = drafter_core::meshopt::decompress_glb(bytes).ok().flatten();
         let bytes = plain.as_deref().unwrap_or(bytes);
-        let imported = drafter_io::import_bytes(path, bytes)?;
+        let imported = drafter_io::import_bytes_within(path, bytes, limits)?;
         let baked = read_baked(path, bytes)?;
         let normal_sets = match &baked {
             Some(_) => read_normal_sets(path, bytes)?,

@@ -66,6 +66,10 @@ pub struct Args {
     /// that plain glTF viewers show the enhancement.
     #[arg(long)]
     pub enhanced_in_normal: bool,
+    /// Refuse an input that lists more triangles than this (over all meshes, an instanced mesh
+    /// once; a glTF's are counted before any is read).
+    #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
     /// Worker threads, 1 to 1024 (default: all cores). The output is identical at any count.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -166,9 +170,10 @@ pub fn run(args: Args) -> Result<()> {
     }
 
     progress.step(1, "importing");
+    let limits = drafter_io::Limits { max_triangles: args.max_triangles };
     // The input's digest (for the report) beside the import: 9 ms of one core on the dragon's 16 MB.
     let (imported, digest) =
-        rayon::join(|| drafter_io::import_bytes(&input_path, &bytes), || sha2::Sha256::digest(&bytes));
+        rayon::join(|| drafter_io::import_bytes_within(&input_path, &bytes, &limits), || sha2::Sha256::digest(&bytes));
     let imported = imported?;
     // The scene holds what it needs of the file (a glTF's buffers, for the writer's pass-through):
     // the file's bytes (16 MB for the dragon) are not kept through the bake, where memory peaks.

@@ -143,7 +143,7 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let model = crate::cmd::render::load(&args.file)?;
+    let model = crate::cmd::render::load(&args.file, drafter_io::DEFAULT_MAX_TRIANGLES)?;
     let load = ms(start);
     let t = Instant::now();
     let mut renderer = Renderer::new()?;

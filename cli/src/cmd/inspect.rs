@@ -33,6 +33,10 @@ pub struct Args {
     /// Treat any input diagnostic as bad input (exit code 2).
     #[arg(long)]
     pub strict: bool,
+    /// Refuse a model that lists more triangles than this (over all meshes, an instanced mesh
+    /// once; a glTF's are counted before any is read).
+    #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
 }
 
 /// The report, also the `--json` schema. Topology is computed per unique mesh after welding and
@@ -151,7 +155,8 @@ pub struct MeshRow {
 pub fn run(args: Args) -> Result<()> {
     let bytes =
         std::fs::read(&args.file).map_err(|source| drafter_io::ImportError::Io { path: args.file.clone(), source })?;
-    let imported = drafter_io::import_bytes(&args.file, &bytes)?;
+    let limits = drafter_io::Limits { max_triangles: args.max_triangles };
+    let imported = drafter_io::import_bytes_within(&args.file, &bytes, &limits)?;
     let weld = match (args.weld_tolerance, args.weld) {
         (Some(fraction), _) if !(fraction.is_finite() && (0.0..=1.0).contains(&fraction)) => {
             return Err(BadInput(format!(

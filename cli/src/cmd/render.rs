@@ -61,6 +61,10 @@ pub struct Args {
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Refuse a model that lists more triangles than this (over all meshes, an instanced mesh
+    /// once; a glTF's are counted before any is read).
+    #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -142,8 +146,8 @@ impl Args {
 }
 
 /// Loads a model for rendering, mapping the viewer's load errors onto the CLI's exit codes.
-pub fn load(path: &std::path::Path) -> Result<Model> {
-    Model::load(path).map_err(|e| match e {
+pub fn load(path: &std::path::Path, max_triangles: u64) -> Result<Model> {
+    Model::load_within(path, &drafter_io::Limits { max_triangles }).map_err(|e| match e {
         LoadError::Import(e) => anyhow::Error::from(e),
         other => anyhow::Error::from(BadInput(other.to_string())),
     })
@@ -155,7 +159,7 @@ pub fn run(args: Args) -> Result<()> {
     if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
         return Err(BadInput(format!("{}: output must end in .png", args.output.display())).into());
     }
-    let model = load(&args.file)?;
+    let model = load(&args.file, args.max_triangles)?;
     let mut renderer = Renderer::new()?;
     renderer.set_model(&model)?;
     let image = renderer.render(&options)?;

@@ -40,6 +40,10 @@ pub struct Args {
     /// Start with an orthographic camera.
     #[arg(long)]
     pub ortho: bool,
+    /// Refuse a model that lists more triangles than this (over all meshes, an instanced mesh
+    /// once; a glTF's are counted before any is read).
+    #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -54,7 +58,7 @@ pub fn run(args: Args) -> Result<()> {
         ..RenderOptions::default()
     };
     options.validate().map_err(BadInput)?;
-    let model = load(&args.file)?;
+    let model = load(&args.file, args.max_triangles)?;
     for notice in &model.notices {
         eprintln!("  note: {notice}");
     }

@@ -26,6 +26,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::json::validation::Validate as _;
 use gltf::mesh::Mode;
 
+use crate::Limits;
 use crate::error::{ImportError, ParseError};
 use crate::raw::drop_nonfinite_faces;
 
@@ -39,7 +40,12 @@ const ACCEPTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
 ];
 
-pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -> Result<Scene, ImportError> {
+pub(crate) fn import(
+    path: &Path,
+    bytes: &[u8],
+    limits: &Limits,
+    diagnostics: &mut Diagnostics,
+) -> Result<Scene, ImportError> {
     // The container is split by drafter-core's framer (the workspace's one GLB reader), so the gltf
     // crate only ever sees JSON and a lying header is refused with the offset of the bad field.
     let (format, json_bytes, blob) = if glb::is_glb(bytes) {
@@ -52,6 +58,7 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     let doc = &gltf.document;
     check_required_extensions(doc.as_json()).map_err(|e| e.in_path(path))?;
     validate(doc.as_json()).map_err(|e| e.in_path(path))?;
+    check_listed_triangles(doc, limits).map_err(|e| e.in_path(path))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut buffers = load_buffers(doc, blob, folder).map_err(|e| e.in_path(path))?;
     let mut scene = build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))?;
@@ -63,6 +70,41 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     let json = if names_files { embed_image_files(json, &mut buffers, folder, diagnostics) } else { json };
     scene.source = Some(std::sync::Arc::new(SourceDocument { json, buffers }));
     Ok(scene)
+}
+
+/// Refuses a document whose primitives list more than `limits.max_triangles` triangles, counted
+/// from the accessors' counts before any is read: primitives may list the same accessors again, so
+/// a few kilobytes of JSON can describe billions of triangles (each of which the import would
+/// build). Names the primitive at which the count passes the limit.
+fn check_listed_triangles(doc: &gltf::Document, limits: &Limits) -> Result<(), ParseError> {
+    let mut listed = 0u64;
+    for mesh in doc.meshes() {
+        for primitive in mesh.primitives() {
+            let count = match (primitive.indices(), primitive.get(&gltf::Semantic::Positions)) {
+                (Some(indices), _) => indices.count() as u64,
+                (None, Some(positions)) => positions.count() as u64,
+                (None, None) => 0,
+            };
+            listed += match primitive.mode() {
+                Mode::Triangles => count / 3,
+                Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+                _ => 0,
+            };
+            if listed > limits.max_triangles {
+                let place = format!("/meshes/{}/primitives/{}", mesh.index(), primitive.index());
+                return Err(ParseError::at_json(
+                    place,
+                    format!(
+                        "the meshes list {} triangles up to here, more than the limit of {} (--max-triangles; \
+                         primitives may list the same accessors again)",
+                        drafter_core::thousands(listed.min(usize::MAX as u64) as usize),
+                        drafter_core::thousands(limits.max_triangles.min(usize::MAX as u64) as usize)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn glb_error(e: glb::GlbError) -> ParseError {

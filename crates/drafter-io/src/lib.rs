@@ -32,6 +32,26 @@ pub struct Imported {
     pub diagnostics: Vec<Diagnostic>,
 }
 
+/// The most triangles an import takes by default ([`Limits::max_triangles`]): about 9 GB at the
+/// peak of a bake (the dragon's bake peaks at 0.44 KB a triangle).
+pub const DEFAULT_MAX_TRIANGLES: u64 = 20_000_000;
+
+/// Bounds on what an import builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// The most triangles over all meshes, counted as the file lists them (an instanced mesh
+    /// once). A glTF can list the same accessors in any number of primitives, so a file of a few
+    /// kilobytes can describe billions of triangles: those are counted from the accessors before
+    /// any is read. The other formats hold every triangle they list.
+    pub max_triangles: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_triangles: DEFAULT_MAX_TRIANGLES }
+    }
+}
+
 /// Reads `path`, choosing the format by content and extension.
 pub fn import(path: &Path) -> Result<Imported, ImportError> {
     let bytes = std::fs::read(path).map_err(|source| ImportError::Io { path: path.to_path_buf(), source })?;
@@ -41,23 +61,43 @@ pub fn import(path: &Path) -> Result<Imported, ImportError> {
 /// Imports `bytes` that were read from `path`. The path names the file in errors, resolves a glTF's
 /// external buffers and OBJ material libraries, and breaks ties in format detection.
 pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, ImportError> {
+    import_bytes_within(path, bytes, &Limits::default())
+}
+
+/// [`import_bytes`] within `limits`: a file that lists more is refused, naming the place where
+/// the count passes the limit.
+pub fn import_bytes_within(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Imported, ImportError> {
     let format = detect_format(path, bytes)?;
     let mut diagnostics = Diagnostics::new();
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let scene = match format {
         SourceFormat::Glb => match drafter_core::meshopt::decompress_glb(bytes) {
             // EXT_meshopt_compression (drafter bake --compress, gltfpack -cc): the plain GLB.
-            Ok(Some(plain)) => gltf_import::import(path, &plain, &mut diagnostics)?,
-            Ok(None) => gltf_import::import(path, bytes, &mut diagnostics)?,
+            Ok(Some(plain)) => gltf_import::import(path, &plain, limits, &mut diagnostics)?,
+            Ok(None) => gltf_import::import(path, bytes, limits, &mut diagnostics)?,
             Err(e) => return Err(ParseError::in_file(e.to_string()).in_path(path)),
         },
-        SourceFormat::Gltf => gltf_import::import(path, bytes, &mut diagnostics)?,
+        SourceFormat::Gltf => gltf_import::import(path, bytes, limits, &mut diagnostics)?,
         SourceFormat::Obj => obj::import(path, bytes, &mut diagnostics)?,
         SourceFormat::Stl => raw_scene(path, stl::read(bytes), format, &name, &mut diagnostics)?,
         SourceFormat::Off => raw_scene(path, off::read(bytes), format, &name, &mut diagnostics)?,
         SourceFormat::Ply => raw_scene(path, ply::read(bytes), format, &name, &mut diagnostics)?,
     };
+    // The text and STL formats hold every triangle they list, so this follows their parse.
+    let triangles: u64 = scene.meshes.iter().map(|m| m.triangles.len() as u64).sum();
+    if triangles > limits.max_triangles {
+        return Err(over_limit(triangles, limits).in_path(path));
+    }
     Ok(Imported { scene, diagnostics: diagnostics.into_vec() })
+}
+
+/// The error of a file that lists `triangles`, over `limits`.
+pub(crate) fn over_limit(triangles: u64, limits: &Limits) -> ParseError {
+    ParseError::in_file(format!(
+        "{} triangles, more than the limit of {} (--max-triangles)",
+        drafter_core::thousands(triangles.min(usize::MAX as u64) as usize),
+        drafter_core::thousands(limits.max_triangles.min(usize::MAX as u64) as usize)
+    ))
 }
 
 fn raw_scene(

@@ -288,3 +288,55 @@ fn packed_and_strided_accessors_decode_alike() {
         assert!(imported.scene.meshes.iter().all(|m| m.triangles.is_empty()));
     }
 }
+
+/// The triangle limit counts what the primitives list (lists, strips, fans, unindexed, the same
+/// accessors listed again) before reading any: at the count the import builds it passes, one
+/// below it the import is refused at the primitive where the count passes the limit.
+#[test]
+fn the_triangle_limit_counts_what_the_primitives_list() {
+    let mut b = Builder::default();
+    let quad = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+    let pos = b.positions(&quad);
+    let list = b.indices(&[0, 1, 2, 1, 3, 2, 0]);
+    let strip = b.indices(&[0, 1, 2, 3]);
+    let fan = b.indices(&[0, 1, 3, 2]);
+    let mut primitives = Vec::new();
+    for _ in 0..5 {
+        primitives.push(json!({"attributes": {"POSITION": pos}, "indices": list}));
+        primitives.push(json!({"attributes": {"POSITION": pos}, "indices": strip, "mode": 5}));
+        primitives.push(json!({"attributes": {"POSITION": pos}, "indices": fan, "mode": 6}));
+        primitives.push(json!({"attributes": {"POSITION": pos}}));
+        primitives.push(json!({"attributes": {"POSITION": pos}, "indices": list, "mode": 1}));
+    }
+    let doc = b.document(json!({
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"mesh": 1}],
+        "meshes": [{"primitives": primitives}, {"primitives": [{"attributes": {"POSITION": pos}, "indices": strip, "mode": 5}]}]
+    }));
+    let path = Path::new("mem.gltf");
+    let built = drafter_io::import_bytes(path, &doc).expect("imports").scene;
+    let total: usize = built.meshes.iter().map(|m| m.triangles.len()).sum();
+    assert_eq!(total, 5 * (2 + 2 + 2 + 1) + 2, "lines are skipped, a 7-index list drops its last index");
+    let at_limit = drafter_io::Limits { max_triangles: total as u64 };
+    drafter_io::import_bytes_within(path, &doc, &at_limit).expect("a file at the limit imports");
+    let below = drafter_io::Limits { max_triangles: total as u64 - 1 };
+    let e =
+        drafter_io::import_bytes_within(path, &doc, &below).expect_err("one below the limit is refused").to_string();
+    assert!(e.contains("mem.gltf: /meshes/1/primitives/0: the meshes list 37 triangles up to here"), "{e}");
+    let e = drafter_io::import_bytes_within(path, &doc, &drafter_io::Limits { max_triangles: 6 })
+        .expect_err("refused early")
+        .to_string();
+    assert!(e.contains("/meshes/0/primitives/3: the meshes list 7 triangles"), "{e}");
+}
+
+/// The other formats are checked after their parse: they hold every triangle they list.
+#[test]
+fn the_triangle_limit_holds_for_text_formats() {
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+    let path = Path::new("two.obj");
+    drafter_io::import_bytes_within(path, obj, &drafter_io::Limits { max_triangles: 2 }).expect("at the limit");
+    let e = drafter_io::import_bytes_within(path, obj, &drafter_io::Limits { max_triangles: 1 })
+        .expect_err("over the limit")
+        .to_string();
+    assert_eq!(e, "two.obj: file: 2 triangles, more than the limit of 1 (--max-triangles)");
+}
