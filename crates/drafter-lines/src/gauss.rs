@@ -845,16 +845,17 @@ fn subtree_cap(arcs: &[Arc], cell_center: Option<DVec3>) -> Measured {
         (sum, p_sum, p_max)
     };
     let parallel = arcs.len() > PARALLEL_ARCS;
-    let partials: Vec<(DVec3, f64, f64)> = if parallel {
-        arcs.par_chunks(CAP_CHUNK).map(partial).collect()
-    } else {
-        arcs.chunks(CAP_CHUNK).map(partial).collect()
-    };
     let (mut mean, mut p_sum, mut p_max) = (DVec3::ZERO, 0.0, 0.0f64);
-    for (s, ps, pm) in partials {
+    let add = |(s, ps, pm): (DVec3, f64, f64)| {
         mean += s;
         p_sum += ps;
         p_max = p_max.max(pm);
+    };
+    // The partial sums added in chunk order either way (a small node's in place: most nodes are).
+    if parallel {
+        arcs.par_chunks(CAP_CHUNK).map(partial).collect::<Vec<_>>().into_iter().for_each(add);
+    } else {
+        arcs.chunks(CAP_CHUNK).map(partial).for_each(add);
     }
     let widest = |c: &[DVec3]| {
         let of = |chunk: &[Arc]| widest_angles_of_arcs(c, chunk);
@@ -1247,42 +1248,35 @@ fn widest_angle(c: DVec3, points: impl Iterator<Item = DVec3>) -> f64 {
     w.widest
 }
 
-/// [`widest_angle`] over both endpoints of `arcs` in order, from each of up to two centres `cs`
-/// in one pass over the arcs (the first `cs.len()` results; the others are 0). A plain loop: the
-/// build runs this over every arc at every level, and through a `flat_map` over the pairs it was
-/// 22 % of a one-thread profile of the dragon's build, against 4 % then.
+/// [`widest_angle`] over both endpoints of `arcs`, from each of up to two centres `cs` in one pass
+/// over the arcs (the first `cs.len()` results; the others are 0), a group of 4 arcs at a time
+/// ([`Widest::add_group`]). The build runs this over every arc at every level.
 fn widest_angles_of_arcs(cs: &[DVec3], arcs: &[Arc]) -> [f64; 2] {
     let mut w = [Widest::default(), Widest::default()];
+    let cs = &cs[..cs.len().min(2)];
     #[cfg(target_arch = "x86_64")]
     #[allow(unsafe_code)]
     // SAFETY: the CPU has AVX, the one feature the function is compiled with.
     let arcs = if std::arch::is_x86_feature_detected!("avx") { unsafe { widest_avx(cs, arcs, &mut w) } } else { arcs };
-    match *cs {
-        [c] => {
-            for a in arcs {
-                w[0].add(c, a.n1);
-                w[0].add(c, a.n2);
+    for four in arcs.chunks(4) {
+        for (&c, w) in cs.iter().zip(w.iter_mut()) {
+            let mut dots = [f64::NAN; 8];
+            for (k, a) in four.iter().enumerate() {
+                dots[2 * k] = c.dot(a.n1);
+                dots[2 * k + 1] = c.dot(a.n2);
             }
+            w.add_group(c, &dots[..2 * four.len()], |k| if k % 2 == 0 { four[k / 2].n1 } else { four[k / 2].n2 });
         }
-        [c0, c1] => {
-            for a in arcs {
-                w[0].add(c0, a.n1);
-                w[0].add(c0, a.n2);
-                w[1].add(c1, a.n1);
-                w[1].add(c1, a.n2);
-            }
-        }
-        _ => {}
     }
     [w[0].widest, w[1].widest]
 }
 
 /// [`widest_angles_of_arcs`] on the arcs in whole groups of 4, into `w`; returns the arcs left.
-/// The dot products of 4 arcs' endpoints with each centre in one pass, and [`Widest::add`] on
-/// those arcs only where some endpoint comes within the slack of the smallest dot product so far:
-/// where none does, `add` would change nothing for any of them, so the state after each group is
-/// what the plain loop leaves, bit for bit (the dot products round as glam's, without FMA). Once
-/// the smallest so far is near the node's minimum, a group needs only the vector test.
+/// The 8 dot products of a group with each centre in one pass (rounded as glam's, without FMA,
+/// so the same bits as the scalar loop), their minimum across the lanes, and `atan2` only for the
+/// lanes [`Widest::add_group`] picks. Small nodes (most of them hold a handful of arcs) spent most
+/// of this function in `atan2` when every point of a group that came near the smallest dot product
+/// so far was measured.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Arc] {
@@ -1301,15 +1295,24 @@ fn widest_avx<'a>(cs: &[DVec3], arcs: &'a [Arc], w: &mut [Widest; 2]) -> &'a [Ar
                     _mm256_mul_pd(splat(c.z), z),
                 )
             };
-            let near = splat(w.cos_min + Widest::DOT_SLACK);
-            let close =
-                _mm256_or_pd(_mm256_cmp_pd::<_CMP_LE_OQ>(dot(n1), near), _mm256_cmp_pd::<_CMP_LE_OQ>(dot(n2), near));
-            if _mm256_movemask_pd(close) != 0 {
-                for a in four {
-                    w.add(c, a.n1);
-                    w.add(c, a.n2);
-                }
+            let (d1, d2) = (dot(n1), dot(n2));
+            // The smallest of the 8 (a minimum of non-NaN values in any order is the same value).
+            let m = _mm256_min_pd(d1, d2);
+            let m = _mm256_min_pd(m, _mm256_permute2f128_pd::<1>(m, m));
+            let m = _mm256_min_pd(m, _mm256_permute_pd::<0b0101>(m));
+            let smallest = _mm256_cvtsd_f64(m);
+            if smallest > w.cos_min + Widest::DOT_SLACK || smallest.is_nan() {
+                continue;
             }
+            let mut dots = [0f64; 8];
+            // SAFETY: `dots` holds 8 f64s; the stores are unaligned.
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm256_storeu_pd(dots.as_mut_ptr(), d1);
+                _mm256_storeu_pd(dots.as_mut_ptr().add(4), d2);
+            }
+            // Lane k of `d1` is arc k's first endpoint, lane k of `d2` its second.
+            w.add_group(c, &dots, |k| if k < 4 { four[k].n1 } else { four[k - 4].n2 });
         }
     }
     rest
@@ -1332,12 +1335,30 @@ impl Widest {
     /// angles are in the opposite order of their rounded dot products differ by less than this.
     const DOT_SLACK: f64 = 1e-15;
 
-    #[inline(always)]
+    #[cfg(test)]
     fn add(&mut self, c: DVec3, p: DVec3) {
-        let d = c.dot(p);
-        if d <= self.cos_min + Self::DOT_SLACK {
-            self.cos_min = self.cos_min.min(d);
-            self.widest = self.widest.max(c.cross(p).length().atan2(d));
+        self.add_group(c, &[c.dot(p)], |_| p);
+    }
+
+    /// Takes the points `point(k)` whose dot products with the centre `c` are `dots[k]`: the
+    /// smallest dot product so far is lowered to theirs, and the exact angle of a point is
+    /// measured only where its dot product is within [`Self::DOT_SLACK`] of that. A point outside
+    /// has a dot product beyond the slack above the smallest one seen by then, which stays above
+    /// the final smallest, so its angle is below that point's, which is measured: the widest angle
+    /// is the maximum over every point whichever way the points are grouped.
+    #[inline(always)]
+    fn add_group(&mut self, c: DVec3, dots: &[f64], point: impl Fn(usize) -> DVec3) {
+        let smallest = dots.iter().fold(f64::INFINITY, |m, &d| min(m, d));
+        // (NaN compares false: nothing to take.)
+        if smallest.is_nan() || smallest > self.cos_min + Self::DOT_SLACK {
+            return;
+        }
+        self.cos_min = self.cos_min.min(smallest);
+        let near = self.cos_min + Self::DOT_SLACK;
+        for (k, &d) in dots.iter().enumerate() {
+            if d <= near {
+                self.widest = self.widest.max(c.cross(point(k)).length().atan2(d));
+            }
         }
     }
 }
