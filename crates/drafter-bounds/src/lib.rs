@@ -51,6 +51,6 @@ pub use error::{BoundsError, ParamError};
 pub use hull::{ConvexHull, DEFAULT_HULL_TOLERANCE, HullDimension, HullOptions, convex_hull};
 pub use obb::{
     Coverage, DEFAULT_FACE_NORMALS, DEFAULT_OBB_METHOD, DEFAULT_OPTIMAL_BUDGET, Obb, ObbMethod, ObbOptions, ObbStats,
-    aabb, oriented_box, oriented_box_f32, oriented_box_with_stats, world_points,
+    aabb, box_with_axes, oriented_box, oriented_box_f32, oriented_box_with_stats, world_points,
 };
 pub use projector::{BIAS_MATRIX, Projector};

@@ -236,6 +236,15 @@ pub fn oriented_box_f32(points: &[Vec3], options: &ObbOptions) -> Result<Obb, Bo
     oriented_box(&points.iter().map(|p| p.as_dvec3()).collect::<Vec<_>>(), options)
 }
 
+/// The box of `points` along `axes` (orthonormalised, snapped to the world axes and ordered as
+/// every method's box is), recording `method`: where the orientation was found on other points,
+/// such as one mesh's for each of its instances ([`Obb`]'s extents and centre always come from
+/// `points` themselves, so the box holds them whatever `axes` are).
+pub fn box_with_axes(points: &[DVec3], axes: [DVec3; 3], method: ObbMethod) -> Result<Obb, BoundsError> {
+    let local = LocalPoints::new(points)?;
+    Ok(finish(&local, axes, method))
+}
+
 /// Object-space positions moved to world space in f64 (`world_from_object · p`).
 pub fn world_points(positions_in_object: &[Vec3], world_from_object: &DMat4) -> Vec<DVec3> {
     positions_in_object.iter().map(|p| world_from_object.transform_point3(p.as_dvec3())).collect()
