@@ -183,32 +183,23 @@ fn headers_claiming_more_than_the_file_holds() {
 #[test]
 fn geometry_listed_again_and_again_is_refused_before_it_is_built() {
     let dir = common::scratch("hostile-listed-again");
-    let mut bin = Vec::new();
-    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0] {
-        bin.extend_from_slice(&v.to_le_bytes());
-    }
-    for i in 0..10_002u16 {
-        bin.extend_from_slice(&(i % 4).to_le_bytes());
-    }
-    let uri =
-        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
-    let primitive = serde_json::json!({"attributes": {"POSITION": 0}, "indices": 1, "mode": 5});
-    let doc = serde_json::json!({
-        "asset": {"version": "2.0"},
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": vec![primitive; 2001]}],
-        "buffers": [{"byteLength": bin.len(), "uri": uri}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
-            {"buffer": 0, "byteOffset": 48, "byteLength": 20_004}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
-            {"bufferView": 1, "componentType": 5123, "count": 10_002, "type": "SCALAR"}
-        ]
+    // The one-triangle file, its indices a strip of 10,002 (cycling over its three vertices).
+    let strip: Vec<u8> = (0..10_002u16).flat_map(|i| (i % 3).to_le_bytes()).collect();
+    let doc = common::gltf_triangle(|j| {
+        let mut bin = base64::engine::general_purpose::STANDARD
+            .decode(j["buffers"][0]["uri"].as_str().expect("uri").split_once(',').expect("data URI").1)
+            .expect("base64");
+        bin.truncate(36);
+        bin.extend_from_slice(&strip);
+        let uri = base64::engine::general_purpose::STANDARD.encode(&bin);
+        j["buffers"][0] =
+            serde_json::json!({"byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{uri}")});
+        j["bufferViews"][1]["byteLength"] = strip.len().into();
+        j["accessors"][1]["count"] = 10_002.into();
+        let primitive = serde_json::json!({"attributes": {"POSITION": 0}, "indices": 1, "mode": 5});
+        j["meshes"][0]["primitives"] = serde_json::Value::Array(vec![primitive; 2001]);
     });
-    let file = write(&dir, "listed-again.gltf", &serde_json::to_vec(&doc).expect("json"));
+    let file = write(&dir, "listed-again.gltf", &doc);
     assert_rejected(
         &file,
         "/meshes/0/primitives/2000: the meshes list 20,010,000 triangles up to here, more than the limit of 20,000,000 (--max-triangles",
