@@ -746,19 +746,45 @@ fn canonical_meshes(scene: &Scene, parts: &Parts) -> Vec<usize> {
             && a.groups.len() == b.groups.len()
             && a.groups.iter().zip(&b.groups).all(|(x, y)| without_material(x) == without_material(y))
     };
-    let mut canonical: Vec<usize> = (0..scene.meshes.len()).collect();
-    let mut firsts: std::collections::BTreeMap<(usize, usize, usize), Vec<usize>> = Default::default();
+    // Meshes are compared only within a group of equal sizes and, where a size is shared, equal
+    // content hashes: many different meshes of one size (an OBJ of thousands of equal groups) must
+    // not be compared pairwise. A mesh whose size no other shares is not hashed at all.
+    let size = |mesh: &drafter_core::Mesh| (mesh.positions.len(), mesh.triangles.len(), mesh.groups.len());
+    let mut sizes: std::collections::BTreeMap<(usize, usize, usize), usize> = Default::default();
     for (m, mesh) in scene.meshes.iter().enumerate() {
-        if !used[m] {
-            continue;
+        if used[m] {
+            *sizes.entry(size(mesh)).or_default() += 1;
         }
-        let list = firsts.entry((mesh.positions.len(), mesh.triangles.len(), mesh.groups.len())).or_default();
+    }
+    let hashes: Vec<Option<u64>> = scene
+        .meshes
+        .par_iter()
+        .enumerate()
+        .map(|(m, mesh)| (used[m] && sizes[&size(mesh)] > 1).then(|| content_hash(mesh)))
+        .collect();
+    let mut canonical: Vec<usize> = (0..scene.meshes.len()).collect();
+    let mut firsts: std::collections::BTreeMap<u64, Vec<usize>> = Default::default();
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        let Some(hash) = hashes[m] else { continue };
+        let list = firsts.entry(hash).or_default();
         match list.iter().find(|&&c| same_labels(labels[c], labels[m]) && same_geometry(&scene.meshes[c], mesh)) {
             Some(&c) => canonical[m] = c,
             None => list.push(m),
         }
     }
     canonical
+}
+
+/// A hash of a mesh's positions and triangles (bit patterns), to find candidates for
+/// [`canonical_meshes`]; equal meshes are then compared in full.
+fn content_hash(mesh: &drafter_core::Mesh) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in &mesh.positions {
+        p.to_array().map(f32::to_bits).hash(&mut h);
+    }
+    mesh.triangles.hash(&mut h);
+    h.finish()
 }
 
 /// Gives every repeated mesh (see [`canonical_meshes`]) a copy of its first's result.
