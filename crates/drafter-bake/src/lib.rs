@@ -1078,34 +1078,19 @@ mod tests {
     use drafter_core::{Instance, MaterialId, Mesh, MeshId, SourceFormat};
     use glam::Vec3;
 
-    fn block(material: u32, top: f32) -> Mesh {
-        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]
-            .into_iter()
-            .chain([[0.0, 0.0, top], [1.0, 0.0, top], [1.0, 1.0, top], [0.0, 1.0, top]])
-            .map(Vec3::from_array)
-            .collect();
-        let triangles = vec![
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
+    /// A closed tetrahedron whose apex is at height `top`.
+    fn tetrahedron(material: u32, top: f32) -> Mesh {
+        let positions =
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.2, 0.2, top]].map(Vec3::from_array).to_vec();
+        let triangles = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
         let groups = vec![TriangleGroup {
             start: 0,
-            count: 12,
+            count: 4,
             material: Some(MaterialId(material)),
-            vertex_count: 8,
+            vertex_count: 4,
             ..Default::default()
         }];
-        Mesh { name: format!("block {material}"), positions, triangles, groups, ..Default::default() }
+        Mesh { name: format!("tetrahedron {material}"), positions, triangles, groups, ..Default::default() }
     }
 
     /// A mesh repeats the first used mesh with its geometry and parts, whatever its name and
@@ -1113,7 +1098,13 @@ mod tests {
     #[test]
     fn repeated_meshes_are_found() {
         let mut scene = Scene::new(SourceFormat::Obj);
-        scene.meshes = vec![block(0, 1.0), block(1, 1.0), block(0, 1.5), block(2, 1.0), block(3, 1.0)];
+        scene.meshes = vec![
+            tetrahedron(0, 1.0),
+            tetrahedron(1, 1.0),
+            tetrahedron(0, 1.5),
+            tetrahedron(2, 1.0),
+            tetrahedron(3, 1.0),
+        ];
         for m in [2, 0, 1, 0, 4] {
             let at = DMat4::from_translation(DVec3::new(3.0 * m as f64, 0.0, 0.0));
             scene.instances.push(Instance {

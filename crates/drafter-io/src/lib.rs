@@ -92,7 +92,7 @@ pub fn import_bytes_within(path: &Path, bytes: &[u8], limits: &Limits) -> Result
 }
 
 /// The error of a file that lists `triangles`, over `limits`.
-pub(crate) fn over_limit(triangles: u64, limits: &Limits) -> ParseError {
+fn over_limit(triangles: u64, limits: &Limits) -> ParseError {
     ParseError::in_file(format!(
         "{} triangles, more than the limit of {} (--max-triangles)",
         drafter_core::thousands(triangles.min(usize::MAX as u64) as usize),
