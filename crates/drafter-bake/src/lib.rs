@@ -309,8 +309,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         diagnostics.push(Diagnostic { kind: DiagnosticKind::Output, count: 1, first_example: note.clone() });
     }
 
-    let sections = drafter_format::byte_sections(&written.main, &|_| written.bin.clone())
-        .map_err(|e| BakeError::Internal { stage: "write", message: format!("the written file does not read: {e}") })?;
+    let sections = written.sections;
     let mut written = written;
     let compression = match (config.compress, &config.container) {
         (Compression::None, _) => None,

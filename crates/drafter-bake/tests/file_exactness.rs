@@ -47,6 +47,11 @@ fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
     let config = drafter_bake::BakeConfig { compress, ..Default::default() };
     let baked = drafter_bake::bake(&imported.scene, &config).expect("bakes");
     let bytes = baked.written.main;
+    if compress == drafter_bake::Compression::None {
+        // The writer's sections, taken from its document, are what a reader finds in the file.
+        let read = drafter_format::byte_sections(&bytes, &|_| None).expect("sections read");
+        assert_eq!(baked.report.sections, read, "{}", path.display());
+    }
     let file = drafter_format::read(&bytes, &|_| None).expect("reads");
     let scene = drafter_io::import_bytes(Path::new("baked.glb"), &bytes).expect("imports").scene;
     let mut hierarchies = 0;
@@ -211,4 +216,24 @@ fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
     let mean = |v: &[glam::Vec3]| v.iter().copied().sum::<glam::Vec3>() / v.len() as f32;
     assert!(mean(&na).distance(mean(&nb)) < 0.02, "{} vs {}", mean(&na), mean(&nb));
     assert!(check(&path, drafter_bake::Compression::Meshopt) > 0);
+}
+
+/// The byte sections in the bake's report come from the writer's own document; they must be what
+/// `drafter inspect` reads from the files, for both containers and a glTF source whose nodes
+/// carry the part records.
+#[test]
+fn reported_sections_are_read_back_from_both_containers() {
+    let imported = drafter_io::import(&model("gltf/2CylinderEngine/2CylinderEngine.gltf")).expect("imports");
+    for container in [drafter_format::Container::Glb, drafter_format::Container::Gltf { bin_uri: "out.bin".into() }] {
+        let config = drafter_bake::BakeConfig { container: container.clone(), ..Default::default() };
+        let baked = drafter_bake::bake(&imported.scene, &config).expect("bakes");
+        let bin = baked.written.bin.clone();
+        let read = drafter_format::byte_sections(&baked.written.main, &|uri| {
+            assert_eq!(uri, "out.bin");
+            bin.clone()
+        })
+        .expect("sections read");
+        assert_eq!(baked.report.sections, read, "{container:?}");
+        assert!(read.json > 0 && read.geometry > 0 && read.total > read.json, "{read:?}");
+    }
 }

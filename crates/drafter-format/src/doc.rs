@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
+use crate::reader::{ByteSections, sections_of};
 
 pub(crate) const ARRAY_BUFFER: u32 = 34962;
 pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
@@ -524,19 +525,122 @@ impl Doc {
         self.json.insert("buffers".into(), json!([buffer]));
     }
 
-    /// A .glb: header, JSON chunk (space padded), BIN chunk (zero padded).
-    pub fn into_glb(mut self) -> Result<Vec<u8>, FormatError> {
+    /// A .glb: header, JSON chunk (space padded), BIN chunk (zero padded); and its byte sections.
+    /// Node `n` gets `node_extension(n)` (if any) as its extension `name`, see [`NodeExtensions`].
+    pub fn into_glb(
+        mut self,
+        name: &str,
+        node_extension: NodeExtensionFn,
+    ) -> Result<(Vec<u8>, ByteSections), FormatError> {
         self.set_buffer(None);
-        let json = serde_json::to_vec(&Value::Object(std::mem::take(&mut self.json)))?;
-        drafter_core::glb::write(&json, &self.bin).map_err(FormatError::from)
+        let tree = std::mem::take(&mut self.json);
+        let json = serde_json::to_vec(&NodeExtensions::over(&tree, name, node_extension))?;
+        let glb = drafter_core::glb::write(&json, &self.bin).map_err(FormatError::from)?;
+        let sections = sections_of(&tree, json.len().next_multiple_of(4) as u64, glb.len() as u64);
+        Ok((glb, sections))
     }
 
-    /// A .gltf (pretty JSON) and its .bin, the buffer referring to `bin_uri`.
-    pub fn into_gltf(mut self, bin_uri: &str) -> Result<(Vec<u8>, Vec<u8>), FormatError> {
+    /// A .gltf (pretty JSON) and its .bin, the buffer referring to `bin_uri`; and their byte
+    /// sections. Node extensions as for [`Doc::into_glb`].
+    pub fn into_gltf(
+        mut self,
+        bin_uri: &str,
+        name: &str,
+        node_extension: NodeExtensionFn,
+    ) -> Result<(Vec<u8>, Vec<u8>, ByteSections), FormatError> {
         self.set_buffer(Some(bin_uri));
-        let mut json = serde_json::to_vec_pretty(&Value::Object(std::mem::take(&mut self.json)))?;
+        let tree = std::mem::take(&mut self.json);
+        let mut json = serde_json::to_vec_pretty(&NodeExtensions::over(&tree, name, node_extension))?;
         json.push(b'\n');
-        Ok((json, std::mem::take(&mut self.bin)))
+        let bin = std::mem::take(&mut self.bin);
+        let sections = sections_of(&tree, json.len() as u64, (json.len() + bin.len()) as u64);
+        Ok((json, bin, sections))
+    }
+}
+
+/// The extension object of node `n`, made when the node is serialised (`None`: the node keeps the
+/// extensions it has).
+pub(crate) type NodeExtensionFn<'a> = &'a dyn Fn(usize) -> Option<Result<Value, serde_json::Error>>;
+
+/// A document tree serialised with node `n`'s `extensions.<name>` set to `node_extension(n)`: the
+/// bytes `serde_json` writes for the tree with those objects inserted, without holding all of
+/// them at once (one node's at a time).
+struct NodeExtensions<'a> {
+    tree: &'a Map<String, Value>,
+    name: &'a str,
+    node_extension: NodeExtensionFn<'a>,
+}
+
+impl<'a> NodeExtensions<'a> {
+    fn over(tree: &'a Map<String, Value>, name: &'a str, node_extension: NodeExtensionFn<'a>) -> Self {
+        NodeExtensions { tree, name, node_extension }
+    }
+}
+
+impl serde::Serialize for NodeExtensions<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self.tree.get("nodes").and_then(Value::as_array) {
+            Some(nodes) => {
+                WithEntry { map: Some(self.tree), key: "nodes", value: NodesOut { nodes, of: self } }.serialize(s)
+            }
+            None => self.tree.serialize(s),
+        }
+    }
+}
+
+struct NodesOut<'a> {
+    nodes: &'a [Value],
+    of: &'a NodeExtensions<'a>,
+}
+
+impl serde::Serialize for NodesOut<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::{Error, SerializeSeq};
+        let mut seq = s.serialize_seq(Some(self.nodes.len()))?;
+        for (n, node) in self.nodes.iter().enumerate() {
+            match ((self.of.node_extension)(n), node) {
+                (Some(ext), Value::Object(_) | Value::Null) => {
+                    let ext = ext.map_err(S::Error::custom)?;
+                    let existing = node.get("extensions").and_then(Value::as_object);
+                    let extensions = WithEntry { map: existing, key: self.of.name, value: &ext };
+                    seq.serialize_element(&WithEntry { map: node.as_object(), key: "extensions", value: extensions })?;
+                }
+                _ => seq.serialize_element(node)?,
+            }
+        }
+        seq.end()
+    }
+}
+
+/// `map` (none: empty) with `key` set to `value`: replaced, or inserted where the map's sorted
+/// order puts it, as `serde_json` writes a `Map` that holds it.
+struct WithEntry<'a, V> {
+    map: Option<&'a Map<String, Value>>,
+    key: &'a str,
+    value: V,
+}
+
+impl<V: serde::Serialize> serde::Serialize for WithEntry<'_, V> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let empty = Map::new();
+        let map = self.map.unwrap_or(&empty);
+        let mut out = s.serialize_map(Some(map.len() + usize::from(!map.contains_key(self.key))))?;
+        let mut written = false;
+        for (k, v) in map {
+            if !written && k.as_str() >= self.key {
+                out.serialize_entry(self.key, &self.value)?;
+                written = true;
+                if k == self.key {
+                    continue;
+                }
+            }
+            out.serialize_entry(k, v)?;
+        }
+        if !written {
+            out.serialize_entry(self.key, &self.value)?;
+        }
+        out.end()
     }
 }
 
@@ -564,4 +668,63 @@ fn content_hash(bytes: &[u8], target: Option<u32>, stride: Option<usize>) -> u64
     h = step(h, u64::from_le_bytes(last));
     h = step(h, target.map_or(u64::MAX, u64::from));
     step(h, stride.map_or(u64::MAX, |s| s as u64))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tree with node `n`'s `extensions.<name>` set to `ext(n)` (or the node left as it is), as
+    /// the writer built it before [`NodeExtensions`]: the reference.
+    fn inserted(tree: &Map<String, Value>, name: &str, ext: &dyn Fn(usize) -> Option<Value>) -> Value {
+        let mut tree = tree.clone();
+        if let Some(Value::Array(nodes)) = tree.get_mut("nodes") {
+            for (n, node) in nodes.iter_mut().enumerate() {
+                if let Some(e) = ext(n) {
+                    if !node["extensions"].is_object() {
+                        node["extensions"] = json!({});
+                    }
+                    node["extensions"][name] = e;
+                }
+            }
+        }
+        Value::Object(tree)
+    }
+
+    #[test]
+    fn node_extensions_serialise_as_the_tree_that_holds_them() {
+        let ours =
+            |n: usize| (n != 4).then(|| json!({"parts": [{"id": n, "name": format!("p{n}"), "v": [1.5, -0.0]}]}));
+        let node_cases = [
+            json!({"mesh": 0, "name": "plain"}),
+            json!({"children": [2, 3], "extensions": {"AAA_first": {"x": 1}, "ZZZ_last": true}, "mesh": 1}),
+            json!({"extensions": {"DRAFTER_illustration": {"stale": 1}, "KHR_other": {}}, "matrix": [1, 0]}),
+            json!({"camera": 0, "extensions": 7}),
+            json!({"a": 1, "z": 2}),
+            Value::Null,
+            json!({}),
+            json!({"extensions": {}}),
+        ];
+        let mut tree = Map::new();
+        tree.insert("asset".into(), json!({"version": "2.0"}));
+        tree.insert("nodes".into(), Value::Array(node_cases.to_vec()));
+        tree.insert("scenes".into(), json!([{"nodes": [0]}]));
+        let name = "DRAFTER_illustration";
+        let made = |n: usize| ours(n).map(Ok);
+        let expected = inserted(&tree, name, &ours);
+        let written = NodeExtensions::over(&tree, name, &made);
+        assert_eq!(serde_json::to_string(&written).unwrap(), serde_json::to_string(&expected).unwrap());
+        assert_eq!(serde_json::to_string_pretty(&written).unwrap(), serde_json::to_string_pretty(&expected).unwrap());
+        // No node extensions, and a tree without nodes: the tree as it is.
+        let none = |_: usize| None;
+        assert_eq!(
+            serde_json::to_string(&NodeExtensions::over(&tree, name, &none)).unwrap(),
+            serde_json::to_string(&tree).unwrap()
+        );
+        tree.remove("nodes");
+        assert_eq!(
+            serde_json::to_string(&NodeExtensions::over(&tree, name, &made)).unwrap(),
+            serde_json::to_string(&tree).unwrap()
+        );
+    }
 }

@@ -219,6 +219,13 @@ pub struct NodeExtension {
     pub parts: Vec<PartRecord>,
 }
 
+/// [`NodeExtension`] over borrowed parts, as the writer serialises it: the same JSON.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+pub(crate) struct NodeExtensionRef<'a> {
+    pub parts: &'a [PartRecord],
+}
+
 /// Everything baked for one part.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]

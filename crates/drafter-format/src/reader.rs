@@ -558,6 +558,14 @@ pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -
         Some(_) => load_buffer(&doc, None, external)?.map_or(0, |b| b.len() as u64),
         None => 0,
     };
+    let empty = serde_json::Map::new();
+    Ok(sections_of(doc.as_object().unwrap_or(&empty), json.len() as u64, bytes.len() as u64 + external_bytes))
+}
+
+/// [`ByteSections`] of the document `doc`, whose JSON takes `json` bytes of a file (or a .glb and
+/// its .bin) of `total` bytes. The writer calls this on the document it has just serialised, so the
+/// bake's report does not parse the file back.
+pub(crate) fn sections_of(doc: &serde_json::Map<String, Value>, json: u64, total: u64) -> ByteSections {
     let views = doc.get("bufferViews").and_then(Value::as_array).map_or(&[][..], Vec::as_slice);
     let mut counted = vec![false; views.len()];
     let mut count_view = |view: Option<u64>, into: &mut u64| {
@@ -570,8 +578,7 @@ pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -
     let view_of = |accessor: &Value| {
         accessor.as_u64().and_then(|a| doc.get("accessors")?.get(a as usize)?.get("bufferView")?.as_u64())
     };
-    let mut s =
-        ByteSections { json: json.len() as u64, total: bytes.len() as u64 + external_bytes, ..Default::default() };
+    let mut s = ByteSections { json, total, ..Default::default() };
     let enhanced = crate::ext::ENHANCED_NORMAL_ATTRIBUTE;
     for mesh in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
         for prim in mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
@@ -612,5 +619,5 @@ pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -
     }
     let named = s.geometry + s.normals + s.khronos_edges + s.labels + s.hierarchies + s.textures + s.json;
     s.other = s.total.saturating_sub(named);
-    Ok(s)
+    s
 }
