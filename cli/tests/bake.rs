@@ -311,6 +311,26 @@ fn failures_leave_no_output_and_exit_2() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no such part"));
+    // An anchor or scale that leaves no gradient (it used to be written as an all-zero projector).
+    for bad in [
+        "anchor = [1e300, 0.0, 0.0]",
+        "scale = 1e-300",
+        "anchor = [0.0, 1e39, 0.0]",
+        "anchor = [1.0, 0.0, 0.0]\nscale = 1e39",
+    ] {
+        std::fs::write(&config, format!("[[part]]\nid = 0\n{bad}\n")).expect("config");
+        let out = common::run(&[
+            "bake",
+            repo().join("samples/gear.glb").to_str().expect("utf-8"),
+            "-o",
+            output.to_str().expect("utf-8"),
+            "--config",
+            config.to_str().expect("utf-8"),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(stderr.contains("gives no gradient") && stderr.lines().count() == 1, "{bad}: {stderr}");
+    }
     // Unreadable input.
     let garbage = dir.join("garbage.stl");
     std::fs::write(&garbage, b"solid x\nfacet normal\n").expect("garbage");

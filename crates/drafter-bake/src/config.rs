@@ -57,7 +57,9 @@
 //! flat = 0.0                 # a flat grey in [0, 1] instead of shading (0 black, 1 white)
 //! ```
 //!
-//! Unknown keys and out-of-range values are errors that name the key.
+//! Unknown keys and out-of-range values are errors that name the key. An `anchor` and `scale` that
+//! leave a part no gradient (a scale at or below 1e-12 of the anchor's largest coordinate, or either
+//! beyond `f32`) are refused when the part's projector is made.
 
 use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
 use drafter_format::{Container, InputInfo, PartStyle};

@@ -901,6 +901,15 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                 style = o.style.or(style);
                 flat = o.flat.map(f64::from).or(flat);
             }
+            if overrides.iter().any(|o| o.anchor.is_some() || o.scale.is_some()) && projector.is_degenerate() {
+                return Err(BakeError::Config(format!(
+                    "[[part]] for part {p} ({}): anchor {:?} with scale {} gives no gradient (the scale must \
+                     exceed 1e-12 of the anchor's largest coordinate, and both must fit in f32)",
+                    part.name,
+                    projector.anchor.to_array(),
+                    projector.scale
+                )));
+            }
             Ok(PartRecord {
                 id: p as u32,
                 name: part.name.clone(),

@@ -85,6 +85,14 @@ impl Projector {
         Ok(())
     }
 
+    /// Whether the projector gives no gradient: a scale at or below 1e-12 of the anchor's largest
+    /// coordinate (or not finite) makes [`Self::matrix`] map every point to the same `p`, and an
+    /// anchor or scale beyond `f32` gives matrix entries a renderer cannot hold.
+    pub fn is_degenerate(&self) -> bool {
+        let fits_f32 = self.anchor.as_vec3().is_finite() && (self.scale as f32).is_finite();
+        self.inverse_scale() == 0.0 || !fits_f32 || !self.matrix_f32().is_finite()
+    }
+
     /// `1/s`, or 0 for a degenerate scale (≤ 1e-12 of the anchor's magnitude, or not finite).
     fn inverse_scale(&self) -> f64 {
         let floor = 1e-12 * self.anchor.abs().max_element().max(1e-300);
@@ -138,6 +146,24 @@ mod tests {
 
     fn test_obb(center: DVec3, axes: [DVec3; 3], half: DVec3) -> Obb {
         Obb { center, axes, half_extents: half, volume: 8.0 * half.x * half.y * half.z, method: ObbMethod::Optimal }
+    }
+
+    #[test]
+    fn degenerate_projectors_are_told_apart() {
+        let obb = test_obb(DVec3::new(3.0, -1.0, 2.0), [DVec3::X, DVec3::Y, DVec3::Z], DVec3::new(2.0, 1.0, 0.5));
+        let fitted = Projector::from_obb(&obb, DVec3::ZERO);
+        assert!(!fitted.is_degenerate());
+        assert!(!Projector { anchor: DVec3::new(1e30, 0.0, 0.0), scale: 1e20, ..fitted }.is_degenerate());
+        for bad in [
+            Projector { anchor: DVec3::new(1e300, 0.0, 0.0), ..fitted },
+            Projector { anchor: DVec3::new(0.0, 1e39, 0.0), scale: 1e30, ..fitted },
+            Projector { scale: 0.0, ..fitted },
+            Projector { scale: 1e-300, ..fitted },
+            Projector { scale: 1e39, ..fitted },
+            Projector { scale: f64::NAN, ..fitted },
+        ] {
+            assert!(bad.is_degenerate(), "{bad:?}");
+        }
     }
 
     #[test]
