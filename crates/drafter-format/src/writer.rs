@@ -299,8 +299,8 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     let node_of = |i: usize| scene.instances[i].node.map_or(i, |n| n.index());
     // The part records join their nodes only as the document is serialised, one node at a time
     // (`node_extension` below): as a JSON tree beside the rest they were most of the writer's
-    // memory and time on assemblies of many parts (20,000 one-triangle objects: 420 MB at the
-    // peak).
+    // memory and time on assemblies of many parts (20,000 one-triangle objects: a 435 MB peak,
+    // 328 MB this way; docs/bench.md, "Many parts").
     let mut node_parts: Vec<Option<&[PartRecord]>> = vec![None; doc.array("nodes").len()];
     for (i, parts) in out.instance_parts.iter().enumerate() {
         let slot = node_parts
