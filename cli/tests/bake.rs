@@ -331,6 +331,22 @@ fn failures_leave_no_output_and_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
         assert!(stderr.contains("gives no gradient") && stderr.lines().count() == 1, "{bad}: {stderr}");
     }
+    // A point-like part has no gradient of its own: the anchor and scale that `drafter view`
+    // exports for it (its own) still bake.
+    let point = dir.join("point.obj");
+    std::fs::write(&point, "v 1e6 1e6 1e6\nv 1e6 1e6 1e6\nv 1e6 1e6 1e6\nf 1 2 3\n").expect("obj");
+    std::fs::write(&config, "[[part]]\nid = 0\nanchor = [1e6, 1e6, 1e6]\nscale = 0.0000001\n").expect("config");
+    let baked = dir.join("point.glb");
+    let out = common::run(&[
+        "bake",
+        point.to_str().expect("utf-8"),
+        "-o",
+        baked.to_str().expect("utf-8"),
+        "--config",
+        config.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::remove_file(&baked).expect("baked");
     // Unreadable input.
     let garbage = dir.join("garbage.stl");
     std::fs::write(&garbage, b"solid x\nfacet normal\n").expect("garbage");

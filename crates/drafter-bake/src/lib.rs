@@ -877,7 +877,8 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                 None => oriented_box(&points, &ObbOptions { method, ..config.obb }),
             }
             .map_err(|e| BakeError::Internal { stage: "bounds", message: format!("part {p} ({}): {e}", part.name) })?;
-            let mut projector = Projector::from_obb(&obb, center);
+            let fitted = Projector::from_obb(&obb, center);
+            let mut projector = fitted;
             let mut gradient = config.gradient;
             let mut transfer = config.transfer;
             let mut style = None;
@@ -901,7 +902,12 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
                 style = o.style.or(style);
                 flat = o.flat.map(f64::from).or(flat);
             }
-            if overrides.iter().any(|o| o.anchor.is_some() || o.scale.is_some()) && projector.is_degenerate() {
+            // Only where the override made it so: a point-like part's own projector is degenerate
+            // and drawn flat, and `drafter view` exports every part's anchor and scale.
+            if overrides.iter().any(|o| o.anchor.is_some() || o.scale.is_some())
+                && projector.is_degenerate()
+                && !fitted.is_degenerate()
+            {
                 return Err(BakeError::Config(format!(
                     "[[part]] for part {p} ({}): anchor {:?} with scale {} gives no gradient (the scale must \
                      exceed 1e-12 of the anchor's largest coordinate, and both must fit in f32)",

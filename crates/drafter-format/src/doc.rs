@@ -609,14 +609,19 @@ impl serde::Serialize for NodesOut<'_> {
         use serde::ser::{Error, SerializeSeq};
         let mut seq = s.serialize_seq(Some(self.nodes.len()))?;
         for (n, node) in self.nodes.iter().enumerate() {
-            match ((self.of.node_extension)(n), node) {
-                (Some(ext), Value::Object(_) | Value::Null) => {
+            match (self.of.node_extension)(n) {
+                Some(ext) => {
                     let ext = ext.map_err(S::Error::custom)?;
+                    if !(node.is_object() || node.is_null()) {
+                        return Err(S::Error::custom(format!(
+                            "node {n} is not an object; its part records have no place"
+                        )));
+                    }
                     let existing = node.get("extensions").and_then(Value::as_object);
                     let extensions = WithEntry { map: existing, key: self.of.name, value: &ext };
                     seq.serialize_element(&WithEntry { map: node.as_object(), key: "extensions", value: extensions })?;
                 }
-                _ => seq.serialize_element(node)?,
+                None => seq.serialize_element(node)?,
             }
         }
         seq.end()
@@ -724,8 +729,8 @@ mod tests {
 
     #[test]
     fn node_extensions_serialise_as_the_tree_that_holds_them() {
-        let ours =
-            |n: usize| (n != 4).then(|| json!({"parts": [{"id": n, "name": format!("p{n}"), "v": [1.5, -0.0]}]}));
+        // Every node but the last gets an extension; the cases put `extensions` and our key first,
+        // between and after the existing keys, in place of an old one and of a non-object.
         let node_cases = [
             json!({"mesh": 0, "name": "plain"}),
             json!({"children": [2, 3], "extensions": {"AAA_first": {"x": 1}, "ZZZ_last": true}, "mesh": 1}),
@@ -735,7 +740,14 @@ mod tests {
             Value::Null,
             json!({}),
             json!({"extensions": {}}),
+            json!({"camera": 0, "children": [1]}),
+            json!({"extensions": {"AAA": 1, "DRAFTER_": 2, "DRAFTER_illustrationX": 3, "drafter_illustration": 4}}),
+            json!({"extensions": {"DRAFTER_illustrationX": 3}, "mesh": 2}),
+            json!({"mesh": 3}),
         ];
+        let last = node_cases.len() - 1;
+        let ours =
+            |n: usize| (n != last).then(|| json!({"parts": [{"id": n, "name": format!("p{n}"), "v": [1.5, -0.0]}]}));
         let mut tree = Map::new();
         tree.insert("asset".into(), json!({"version": "2.0"}));
         tree.insert("nodes".into(), Value::Array(node_cases.to_vec()));
@@ -752,6 +764,14 @@ mod tests {
             serde_json::to_string(&NodeExtensions::over(&tree, name, &none)).unwrap(),
             serde_json::to_string(&tree).unwrap()
         );
+        // A record that cannot be made, or a node that cannot hold one, fails the serialisation.
+        let failing = |n: usize| (n == 2).then(|| Err(serde::ser::Error::custom("no record")));
+        assert!(serde_json::to_string(&NodeExtensions::over(&tree, name, &failing)).is_err());
+        let mut odd = tree.clone();
+        odd.insert("nodes".into(), json!([{"mesh": 0}, 7]));
+        assert!(serde_json::to_string(&NodeExtensions::over(&odd, name, &made)).is_err());
+        let first_only = |n: usize| if n == 0 { made(n) } else { None };
+        assert!(serde_json::to_string(&NodeExtensions::over(&odd, name, &first_only)).is_ok());
         tree.remove("nodes");
         assert_eq!(
             serde_json::to_string(&NodeExtensions::over(&tree, name, &made)).unwrap(),

@@ -441,6 +441,37 @@ pub struct ConeBvhRecord {
 mod tests {
     use super::*;
 
+    /// The writer's borrowed node object is the reader's `NodeExtension`, key for key.
+    #[test]
+    fn the_borrowed_node_extension_writes_what_is_read() {
+        let part = |id: u32, style: Option<PartStyle>, flat: Option<f64>| PartRecord {
+            id,
+            name: format!("part {id}"),
+            triangles: 12,
+            obb: BoxRecord {
+                center: [1.0, -2.0, 3.5],
+                axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                half_extents: [0.5, 0.25, -0.0],
+                volume: 0.0,
+                method: ObbMethod::ALL[0],
+            },
+            projector: ProjectorRecord {
+                anchor: [1.0, -2.0, 3.5],
+                direction: [1.0, 0.0, 0.0],
+                scale: 1.0,
+                matrix: std::array::from_fn(|i| i as f64 * 0.1),
+            },
+            gradient: GradientRecord { q: 10.0, f: 0.5, p: 1.0, transfer: TransferCurve::default() },
+            style,
+            flat,
+        };
+        let parts = vec![part(0, None, None), part(1, Some(PartStyle::Metal), Some(0.25))];
+        let borrowed = serde_json::to_value(NodeExtensionRef { parts: &parts }).expect("serialises");
+        assert_eq!(borrowed, serde_json::to_value(NodeExtension { parts: parts.clone() }).expect("serialises"));
+        let read: NodeExtension = serde_json::from_value(borrowed).expect("reads");
+        assert_eq!(read.parts, parts);
+    }
+
     /// The names the code prints are the JSON spellings, and both are the schema's enumerations.
     #[test]
     fn enum_names_are_their_json_spelling_and_the_schemas() {
