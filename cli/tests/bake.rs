@@ -299,16 +299,21 @@ fn failures_leave_no_output_and_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
         assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1, "{args:?}");
     }
+    // `bake INPUT -o OUTPUT --config bad.toml`.
+    let with_config = |input: &Path, output: &Path| {
+        common::run(&[
+            "bake",
+            input.to_str().expect("utf-8"),
+            "-o",
+            output.to_str().expect("utf-8"),
+            "--config",
+            config.to_str().expect("utf-8"),
+        ])
+    };
+    let gear = repo().join("samples/gear.glb");
     // A part override that matches nothing is bad input too.
     std::fs::write(&config, "[[part]]\nname = \"no such part\"\nstyle = \"metal\"\n").expect("config");
-    let out = common::run(&[
-        "bake",
-        repo().join("samples/gear.glb").to_str().expect("utf-8"),
-        "-o",
-        output.to_str().expect("utf-8"),
-        "--config",
-        config.to_str().expect("utf-8"),
-    ]);
+    let out = with_config(&gear, &output);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no such part"));
     // An anchor or scale that leaves no gradient (it used to be written as an all-zero projector).
@@ -319,14 +324,7 @@ fn failures_leave_no_output_and_exit_2() {
         "anchor = [1.0, 0.0, 0.0]\nscale = 1e39",
     ] {
         std::fs::write(&config, format!("[[part]]\nid = 0\n{bad}\n")).expect("config");
-        let out = common::run(&[
-            "bake",
-            repo().join("samples/gear.glb").to_str().expect("utf-8"),
-            "-o",
-            output.to_str().expect("utf-8"),
-            "--config",
-            config.to_str().expect("utf-8"),
-        ]);
+        let out = with_config(&gear, &output);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
         assert!(stderr.contains("gives no gradient") && stderr.lines().count() == 1, "{bad}: {stderr}");
@@ -337,14 +335,7 @@ fn failures_leave_no_output_and_exit_2() {
     std::fs::write(&point, "v 1e6 1e6 1e6\nv 1e6 1e6 1e6\nv 1e6 1e6 1e6\nf 1 2 3\n").expect("obj");
     std::fs::write(&config, "[[part]]\nid = 0\nanchor = [1e6, 1e6, 1e6]\nscale = 0.0000001\n").expect("config");
     let baked = dir.join("point.glb");
-    let out = common::run(&[
-        "bake",
-        point.to_str().expect("utf-8"),
-        "-o",
-        baked.to_str().expect("utf-8"),
-        "--config",
-        config.to_str().expect("utf-8"),
-    ]);
+    let out = with_config(&point, &baked);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     std::fs::remove_file(&baked).expect("baked");
     // Unreadable input.
