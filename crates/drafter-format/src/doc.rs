@@ -192,7 +192,8 @@ impl Doc {
     fn push_accessor(&mut self, accessor: Value) -> usize {
         // Only an accessor on a buffer view that an earlier push used can repeat one, and views are
         // mostly new: the JSON text is formatted only then (formatting every accessor to key a map
-        // was a tenth of the write stage for 20,000 small meshes).
+        // was about a sixth of the write stage for 20,000 small meshes: 13 % of a one-thread
+        // profile against the stage's 73 %).
         let view = accessor.get("bufferView").and_then(Value::as_u64);
         if let Some(earlier) = view.and_then(|v| self.pushed_accessors.get(&v)) {
             // Compared as text, as written: `Value`'s `==` takes -0.0 for 0.0.
