@@ -21,12 +21,15 @@
 //! Binary OFF (`OFF BINARY`), 4D and n-dimensional OFF (`4OFF`, `nOFF`), a vertex line with fewer
 //! than 3 numbers, a token that is not a number, a face with fewer than 3 vertices or fewer indices
 //! than it announces, a negative index or one `>=` the vertex count, a file that ends before the
-//! counts are met, and counts the rest of the file cannot hold.
+//! counts are met, and counts the rest of the file cannot hold (blamed on the header line, unless a
+//! record before the end is malformed itself: a face `2 0 1` is shorter than any valid face, and
+//! its own line is the better place to point at).
 //!
 //! # Safety rules
 //! Nothing is allocated by a count until the bytes left can back it: a vertex takes at least 6
 //! bytes (`0 0 0` and a separator), a face at least 8 (`3 0 1 2` and a separator), so a 100-byte
-//! file claiming 4e9 vertices fails at once. Other allocations grow with the bytes actually read.
+//! file claiming 4e9 vertices reserves room for at most 16 and fails at the end of its records.
+//! Other allocations grow with the bytes actually read.
 //! Bytes are reached only through `get`, counts through checked conversions: no input panics.
 
 use crate::error::ParseError;
@@ -34,9 +37,9 @@ use crate::raw::RawMesh;
 
 use text::{Tokens, fits, parse_f32, parse_i64, show};
 
-/// Fewest bytes a vertex line can take: three one-digit numbers and their separators.
+/// Fewest bytes a valid vertex line can take: three one-digit numbers and their separators.
 const MIN_VERTEX_BYTES: u64 = 6;
-/// Fewest bytes a face line can take: `3 0 1 2` and its separators.
+/// Fewest bytes a valid face line can take: `3 0 1 2` and its separators.
 const MIN_FACE_BYTES: u64 = 8;
 
 pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
@@ -59,30 +62,62 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
             format!("header says {vertex_count} vertices; 32-bit indices address at most {}", u32::MAX),
         ));
     }
-    if !fits(vertex_count, MIN_VERTEX_BYTES, text_room(&tokens)) {
-        return Err(ParseError::at_line(
-            counts_line,
-            format!(
-                "header says {vertex_count} vertices but the {} bytes left can hold at most {}",
-                tokens.remaining(),
-                text_room(&tokens) / MIN_VERTEX_BYTES
-            ),
-        ));
-    }
-    let positions = read_vertices(&mut tokens, vertex_count)?;
-
-    if !fits(face_count, MIN_FACE_BYTES, text_room(&tokens)) {
-        return Err(ParseError::at_line(
-            counts_line,
-            format!(
-                "header says {face_count} faces but the {} bytes after the vertices can hold at most {}",
-                tokens.remaining(),
-                text_room(&tokens) / MIN_FACE_BYTES
-            ),
-        ));
-    }
-    let triangles = read_faces(&mut tokens, face_count, vertex_count)?;
+    // A count the bytes left cannot back is refused at the header line, unless a record before the
+    // end of the file is malformed itself (a face `2 0 1` is shorter than any valid face): that
+    // record's line is the better place to point at.
+    let budget = Budget::of(&tokens, vertex_count, MIN_VERTEX_BYTES, counts_line);
+    let positions = read_vertices(&mut tokens, vertex_count, budget.capacity).map_err(|fault| {
+        budget.blame(fault, |room, most| {
+            format!("header says {vertex_count} vertices but the {room} bytes left can hold at most {most}")
+        })
+    })?;
+    let budget = Budget::of(&tokens, face_count, MIN_FACE_BYTES, counts_line);
+    let triangles = read_faces(&mut tokens, face_count, vertex_count, budget.capacity).map_err(|fault| {
+        budget.blame(fault, |room, most| {
+            format!("header says {face_count} faces but the {room} bytes after the vertices can hold at most {most}")
+        })
+    })?;
     Ok(RawMesh { positions, triangles, normals: None })
+}
+
+/// Why a list of records could not be read.
+enum Fault {
+    /// A record is malformed: its own line is to blame.
+    Record(ParseError),
+    /// The file ended before the count was met.
+    End(ParseError),
+}
+
+/// Whether the bytes left can back a list's count ([`fits`]), and the capacity to reserve: the
+/// count where they can, otherwise as many records of the smallest valid size as the bytes hold.
+struct Budget {
+    fits: bool,
+    capacity: usize,
+    /// The bytes left and the most records they hold, for the header's message.
+    room: (usize, u64),
+    /// The line of the header's counts.
+    counts_line: usize,
+}
+
+impl Budget {
+    fn of(tokens: &Tokens<'_>, count: u64, min_bytes: u64, counts_line: usize) -> Budget {
+        let room = text_room(tokens);
+        let fits = fits(count, min_bytes, room);
+        let most = room / min_bytes;
+        // `fits` has bounded the count by the file length, so it also fits a usize.
+        let capacity = usize::try_from(if fits { count } else { most }).unwrap_or(0);
+        Budget { fits, capacity, room: (tokens.remaining(), most), counts_line }
+    }
+
+    /// The error to report for `fault`: a file that ends before a count it could never hold is
+    /// the header's fault (`header(room, most)` says so), anything else the record's.
+    fn blame(&self, fault: Fault, header: impl Fn(usize, u64) -> String) -> ParseError {
+        match fault {
+            Fault::Record(e) => e,
+            Fault::End(e) if self.fits => e,
+            Fault::End(_) => ParseError::at_line(self.counts_line, header(self.room.0, self.room.1)),
+        }
+    }
 }
 
 /// Bytes available to records, counting the separator the last record may lack.
@@ -115,16 +150,14 @@ fn read_count(tokens: &mut Tokens<'_>, what: &str) -> Result<u64, ParseError> {
     count.ok_or_else(|| ParseError::at_line(tokens.line(), format!("expected the {what} count, found {}", show(token))))
 }
 
-fn read_vertices(tokens: &mut Tokens<'_>, count: u64) -> Result<Vec<[f32; 3]>, ParseError> {
-    // `fits` has bounded `count` by the file length, so it also fits a usize.
-    let capacity = usize::try_from(count).unwrap_or(0);
+fn read_vertices(tokens: &mut Tokens<'_>, count: u64, capacity: usize) -> Result<Vec<[f32; 3]>, Fault> {
     let mut positions = Vec::with_capacity(capacity);
     for i in 0..count {
         let first = tokens.next_token().ok_or_else(|| {
-            ParseError::at_line(
+            Fault::End(ParseError::at_line(
                 tokens.line(),
                 format!("unexpected end of file in vertex list (read {i} of {count} vertices)"),
-            )
+            ))
         })?;
         let line = tokens.line();
         let mut position = [0.0f32; 3];
@@ -133,11 +166,14 @@ fn read_vertices(tokens: &mut Tokens<'_>, count: u64) -> Result<Vec<[f32; 3]>, P
                 first
             } else {
                 tokens.next_on_line().ok_or_else(|| {
-                    ParseError::at_line(line, format!("vertex {i}: expected 3 coordinates, found {k}"))
+                    Fault::Record(ParseError::at_line(line, format!("vertex {i}: expected 3 coordinates, found {k}")))
                 })?
             };
             *coordinate = parse_f32(token).ok_or_else(|| {
-                ParseError::at_line(line, format!("vertex {i}: expected a number, found {}", show(token)))
+                Fault::Record(ParseError::at_line(
+                    line,
+                    format!("vertex {i}: expected a number, found {}", show(token)),
+                ))
             })?;
         }
         tokens.skip_line(); // colour, normal or texture columns
@@ -146,31 +182,35 @@ fn read_vertices(tokens: &mut Tokens<'_>, count: u64) -> Result<Vec<[f32; 3]>, P
     Ok(positions)
 }
 
-fn read_faces(tokens: &mut Tokens<'_>, count: u64, vertex_count: u64) -> Result<Vec<[u32; 3]>, ParseError> {
-    let capacity = usize::try_from(count).unwrap_or(0);
+fn read_faces(tokens: &mut Tokens<'_>, count: u64, vertex_count: u64, capacity: usize) -> Result<Vec<[u32; 3]>, Fault> {
     let mut triangles = Vec::with_capacity(capacity);
     for face in 0..count {
         let first = tokens.next_token().ok_or_else(|| {
-            ParseError::at_line(
+            Fault::End(ParseError::at_line(
                 tokens.line(),
                 format!("unexpected end of file in face list (read {face} of {count} faces)"),
-            )
+            ))
         })?;
         let line = tokens.line();
         let corners = parse_i64(first).ok_or_else(|| {
-            ParseError::at_line(line, format!("face {face}: expected a vertex count, found {}", show(first)))
+            Fault::Record(ParseError::at_line(
+                line,
+                format!("face {face}: expected a vertex count, found {}", show(first)),
+            ))
         })?;
         if corners < 3 {
-            return Err(ParseError::at_line(
+            return Err(Fault::Record(ParseError::at_line(
                 line,
                 format!("face {face} has {corners} vertices; a face needs at least 3"),
-            ));
+            )));
         }
-        let mut index = |k: i64| -> Result<u32, ParseError> {
+        let mut index = |k: i64| -> Result<u32, Fault> {
             let token = tokens.next_on_line().ok_or_else(|| {
                 ParseError::at_line(line, format!("face {face}: expected {corners} vertex indices, found {k}"))
-            })?;
-            vertex_index(token, face, vertex_count).map_err(|message| ParseError::at_line(line, message))
+            });
+            token
+                .and_then(|t| vertex_index(t, face, vertex_count).map_err(|message| ParseError::at_line(line, message)))
+                .map_err(Fault::Record)
         };
         let apex = index(0)?;
         let mut previous = index(1)?;
@@ -443,6 +483,31 @@ OFF
         // ... or, when they still fit, the face that is cut short.
         let (line, message) = line_of(read(&full[..last_face - 2]));
         assert_eq!((line, message.as_str()), (19, "face 5: expected 4 vertex indices, found 3"));
+    }
+
+    /// A record too short to be valid makes the counts look too large for the file: the record's
+    /// line is blamed, not the header's (the fuzzing notes had `2 0 1` blamed on the face count).
+    #[test]
+    fn a_short_record_is_blamed_rather_than_the_counts() {
+        let cases: [(&[u8], (usize, &str)); 4] = [
+            (b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", (6, "face 0 has 2 vertices; a face needs at least 3")),
+            (
+                b"OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n3 0 1 2\n",
+                (6, "face 0 has 2 vertices; a face needs at least 3"),
+            ),
+            (b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1 0\n", (6, "face 0 has 1 vertices; a face needs at least 3")),
+            (b"OFF\n2 0 0\n0 0\n1\n", (3, "vertex 0: expected 3 coordinates, found 2")),
+        ];
+        for (text, expected) in cases {
+            let (line, message) = line_of(read(text));
+            assert_eq!((line, message.as_str()), expected, "{}", String::from_utf8_lossy(text));
+        }
+        // A file that ends before counts it could never hold still blames the header.
+        let (line, message) = line_of(read(b"OFF\n3 5 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+        assert_eq!(
+            (line, message.as_str()),
+            (2, "header says 5 faces but the 8 bytes after the vertices can hold at most 1")
+        );
     }
 
     #[test]
