@@ -362,16 +362,31 @@ fn table(r: &Report) -> String {
     for m in &r.meshes {
         let _ = writeln!(
             out,
-            "  mesh {:>4}: {:>3} instance(s), {:>9} candidates, {} in {:.0} ms, {:?}",
+            "  mesh {:>4}: {:>3} instance(s), {:>9} candidates, {} in {:.0} ms, {}",
             m.mesh,
             m.instances,
             m.candidates,
             if r.hierarchies == "stored" { "loaded" } else { "built" },
             m.build_ms,
-            m.choice
+            describe(&m.choice)
         );
     }
     out
+}
+
+/// A hierarchy choice in words: what answers the views, its size, and the speedup the cost model
+/// predicted where the index was built here (a file does not store it).
+fn describe(choice: &HierarchyChoice) -> String {
+    let predicted = |p: f32| if p > 0.0 { format!(", predicted speedup {p:.1}×") } else { String::new() };
+    match *choice {
+        HierarchyChoice::GaussMap { max_depth, nodes, predicted_speedup } => {
+            format!("Gauss map of {nodes} nodes, built to level {max_depth}{}", predicted(predicted_speedup))
+        }
+        HierarchyChoice::ConeBvh { leaf_size, nodes, predicted_speedup } => {
+            format!("cone BVH of {nodes} nodes, leaves of up to {leaf_size}{}", predicted(predicted_speedup))
+        }
+        HierarchyChoice::BruteForce(reason) => format!("brute force ({reason:?})"),
+    }
 }
 
 #[cfg(test)]

@@ -376,6 +376,20 @@ impl SilhouetteIndex {
             .as_ref()
             .map(|b| ConeBvh::from_arrays_with_cells(b, &normals, &points, cells.as_ref()))
             .transpose()?;
+        // The choices as the arrays give them, with the structure of what was loaded: a reader
+        // stores no node counts or leaf size (nor a predicted speedup, which stays as given).
+        let orthographic = match (arrays.orthographic, &gauss) {
+            (HierarchyChoice::GaussMap { predicted_speedup, .. }, Some(g)) => {
+                HierarchyChoice::GaussMap { max_depth: g.max_depth(), nodes: g.node_count(), predicted_speedup }
+            }
+            (choice, _) => choice,
+        };
+        let perspective = match (arrays.perspective, &bvh) {
+            (HierarchyChoice::ConeBvh { predicted_speedup, .. }, Some(b)) => {
+                HierarchyChoice::ConeBvh { leaf_size: b.leaf_size(), nodes: b.node_count(), predicted_speedup }
+            }
+            (choice, _) => choice,
+        };
         Ok(Self {
             candidate_edges,
             brute: std::sync::OnceLock::new(),
@@ -383,8 +397,8 @@ impl SilhouetteIndex {
             points,
             gauss,
             bvh,
-            orthographic: arrays.orthographic,
-            perspective: arrays.perspective,
+            orthographic,
+            perspective,
         })
     }
 }

@@ -236,6 +236,29 @@ fn arrays_round_trip_and_validation() {
     }
     let json = serde_json_like(&arrays);
     assert!(json > 0);
+    // A baked file stores no node counts (its reader passes zeros): the loaded index reports those
+    // of the hierarchies it loaded, the built ones, and keeps the given (absent) prediction.
+    let as_read = SilhouetteArrays {
+        orthographic: HierarchyChoice::GaussMap { max_depth: 0, nodes: 0, predicted_speedup: 0.0 },
+        perspective: HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 },
+        ..arrays.clone()
+    };
+    let reread = SilhouetteIndex::from_arrays(&as_read).unwrap();
+    let unpredicted = |c: HierarchyChoice| match c {
+        HierarchyChoice::GaussMap { max_depth, nodes, .. } => {
+            HierarchyChoice::GaussMap { max_depth, nodes, predicted_speedup: 0.0 }
+        }
+        HierarchyChoice::ConeBvh { leaf_size, nodes, .. } => {
+            HierarchyChoice::ConeBvh { leaf_size, nodes, predicted_speedup: 0.0 }
+        }
+        other => other,
+    };
+    assert_eq!(reread.orthographic_choice(), unpredicted(x.index.orthographic_choice()));
+    assert_eq!(reread.perspective_choice(), unpredicted(x.index.perspective_choice()));
+    assert!(matches!(reread.orthographic_choice(), HierarchyChoice::GaussMap { nodes, .. } if nodes > 1));
+    assert!(
+        matches!(reread.perspective_choice(), HierarchyChoice::ConeBvh { nodes, leaf_size, .. } if nodes > 1 && leaf_size > 0)
+    );
 
     // A cap shrunk below its arcs.
     let mut bad = arrays.clone();
