@@ -1316,8 +1316,7 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], bounds: DualBox, leaf_
                 let bins = bins_of(&bounds, r.centre());
                 // Every axis, splittable or not, so that the loop unrolls without a branch: an
                 // unsplittable axis's bins (clamped like any others) are never read.
-                for a in 0..4 {
-                    let k = bins[a];
+                for (a, k) in bins.into_iter().enumerate() {
                     acc.0[a][k] += 1;
                     grow(&mut acc.1[a][k], &r.b);
                 }
