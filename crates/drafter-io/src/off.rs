@@ -22,8 +22,8 @@
 //! than 3 numbers, a token that is not a number, a face with fewer than 3 vertices or fewer indices
 //! than it announces, a negative index or one `>=` the vertex count, a file that ends before the
 //! counts are met, and counts the rest of the file cannot hold (blamed on the header line, unless a
-//! record before the end is malformed itself: a face `2 0 1` is shorter than any valid face, and
-//! its own line is the better place to point at).
+//! record before the end is too short to be valid: a face `2 0 1` is shorter than any valid face,
+//! and its own line is the better place to point at).
 //!
 //! # Safety rules
 //! Nothing is allocated by a count until the bytes left can back it: a vertex takes at least 6
@@ -63,8 +63,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
         ));
     }
     // A count the bytes left cannot back is refused at the header line, unless a record before the
-    // end of the file is malformed itself (a face `2 0 1` is shorter than any valid face): that
-    // record's line is the better place to point at.
+    // end of the file is too short to be valid (a face `2 0 1`, a vertex of 2 coordinates), which is
+    // what made the count look too large: that record's line is the better place to point at.
     let budget = Budget::of(&tokens, vertex_count, MIN_VERTEX_BYTES, counts_line);
     let positions = read_vertices(&mut tokens, vertex_count, budget.capacity).map_err(|fault| {
         budget.blame(fault, |room, most| {
@@ -82,10 +82,19 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
 
 /// Why a list of records could not be read.
 enum Fault {
-    /// A record is malformed: its own line is to blame.
+    /// A record is shorter than any valid one (fewer than 3 vertices or coordinates, or fewer
+    /// indices than it announces) before the end of the file: its own line is to blame.
+    Short(ParseError),
+    /// A record is malformed otherwise (a token that is not a number, an index out of range).
     Record(ParseError),
-    /// The file ended before the count was met.
+    /// The file ended before the count was met, possibly inside a record.
     End(ParseError),
+}
+
+/// [`Fault::End`] where nothing but blanks and comments follows, [`Fault::Short`] otherwise: a
+/// record that lacks values at the end of the file is a truncation, not a short record.
+fn short_or_end(tokens: &Tokens<'_>, e: ParseError) -> Fault {
+    if tokens.clone().next_token().is_none() { Fault::End(e) } else { Fault::Short(e) }
 }
 
 /// Whether the bytes left can back a list's count ([`fits`]), and the capacity to reserve: the
@@ -113,9 +122,9 @@ impl Budget {
     /// the header's fault (`header(room, most)` says so), anything else the record's.
     fn blame(&self, fault: Fault, header: impl Fn(usize, u64) -> String) -> ParseError {
         match fault {
-            Fault::Record(e) => e,
-            Fault::End(e) if self.fits => e,
-            Fault::End(_) => ParseError::at_line(self.counts_line, header(self.room.0, self.room.1)),
+            Fault::Short(e) => e,
+            Fault::Record(e) | Fault::End(e) if self.fits => e,
+            Fault::Record(_) | Fault::End(_) => ParseError::at_line(self.counts_line, header(self.room.0, self.room.1)),
         }
     }
 }
@@ -165,9 +174,11 @@ fn read_vertices(tokens: &mut Tokens<'_>, count: u64, capacity: usize) -> Result
             let token = if k == 0 {
                 first
             } else {
-                tokens.next_on_line().ok_or_else(|| {
-                    Fault::Record(ParseError::at_line(line, format!("vertex {i}: expected 3 coordinates, found {k}")))
-                })?
+                let missing = ParseError::at_line(line, format!("vertex {i}: expected 3 coordinates, found {k}"));
+                match tokens.next_on_line() {
+                    Some(token) => token,
+                    None => return Err(short_or_end(tokens, missing)),
+                }
             };
             *coordinate = parse_f32(token).ok_or_else(|| {
                 Fault::Record(ParseError::at_line(
@@ -199,18 +210,18 @@ fn read_faces(tokens: &mut Tokens<'_>, count: u64, vertex_count: u64, capacity: 
             ))
         })?;
         if corners < 3 {
-            return Err(Fault::Record(ParseError::at_line(
+            return Err(Fault::Short(ParseError::at_line(
                 line,
                 format!("face {face} has {corners} vertices; a face needs at least 3"),
             )));
         }
         let mut index = |k: i64| -> Result<u32, Fault> {
-            let token = tokens.next_on_line().ok_or_else(|| {
-                ParseError::at_line(line, format!("face {face}: expected {corners} vertex indices, found {k}"))
-            });
-            token
-                .and_then(|t| vertex_index(t, face, vertex_count).map_err(|message| ParseError::at_line(line, message)))
-                .map_err(Fault::Record)
+            let Some(token) = tokens.next_on_line() else {
+                let missing =
+                    ParseError::at_line(line, format!("face {face}: expected {corners} vertex indices, found {k}"));
+                return Err(short_or_end(tokens, missing));
+            };
+            vertex_index(token, face, vertex_count).map_err(|message| Fault::Record(ParseError::at_line(line, message)))
         };
         let apex = index(0)?;
         let mut previous = index(1)?;
@@ -245,7 +256,7 @@ pub(crate) mod text {
     ///
     /// `next_token` crosses line ends (and comments, when a comment byte is set); `next_on_line` stops
     /// at the end of the current line, which is how line-oriented records detect missing values.
-    #[derive(Debug)]
+    #[derive(Clone, Debug)]
     pub(crate) struct Tokens<'a> {
         bytes: &'a [u8],
         pos: usize,
@@ -502,7 +513,13 @@ OFF
             let (line, message) = line_of(read(text));
             assert_eq!((line, message.as_str()), expected, "{}", String::from_utf8_lossy(text));
         }
-        // A file that ends before counts it could never hold still blames the header.
+        // A file that ends before counts it could never hold still blames the header, also inside a
+        // record, and so does a record that is malformed but not short (here text after the list).
+        let (line, message) = line_of(read(b"OFF\n3 1 0\n0 0 0\n1 0"));
+        assert_eq!((line, message.as_str()), (2, "header says 3 vertices but the 9 bytes left can hold at most 1"));
+        let (line, message) = line_of(read(b"OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\nend\n"));
+        assert_eq!((line, message.as_str()), (2, "header says 4 vertices but the 22 bytes left can hold at most 3"));
+        // And a face list cut short:
         let (line, message) = line_of(read(b"OFF\n3 5 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
         assert_eq!(
             (line, message.as_str()),

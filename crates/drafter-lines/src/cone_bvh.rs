@@ -1234,14 +1234,11 @@ fn dual_width(b: &DualBox) -> f32 {
 
 const EMPTY_BOX: DualBox = [[f32::INFINITY; 4], [f32::NEG_INFINITY; 4]];
 
-/// Grows `a` to hold `b`. Four lanes at a time with glam's `Vec4`, one `minps` and one `maxps` on
-/// x86-64, where `f32::min` lane by lane adds a NaN fix-up to every lane. Boxes are never NaN
-/// (finite unit normals and points; [`EMPTY_BOX`] is infinite), and for those the two agree up to
-/// the sign of a zero, which neither a width nor a bin sees.
-#[inline(always)]
 fn grow(a: &mut DualBox, b: &DualBox) {
-    a[0] = Vec4::from_array(a[0]).min(Vec4::from_array(b[0])).to_array();
-    a[1] = Vec4::from_array(a[1]).max(Vec4::from_array(b[1])).to_array();
+    for i in 0..4 {
+        a[0][i] = a[0][i].min(b[0][i]);
+        a[1][i] = a[1][i].max(b[1][i]);
+    }
 }
 
 /// A candidate as the dual-space build moves it: its box and its index. The build reorders
@@ -1314,9 +1311,8 @@ fn dual_node(tree: &mut Tree, records: &mut [DualRecord], bounds: DualBox, leaf_
             let mut acc = empty();
             for r in chunk {
                 let bins = bins_of(&bounds, r.centre());
-                // Every axis, splittable or not, so that the loop unrolls without a branch: an
-                // unsplittable axis's bins (clamped like any others) are never read.
-                for (a, k) in bins.into_iter().enumerate() {
+                for a in (0..4).filter(|&a| splittable[a]) {
+                    let k = bins[a];
                     acc.0[a][k] += 1;
                     grow(&mut acc.1[a][k], &r.b);
                 }
