@@ -366,8 +366,8 @@ pub(crate) mod text {
 /// Helpers shared by the tests of the STL, OFF and PLY readers.
 #[cfg(test)]
 pub(crate) mod testing {
-    /// The shared test models, found relative to this crate (`/work/main/crates/drafter-io` →
-    /// `/work/shared/models`).
+    /// The shared test models, found relative to this crate: `../shared/models` beside the
+    /// repository (`crates/drafter-io/../../../shared/models`).
     const MODELS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/models/");
 
     /// Reads one of the shared test models; panics (the test fails, never skips) when it is missing.
