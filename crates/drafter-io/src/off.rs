@@ -118,8 +118,9 @@ impl Budget {
         Budget { fits, capacity, room: (tokens.remaining(), most), counts_line }
     }
 
-    /// The error to report for `fault`: a file that ends before a count it could never hold is
-    /// the header's fault (`header(room, most)` says so), anything else the record's.
+    /// The error to report for `fault`: a short record is its own line's fault; where the bytes
+    /// could never hold the count, any other fault (the end of the file, a malformed record) is
+    /// the header's (`header(room, most)` says so); otherwise the record's or the end's own.
     fn blame(&self, fault: Fault, header: impl Fn(usize, u64) -> String) -> ParseError {
         match fault {
             Fault::Short(e) => e,
