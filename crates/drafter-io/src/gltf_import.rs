@@ -54,8 +54,14 @@ pub(crate) fn import(
     } else {
         (SourceFormat::Gltf, bytes, None)
     };
-    let gltf = gltf::Gltf::from_slice_without_validation(json_bytes).map_err(|e| gltf_error(e).in_path(path))?;
-    let doc = &gltf.document;
+    // Parsed as JSON and wrapped, never through `gltf::Gltf::from_slice*`: that reads a text that
+    // begins with `glTF` as a GLB of its own, and gltf-1.4.1 `src/binary.rs:252` subtracts the
+    // header's size from its length unchecked (a panic in builds with overflow checks, for a JSON
+    // chunk that is a GLB header claiming fewer than 12 bytes).
+    let root: gltf::json::Root = gltf::json::deserialize::from_slice(json_bytes)
+        .map_err(|e| gltf_error(gltf::Error::Deserialize(e)).in_path(path))?;
+    let document = gltf::Document::from_json_without_validation(root);
+    let doc = &document;
     check_required_extensions(doc.as_json()).map_err(|e| e.in_path(path))?;
     validate(doc.as_json()).map_err(|e| e.in_path(path))?;
     check_listed_triangles(doc, limits).map_err(|e| e.in_path(path))?;
@@ -211,7 +217,51 @@ fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
             errors.push((path, error));
         }
     });
-    if errors.is_empty() { Ok(()) } else { Err(validation_error(&errors)) }
+    if !errors.is_empty() {
+        return Err(validation_error(&errors));
+    }
+    check_what_the_crate_unwraps(root)
+}
+
+/// What gltf-json 1.4.1's validation lets through but the gltf crate's accessors unwrap, so that a
+/// call panics (read from the crate's source; every other `unwrap`, `expect`, index and
+/// `unreachable!` on the paths drafter calls is an index or enum the validation above checks):
+///
+/// * gltf-1.4.1 `src/image.rs:128`: `Image::source` unwraps `uri` when there is no `bufferView`
+///   (an image `{}`); the importer asks every image's source;
+/// * `src/image.rs:125`: it unwraps `mimeType` when there is a `bufferView` (the spec requires it
+///   there);
+/// * `src/camera.rs:82` and `:86`: `Camera::projection` unwraps the member its `type` names (the
+///   crate's validation asks only for one of the two). drafter does not ask, but the writer passes
+///   cameras through, and such a camera is invalid glTF in the baked file as well.
+///
+/// Each is refused here, before any of these is called, naming the object.
+fn check_what_the_crate_unwraps(root: &gltf::json::Root) -> Result<(), ParseError> {
+    use gltf::json::camera::Type;
+    use gltf::json::validation::Checked;
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (None, None, _) => {
+                return Err(ParseError::at_json(format!("/images/{i}"), "an image needs a uri or a bufferView"));
+            }
+            (_, Some(_), None) => {
+                return Err(ParseError::at_json(format!("/images/{i}"), "an image in a bufferView needs a mimeType"));
+            }
+            _ => {}
+        }
+    }
+    for (i, camera) in root.cameras.iter().enumerate() {
+        let missing = match camera.type_ {
+            Checked::Valid(Type::Perspective) if camera.perspective.is_none() => "perspective",
+            Checked::Valid(Type::Orthographic) if camera.orthographic.is_none() => "orthographic",
+            _ => continue,
+        };
+        return Err(ParseError::at_json(
+            format!("/cameras/{i}"),
+            format!("a camera of type {missing} needs the member {missing}"),
+        ));
+    }
+    Ok(())
 }
 
 /// Images the source names by a file URI, moved into buffers of their own (a buffer view and a

@@ -340,3 +340,109 @@ fn the_triangle_limit_holds_for_text_formats() {
         .to_string();
     assert_eq!(e, "two.obj: file: 2 triangles, more than the limit of 1 (--max-triangles)");
 }
+
+/// A valid one-triangle document with `extra` merged into its root (images, cameras, ...).
+fn triangle_with(extra: Value) -> Vec<u8> {
+    let mut b = Builder::default();
+    let pos = b.positions(&TRI);
+    let mut doc = json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}]
+    });
+    for (k, v) in extra.as_object().expect("object") {
+        doc[k] = v.clone();
+    }
+    b.document(doc)
+}
+
+/// A 1×1 PNG as a data URI (the importer does not decode images; any bytes would do).
+const PNG_URI: &str = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8DwHwAFBQIAX8jx0gAAAABJRU5ErkJggg==";
+
+/// Whether `f` panics (the panic hook is quiet meanwhile).
+fn panics(f: impl FnOnce()) -> bool {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let panicked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).is_err();
+    std::panic::set_hook(hook);
+    panicked
+}
+
+/// Issue 47: what gltf-json's validation lets through but the gltf crate unwraps is refused before
+/// the crate is asked, with one line naming the file and the JSON pointer (the CLI's exit 2). Each
+/// document passes the crate's own validation, and the crate's accessor panics on it, which is why
+/// the importer must check first.
+#[test]
+fn what_the_gltf_crate_unwraps_is_refused_by_its_place() {
+    let cases: [(&str, Value, &str); 4] = [
+        // gltf-1.4.1 src/image.rs:128, found by a black-box campaign of the release CLI.
+        ("image {}", json!({"images": [{"uri": PNG_URI}, {}]}), "/images/1: an image needs a uri or a bufferView"),
+        // src/image.rs:125.
+        (
+            "image in a view without mimeType",
+            json!({"images": [{"bufferView": 0}]}),
+            "/images/0: an image in a bufferView needs a mimeType",
+        ),
+        // src/camera.rs:86 (and :82 for an orthographic type).
+        (
+            "perspective camera without perspective",
+            json!({"cameras": [{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}]}),
+            "/cameras/0: a camera of type perspective needs the member perspective",
+        ),
+        (
+            "orthographic camera without orthographic",
+            json!({"cameras": [{"type": "orthographic", "perspective": {"yfov": 1, "znear": 0.1}}]}),
+            "/cameras/0: a camera of type orthographic needs the member orthographic",
+        ),
+    ];
+    for (what, extra, expected) in cases {
+        let bytes = triangle_with(extra);
+        let crate_view = gltf::Gltf::from_slice(&bytes).expect("the gltf crate's validation accepts it");
+        assert!(
+            panics(|| {
+                crate_view.images().for_each(|i| {
+                    let _ = i.source();
+                });
+                crate_view.cameras().for_each(|c| {
+                    let _ = c.projection();
+                });
+            }),
+            "{what}: the gltf crate no longer panics; the guard may go"
+        );
+        let err = drafter_io::import_bytes(Path::new("mem.gltf"), &bytes).expect_err(what).to_string();
+        assert_eq!(err, format!("mem.gltf: {expected}"), "{what}");
+        // As a GLB, the same words.
+        let mut doc: Value = serde_json::from_slice(&bytes).expect("json");
+        let bin = base64::engine::general_purpose::STANDARD
+            .decode(doc["buffers"][0]["uri"].as_str().expect("uri").split_once(',').expect("data uri").1)
+            .expect("base64");
+        doc["buffers"][0].as_object_mut().expect("buffer").remove("uri");
+        let glb = drafter_core::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
+        let err = drafter_io::import_bytes(Path::new("mem.glb"), &glb).expect_err(what).to_string();
+        assert_eq!(err, format!("mem.glb: {expected}"), "{what} (GLB)");
+    }
+    // The valid neighbours of those: images by URI and by view, both camera types.
+    let ok = triangle_with(json!({
+        "images": [{"uri": PNG_URI}, {"bufferView": 0, "mimeType": "image/png"}],
+        "cameras": [
+            {"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1}},
+            {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}
+        ]
+    }));
+    assert_eq!(import(&ok).scene.instanced_triangle_count(), 1);
+}
+
+/// A GLB whose JSON chunk is itself a GLB header claiming 4 bytes: `gltf::Gltf::from_slice` would
+/// read it as a GLB and subtract the header's 12 bytes from 4 (gltf-1.4.1 src/binary.rs:252, a
+/// panic with overflow checks, as in the CI's debug builds). The importer parses the chunk as JSON.
+#[test]
+fn a_json_chunk_that_is_a_glb_header_is_refused_as_json() {
+    let inner = b"glTF\x02\x00\x00\x00\x04\x00\x00\x00";
+    if cfg!(debug_assertions) {
+        assert!(panics(|| drop(gltf::Gltf::from_slice(inner))), "the gltf crate no longer panics here");
+    }
+    let glb = drafter_core::glb::write(inner, &[]).expect("glb");
+    let err = drafter_io::import_bytes(Path::new("nested.glb"), &glb).expect_err("refused").to_string();
+    assert!(err.starts_with("nested.glb: line 1: invalid glTF JSON"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
