@@ -12,7 +12,11 @@
 //!   (`NaN`, `1e309`, `-0`, 30 digits), by a wrong type or an out-of-range index; a key dropped or
 //!   duplicated (textually: a `Value` cannot hold two); a value buried under 64 to 5,000 arrays; array
 //!   elements removed, duplicated or swapped; a sparse block or a missing `bufferView` on an
-//!   accessor; `componentType`, `type`, `byteStride` and `mode` set to their neighbours.
+//!   accessor; `componentType`, `type`, `byteStride` and `mode` set to their neighbours;
+//! * glTF structure (issue 47; half of the JSON edits): a member glTF requires removed (an image's
+//!   `uri` or `bufferView`, an accessor's `count`...), an object emptied (`{}` for an image), a
+//!   reference pointed into another array's range, entries of a top-level array dropped,
+//!   duplicated or cut off, a member's type changed (a number as a string, an object as an array).
 //!
 //! Outputs are capped at [`MAX_OUTPUT`] bytes so that a case costs what a small input costs.
 
@@ -547,6 +551,13 @@ pub fn mutate_json_text(text: &[u8], rng: &mut Rng) -> Vec<u8> {
         Some(Step::Key(k)) => Some(k.clone()),
         _ => None,
     };
+    // Half of the edits change the document's shape (issue 47): a member glTF requires removed,
+    // an object emptied, a reference pointed into another array, entries dropped or duplicated, a
+    // member's type changed. The rest change one value.
+    if rng.below(2) == 0 {
+        mutate_structure(&mut doc, rng);
+        return serde_json::to_vec(&doc).unwrap_or_else(|_| text.to_vec());
+    }
     let Some(target) = get_mut(&mut doc, &path) else { return text.to_vec() };
     let mut raw: Option<String> = None;
     match rng.below(12) {
@@ -754,6 +765,225 @@ fn accessor_edit(doc: &mut Value, rng: &mut Rng) {
                 accessor.remove("bufferView");
                 accessor.insert("count".into(), json!(*choose(rng, &[1u64 << 26, u32::MAX as u64])));
             }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF structure (issue 47)
+
+/// The members glTF 2.0 requires of an object, by its kind ([`kind_of`]). For an image, one of
+/// `uri` and `bufferView`, and `mimeType` with a view; for a camera, `type` and the member it names.
+fn required_members(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "accessors" => &["componentType", "count", "type"],
+        "bufferViews" => &["buffer", "byteLength"],
+        "buffers" => &["byteLength"],
+        "images" => &["uri", "bufferView", "mimeType"],
+        "textures" => &["source"],
+        "cameras" => &["type", "perspective", "orthographic"],
+        "perspective" => &["yfov", "znear"],
+        "orthographic" => &["xmag", "ymag", "zfar", "znear"],
+        "skins" => &["joints"],
+        "animations" => &["channels", "samplers"],
+        "channels" => &["sampler", "target"],
+        "target" => &["node", "path"],
+        "animation samplers" => &["input", "output"],
+        "meshes" => &["primitives"],
+        "primitives" => &["attributes"],
+        "attributes" => &["POSITION"],
+        "sparse" => &["count", "indices", "values"],
+        "indices" => &["bufferView", "componentType"],
+        "values" => &["bufferView"],
+        "asset" => &["version"],
+        "baseColorTexture" | "metallicRoughnessTexture" | "normalTexture" | "occlusionTexture" | "emissiveTexture" => {
+            &["index"]
+        }
+        _ => &[],
+    }
+}
+
+/// The kind of the object at `path`: the key it sits under, or the key of the array it is an
+/// element of (`/images/3` is an `images`); an animation's `samplers` are `animation samplers`.
+fn kind_of(path: &[Step]) -> String {
+    let mut keys = path.iter().filter_map(|s| match s {
+        Step::Key(k) => Some(k.as_str()),
+        Step::Index(_) => None,
+    });
+    let last = keys.next_back().unwrap_or("");
+    if last == "samplers" && keys.any(|k| k == "animations") {
+        "animation samplers".to_owned()
+    } else {
+        last.to_owned()
+    }
+}
+
+/// The top-level array a reference member's integer indexes, by its key (`None`: not a reference
+/// drafter-fuzz knows).
+fn referenced_array(key: &str) -> Option<&'static str> {
+    Some(match key {
+        "bufferView" => "bufferViews",
+        "buffer" => "buffers",
+        "indices" | "POSITION" | "NORMAL" | "TEXCOORD_0" | "TANGENT" | "inverseBindMatrices" | "input" | "output" => {
+            "accessors"
+        }
+        "material" => "materials",
+        "mesh" => "meshes",
+        "node" | "skeleton" => "nodes",
+        "scene" => "scenes",
+        "skin" => "skins",
+        "camera" => "cameras",
+        "source" => "images",
+        "sampler" => "samplers",
+        "index" => "textures",
+        _ => return None,
+    })
+}
+
+/// One structural edit of a glTF document, in place; a document without the needed parts is left
+/// as it was. Objects are picked kind first, then one of that kind, so that an `images` entry
+/// beside hundreds of accessors is as likely a target as an accessor.
+pub fn mutate_structure(doc: &mut Value, rng: &mut Rng) {
+    let mut paths = Vec::new();
+    collect_paths(doc, &mut Vec::new(), &mut paths, 20_000);
+    // Objects by kind (the root excluded: it is never a path).
+    let mut objects: std::collections::BTreeMap<String, Vec<JsonPath>> = std::collections::BTreeMap::new();
+    for path in &paths {
+        if get_mut(doc, path).is_some_and(|v| v.is_object()) {
+            objects.entry(kind_of(path)).or_default().push(path.clone());
+        }
+    }
+    let pick_kind = |rng: &mut Rng, keep: &dyn Fn(&str) -> bool| -> Option<JsonPath> {
+        let kinds: Vec<&String> = objects.keys().filter(|k| keep(k)).collect();
+        if kinds.is_empty() {
+            return None;
+        }
+        let of_kind = &objects[*choose(rng, &kinds)];
+        Some(choose(rng, of_kind).clone())
+    };
+    match rng.below(5) {
+        0 => {
+            // A required member removed (for an image, its source or its MIME type).
+            let Some(path) = pick_kind(rng, &|k| !required_members(k).is_empty()) else { return };
+            let kind = kind_of(&path);
+            let Some(Value::Object(map)) = get_mut(doc, &path) else { return };
+            let present: Vec<&str> = required_members(&kind).iter().copied().filter(|m| map.contains_key(*m)).collect();
+            if !present.is_empty() {
+                let member = *choose(rng, &present);
+                map.remove(member);
+            }
+        }
+        1 => {
+            // An object emptied: `{}` where an image, an accessor, a primitive... was.
+            let Some(path) = pick_kind(rng, &|_| true) else { return };
+            if let Some(target) = get_mut(doc, &path) {
+                *target = json!({});
+            }
+        }
+        2 => {
+            // A reference pointed into another array's range: an index that exists, of the wrong
+            // kind of object (or past the end of its own array).
+            let references: Vec<(JsonPath, &'static str)> = paths
+                .iter()
+                .filter_map(|p| match p.last() {
+                    Some(Step::Key(k)) => referenced_array(k).map(|a| (p.clone(), a)),
+                    Some(Step::Index(_)) => match p.get(p.len().wrapping_sub(2)) {
+                        Some(Step::Key(k)) if matches!(k.as_str(), "nodes" | "children" | "joints") => {
+                            Some((p.clone(), "nodes"))
+                        }
+                        _ => None,
+                    },
+                    None => None,
+                })
+                .filter(|(p, _)| get_mut(doc, p).is_some_and(|v| v.is_u64()))
+                .collect();
+            if references.is_empty() {
+                return;
+            }
+            let (path, own) = choose(rng, &references).clone();
+            let own_len = doc.get(own).and_then(Value::as_array).map_or(0, Vec::len);
+            let others: Vec<usize> = doc
+                .as_object()
+                .into_iter()
+                .flat_map(|root| root.iter())
+                .filter(|(k, _)| k.as_str() != own)
+                .filter_map(|(_, v)| v.as_array().map(Vec::len))
+                .filter(|&len| len > 0 && len != own_len)
+                .collect();
+            let Some(&len) = (!others.is_empty()).then(|| choose(rng, &others)) else { return };
+            // The other array's last index, or any of its indices.
+            let value = if rng.below(2) == 0 { len - 1 } else { index(rng, len) };
+            if let Some(target) = get_mut(doc, &path) {
+                *target = json!(value);
+            }
+        }
+        3 => {
+            // Entries of a top-level array dropped (the later ones' indices shift under their
+            // references) or duplicated.
+            let Some(root) = doc.as_object_mut() else { return };
+            let arrays: Vec<String> = root
+                .iter()
+                .filter(|(_, v)| v.as_array().is_some_and(|a| !a.is_empty()))
+                .map(|(k, _)| k.clone())
+                .collect();
+            if arrays.is_empty() {
+                return;
+            }
+            let key = choose(rng, &arrays).clone();
+            let Some(Value::Array(items)) = root.get_mut(&key) else { return };
+            let i = index(rng, items.len());
+            match rng.below(4) {
+                0 => {
+                    items.remove(i);
+                }
+                1 => {
+                    let copy = items[i].clone();
+                    items.insert(i, copy);
+                }
+                2 => {
+                    let copy = items[i].clone();
+                    items.push(copy);
+                }
+                _ => items.truncate(i),
+            }
+        }
+        _ => {
+            // A member's type changed: a number as a string, a string as a number, an object as
+            // an array holding it, an array as an object, a boolean as a number, null as {}.
+            let members: Vec<&JsonPath> = paths.iter().filter(|p| matches!(p.last(), Some(Step::Key(_)))).collect();
+            if members.is_empty() {
+                return;
+            }
+            let path = (*choose(rng, &members)).clone();
+            let Some(target) = get_mut(doc, &path) else { return };
+            *target = match std::mem::take(target) {
+                Value::Number(n) => {
+                    if rng.below(2) == 0 {
+                        json!(n.to_string())
+                    } else {
+                        json!([n])
+                    }
+                }
+                Value::String(s) => {
+                    if rng.below(2) == 0 {
+                        json!(s.len())
+                    } else {
+                        json!([s])
+                    }
+                }
+                Value::Object(map) => {
+                    if rng.below(2) == 0 {
+                        json!([map])
+                    } else {
+                        Value::Array(map.into_iter().map(|(_, v)| v).collect())
+                    }
+                }
+                Value::Array(items) => {
+                    Value::Object(items.into_iter().enumerate().map(|(i, v)| (i.to_string(), v)).collect())
+                }
+                Value::Bool(b) => json!(u8::from(b)),
+                Value::Null => json!({}),
+            };
         }
     }
 }

@@ -92,6 +92,7 @@ pub fn corpus(repo: &Path, max_bytes: usize) -> anyhow::Result<Corpus> {
         }
     }
 
+    features(&mut corpus);
     baked(&mut corpus)?;
     for target in Target::ALL {
         anyhow::ensure!(!corpus.of(target).is_empty(), "no seeds for {}", target.name());
@@ -272,7 +273,131 @@ fn baked(corpus: &mut Corpus) -> anyhow::Result<()> {
     for (name, scene) in inputs {
         let baked = drafter_bake::bake(&scene, &drafter_bake::BakeConfig::default())
             .with_context(|| format!("{name}: a seed must bake"))?;
+        // A baked sample is a glTF input as well, and one with what the samples lack: images
+        // (the PNG lookups, in buffer views), textures and samplers, extensions.
+        if name.starts_with("samples/") {
+            if let Some(gltf) = glb_to_gltf(&baked.written.main) {
+                corpus.add(Target::Gltf, format!("{name} (baked, as .gltf)"), gltf);
+            }
+            corpus.add(Target::Glb, format!("{name} (baked)"), baked.written.main.clone());
+        }
         corpus.add(Target::Baked, format!("{name} (baked)"), baked.written.main);
     }
     Ok(())
+}
+
+/// A 1×1 PNG (the importer does not decode images; a real one keeps the seed a valid glTF).
+const PNG: &[u8] = &[
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00, 0x00,
+    0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0x1f, 0x15, 0xc4, 0x89, 0x00, 0x00, 0x00, 0x0d, 0x49,
+    0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0xfc, 0xcf, 0xc0, 0xf0, 0x1f, 0x00, 0x05, 0x05, 0x02, 0x00, 0x5f, 0xc8, 0xf1,
+    0xd2, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
+];
+
+/// A small glTF with every part of the format the gltf crate models and the samples do not have
+/// (issue 47): images by URI and by buffer view, textures, a sampler, a textured material with a
+/// KHR_texture_transform, both camera types, a skin with its joint attributes, an animation, a
+/// sparse accessor and strided data; as .gltf (data URIs) and as .glb.
+fn features(corpus: &mut Corpus) {
+    let mut bin: Vec<u8> = Vec::new();
+    let mut views: Vec<serde_json::Value> = Vec::new();
+    let mut view = |bin: &mut Vec<u8>, bytes: &[u8], stride: Option<usize>| -> usize {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let mut v = serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()});
+        if let Some(stride) = stride {
+            v["byteStride"] = stride.into();
+        }
+        bin.extend_from_slice(bytes);
+        views.push(v);
+        views.len() - 1
+    };
+    let floats = |values: &[f32]| values.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
+    // Positions and normals interleaved (stride 24).
+    let quad = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let interleaved: Vec<f32> = quad.iter().flat_map(|p| [p[0], p[1], p[2], 0.0, 0.0, 1.0]).collect();
+    let vertices = view(&mut bin, &floats(&interleaved), Some(24));
+    let uvs = view(&mut bin, &floats(&[0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0]), None);
+    let indices = view(&mut bin, &[0u16, 1, 2, 0, 2, 3].map(u16::to_le_bytes).concat(), None);
+    let joints = view(&mut bin, &[0u8; 16], None);
+    let weights = view(&mut bin, &floats(&[1.0, 0.0, 0.0, 0.0].repeat(4)), None);
+    let identity = floats(&[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+    let inverse_bind = view(&mut bin, &identity, None);
+    let times = view(&mut bin, &floats(&[0.0, 1.0]), None);
+    let translations = view(&mut bin, &floats(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]), None);
+    let sparse_indices = view(&mut bin, &2u16.to_le_bytes(), None);
+    let sparse_values = view(&mut bin, &floats(&[1.0, 1.0, 0.5]), None);
+    let image = view(&mut bin, PNG, None);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "drafter-fuzz features seed"},
+        "extensionsUsed": ["KHR_texture_transform"],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"name": "root", "children": [1, 2, 3, 4]},
+            {"name": "skinned", "mesh": 0, "skin": 0},
+            {"name": "eye", "camera": 0, "translation": [0.5, 0.5, 3.0]},
+            {"name": "top", "camera": 1, "rotation": [-0.70710677, 0.0, 0.0, 0.70710677], "translation": [0.5, 3.0, 0.0]},
+            {"name": "joint", "translation": [0.0, 0.0, 0.0]}
+        ],
+        "meshes": [{"name": "quad", "primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "JOINTS_0": 4, "WEIGHTS_0": 5},
+             "indices": 3, "material": 0},
+            {"attributes": {"POSITION": 9}, "mode": 4}
+        ]}],
+        "accessors": [
+            {"bufferView": vertices, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": vertices, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": uvs, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": indices, "componentType": 5123, "count": 6, "type": "SCALAR"},
+            {"bufferView": joints, "componentType": 5121, "count": 4, "type": "VEC4"},
+            {"bufferView": weights, "componentType": 5126, "count": 4, "type": "VEC4"},
+            {"bufferView": inverse_bind, "componentType": 5126, "count": 1, "type": "MAT4"},
+            {"bufferView": times, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+            {"bufferView": translations, "componentType": 5126, "count": 2, "type": "VEC3"},
+            {"bufferView": vertices, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0.5],
+             "sparse": {"count": 1, "indices": {"bufferView": sparse_indices, "componentType": 5123},
+                        "values": {"bufferView": sparse_values}}}
+        ],
+        "bufferViews": views,
+        "buffers": [{"byteLength": bin.len()}],
+        "images": [
+            {"name": "by uri", "uri": format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(PNG))},
+            {"name": "by view", "bufferView": image, "mimeType": "image/png"}
+        ],
+        "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 33648, "wrapT": 10497}],
+        "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
+        "materials": [{
+            "name": "textured",
+            "pbrMetallicRoughness": {
+                "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}},
+                "metallicRoughnessTexture": {"index": 1},
+                "metallicFactor": 0.5
+            },
+            "normalTexture": {"index": 1, "scale": 0.5},
+            "occlusionTexture": {"index": 0, "strength": 0.5},
+            "emissiveTexture": {"index": 1},
+            "emissiveFactor": [0.1, 0.1, 0.1],
+            "alphaMode": "MASK",
+            "alphaCutoff": 0.3,
+            "doubleSided": true
+        }],
+        "cameras": [
+            {"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01, "zfar": 100, "aspectRatio": 1.5}},
+            {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.01, "zfar": 10}}
+        ],
+        "skins": [{"joints": [4], "inverseBindMatrices": 6, "skeleton": 4}],
+        "animations": [{
+            "channels": [{"sampler": 0, "target": {"node": 4, "path": "translation"}}],
+            "samplers": [{"input": 7, "output": 8, "interpolation": "LINEAR"}]
+        }]
+    });
+    let json = serde_json::to_vec(&doc).unwrap_or_default();
+    if let Ok(glb) = drafter_core::glb::write(&json, &bin) {
+        if let Some(gltf) = glb_to_gltf(&glb) {
+            corpus.add(Target::Gltf, "generated:features (as .gltf)", gltf);
+        }
+        corpus.add(Target::Glb, "generated:features", glb);
+    }
 }
