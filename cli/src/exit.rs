@@ -1,11 +1,10 @@
 //! Mapping errors to exit codes: the input's fault (2), the system's (3: reading or writing failed
-//! for a reason other than the input's content, such as a full disk or a permission), or ours (1).
+//! for a reason other than the input's content, such as a full disk or a permission), or ours (1);
+//! a batch in which some inputs failed ends with 4 (`drafter_catalog::exit`, where the codes live).
 
 use std::process::ExitCode;
 
-pub const INTERNAL: u8 = 1;
-pub const BAD_INPUT: u8 = 2;
-pub const IO_FAILURE: u8 = 3;
+pub use drafter_catalog::exit::{BAD_INPUT, INTERNAL, IO_FAILURE, SOME_FAILED};
 
 /// An error caused by the user's input or options (exit code 2), as opposed to a bug.
 #[derive(Debug)]
@@ -35,6 +34,15 @@ impl std::error::Error for IoFailure {}
 /// not exist or is a folder, which is the user's to fix: 2), 2 for bad input, 1 otherwise.
 pub fn code_of(err: &anyhow::Error) -> u8 {
     for e in err.chain() {
+        if e.is::<crate::cmd::batch::SomeFailed>() {
+            return SOME_FAILED;
+        }
+        if let Some(crate::cmd::batch::Interrupted(signal)) = e.downcast_ref() {
+            return u8::try_from(128 + signal).unwrap_or(INTERNAL);
+        }
+        if let Some(e) = e.downcast_ref::<drafter_catalog::Error>() {
+            return e.exit_code();
+        }
         if e.is::<IoFailure>() {
             return IO_FAILURE;
         }

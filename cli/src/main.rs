@@ -1,8 +1,9 @@
 //! `drafter`: bake technical 3D models into illustration-ready glTF, inspect them, render them.
 //!
 //! Exit codes: 0 success, 2 bad input (one line on stderr naming the file and the place), 3 a file
-//! could not be read or written (disk full, permission denied, ...), 1 internal error (a bug: please
-//! report it); 130 / 143 after Ctrl-C / SIGTERM during a bake, which leaves no partial file.
+//! could not be read or written (disk full, permission denied, ...), 4 a batch in which some inputs
+//! failed (the others were baked; the failures are listed), 1 internal error (a bug: please report
+//! it); 130 / 143 after Ctrl-C / SIGTERM during a bake, which leaves no partial file.
 
 use std::process::ExitCode;
 
@@ -11,7 +12,6 @@ use clap::{Parser, Subcommand};
 mod cmd;
 mod exit;
 mod gpu_env;
-mod interrupt;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -19,8 +19,10 @@ mod interrupt;
     version,
     about = "Bake CAD assemblies and meshes into assets for technical illustration",
     after_help = "Exit codes: 0 success; 2 bad input (one line naming the file and the place); 3 a file could not be \
-                  read or written (disk full, permission); 1 internal error (a bug). Ctrl-C or SIGTERM during a bake \
-                  exits with 130 or 143 and leaves no partial file."
+                  read or written (disk full, permission); 4 some inputs of a batch failed (the others were baked, the \
+                  failures are listed); 1 internal error (a bug). Ctrl-C or SIGTERM during a bake exits with 130 or 143 \
+                  and leaves no partial file (a batch finishes the files it started first; a second signal exits at \
+                  once)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -31,6 +33,8 @@ struct Cli {
 enum Command {
     /// Bake a model into an extended glTF: parts, oriented boxes, projectors and gradients.
     Bake(cmd::bake::Args),
+    /// The content-addressed cache of `bake --cache`: stats, clear, evict.
+    Cache(cmd::cache::Args),
     /// Print what a file contains: parts, meshes, triangle counts, bounds and welded topology.
     Inspect(cmd::inspect::Args),
     /// Render a model headless to PNG in an illustration style (gradient, cel, gooch, metal, ...).
@@ -49,6 +53,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {
         Command::Bake(args) => cmd::bake::run(args),
+        Command::Cache(args) => cmd::cache::run(args),
         Command::Inspect(args) => cmd::inspect::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Bench(args) => cmd::bench::run(args),

@@ -1,23 +1,26 @@
-//! `drafter bake [INPUT] [-o OUTPUT] [--config FILE] [--report FILE.json] [--json] [--textures-out DIR]
-//! [--segment MODE] [--obb METHOD] [--threads N] [--quiet | --verbose]`.
+//! `drafter bake [INPUT...] [-o OUTPUT] [--config FILE] [--report FILE.json] [--json] [--textures-out DIR]
+//! [--segment MODE] [--obb METHOD] [--threads N] [--cache DIR] [--quiet | --verbose]`.
 //!
 //! With no INPUT it bakes the embedded sample assembly into `./sample.baked.glb`. The output is
 //! written atomically (a temporary file beside it, then a rename): a failed or interrupted bake
-//! (Ctrl-C, SIGTERM: [`crate::interrupt`]) leaves no partial output. An output that is the input
+//! (Ctrl-C, SIGTERM: `drafter_catalog::interrupt`) leaves no partial output. An output that is the input
 //! itself (or, for .gltf, whose .bin is one of the input's files) is refused unless `--force`, and
 //! an output path that exists as anything but a regular file (a folder, a device) always is.
+//!
+//! Several inputs, a folder or a `--manifest` make a batch (`batch.rs`). With `--cache DIR` (or
+//! `DRAFTER_CACHE`) a bake whose key has an entry is written from it (`drafter_catalog::cache`).
 
 use crate::cmd::out;
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use drafter_bake::{BakeConfig, BakeError};
+use drafter_bake::BakeConfig;
 use drafter_bounds::ObbMethod;
-use drafter_format::{Container, InputInfo};
+use drafter_catalog::cache::Cache;
+use drafter_format::Container;
 use drafter_segment::SegmentMode;
-use sha2::Digest;
 
 use crate::exit::{BadInput, IoFailure};
 
@@ -28,12 +31,38 @@ const SAMPLE_OUTPUT: &str = "sample.baked.glb";
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The model to bake (glTF, GLB, OBJ, STL, OFF, PLY). Default: the embedded sample assembly.
-    pub input: Option<PathBuf>,
+    /// The models to bake (glTF, GLB, OBJ, STL, OFF, PLY), or folders of them (recursively).
+    /// Default: the embedded sample assembly. More than one input, a folder or a manifest make a
+    /// batch written under `-o DIR`.
+    #[arg(value_name = "INPUT")]
+    pub inputs: Vec<PathBuf>,
     /// Output file: .glb (default) or .gltf (+ .bin beside it). Default: INPUT's name with
-    /// `.baked.glb` in the current folder, `sample.baked.glb` for the sample.
+    /// `.baked.glb` in the current folder, `sample.baked.glb` for the sample. For a batch: the
+    /// output folder, where each output mirrors its input's relative path with `.glb`.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// A list of inputs for a batch: a `.toml` file with `inputs = ["a.gltf", "parts/"]`, or any
+    /// other file with one path per line (`#` comments); paths are relative to the manifest's
+    /// folder. Repeatable.
+    #[arg(long, value_name = "FILE")]
+    pub manifest: Vec<PathBuf>,
+    /// A content-addressed cache of baked files (created if missing): an input baked before with
+    /// the same bytes, external files, options and drafter build is written from it without
+    /// running a stage. Safe to share between processes and machines (a shared folder).
+    #[arg(long, value_name = "DIR", env = "DRAFTER_CACHE")]
+    pub cache: Option<PathBuf>,
+    /// Keep the cache within this size (e.g. 20G, 500M), evicting the least recently used
+    /// entries after the run.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size, env = "DRAFTER_CACHE_MAX")]
+    pub cache_max: Option<u64>,
+    /// A batch's memory budget (e.g. 8G): files are admitted while their estimated peaks fit
+    /// together; a file larger than the budget runs alone. Default: half the available memory.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory: Option<u64>,
+    /// A batch's files baked at once, at most (default: the cores; each file also uses the
+    /// stages' threads).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
     /// Per-part overrides and stage options (TOML; see drafter-bake's config docs).
     #[arg(long, value_name = "FILE.toml")]
     pub config: Option<PathBuf>,
@@ -113,21 +142,18 @@ pub fn run(args: Args) -> Result<()> {
         }
         rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("configuring the thread pool")?;
     }
-    crate::interrupt::install();
-    let started = Instant::now();
-    let progress = Progress::new(!args.quiet && std::io::stderr().is_terminal());
+    drafter_catalog::interrupt::install();
+    let config = config_from_args(&args)?;
+    let is_batch =
+        args.inputs.len() > 1 || !args.manifest.is_empty() || args.inputs.first().is_some_and(|p| p.is_dir());
+    if is_batch {
+        return crate::cmd::batch::run(&args, config);
+    }
+    single(&args, config)
+}
 
-    progress.step(0, "reading");
-    let (input_path, bytes) = match &args.input {
-        Some(path) => {
-            let bytes =
-                std::fs::read(path).map_err(|source| drafter_io::ImportError::Io { path: path.clone(), source })?;
-            (path.clone(), bytes)
-        }
-        None => (PathBuf::from(SAMPLE_NAME), SAMPLE.to_vec()),
-    };
-    let output = args.output.clone().unwrap_or_else(|| default_output(args.input.as_deref()));
-
+/// The configuration the options ask for: `--config`, then the flags over it.
+fn config_from_args(args: &Args) -> Result<BakeConfig> {
     let mut config = BakeConfig::default();
     if let Some(path) = &args.config {
         let text = std::fs::read_to_string(path)
@@ -160,8 +186,34 @@ pub fn run(args: Args) -> Result<()> {
     if args.enhanced_in_normal {
         config.normals.enhanced_in_normal = true;
     }
-    config.container = container_for(&output)?;
-    check_output(&output, &config.container, args.input.as_deref(), &bytes, args.force)?;
+    Ok(config)
+}
+
+/// The cache `--cache` names, opened.
+pub(crate) fn open_cache(args: &Args) -> Result<Option<Cache>> {
+    args.cache
+        .as_ref()
+        .map(|dir| {
+            Cache::open(dir, args.cache_max)
+                .map_err(|e| IoFailure(format!("{}: cannot open the cache: {e}", dir.display())).into())
+        })
+        .transpose()
+}
+
+/// One input (or the sample) into one output file.
+fn single(args: &Args, mut config: BakeConfig) -> Result<()> {
+    let started = Instant::now();
+    let progress = Progress::new(!args.quiet && std::io::stderr().is_terminal());
+
+    progress.step(0, "reading");
+    let input = args.inputs.first();
+    let (input_path, bytes) = match input {
+        Some(path) => (path.clone(), drafter_catalog::job::read_input(path)?),
+        None => (PathBuf::from(SAMPLE_NAME), SAMPLE.to_vec()),
+    };
+    let output = args.output.clone().unwrap_or_else(|| default_output(input.map(PathBuf::as_path)));
+    config.container = drafter_catalog::output::container_for(&output)?;
+    check_output(&output, &config.container, input.map(PathBuf::as_path), &bytes, args.force)?;
     if let Some(report) = &args.report {
         refuse_non_file(report)?;
         if report == &output {
@@ -169,36 +221,45 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
 
+    // The cache holds the file and the report; `--textures-out` needs the bake's images.
+    let cache = if args.textures_out.is_none() { open_cache(args)? } else { None };
+    let key = cache.as_ref().and_then(|_| drafter_catalog::cache::key_of(&input_path, &bytes, &config));
+    if let (Some(cache), Some(key)) = (&cache, &key)
+        && let Ok(payloads) = cache.get(key)
+    {
+        let bin = payloads.get(1).filter(|b| !b.is_empty()).map(Vec::as_slice);
+        let report = payloads.get(2).map(Vec::as_slice).unwrap_or_default();
+        let extra: Vec<(PathBuf, &[u8])> = args.report.iter().map(|p| (p.clone(), report)).collect();
+        drafter_catalog::output::write_outputs(&output, &payloads[0], bin, &config.container, &extra)?;
+        progress.finish();
+        if args.json {
+            out!("{}", String::from_utf8_lossy(report));
+        }
+        if !args.quiet {
+            eprintln!(
+                "cached {} → {}: {} bytes from {} in {:.0} ms",
+                input_path.display(),
+                output.display(),
+                payloads[0].len() + bin.map_or(0, <[u8]>::len),
+                cache.root().display(),
+                started.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        evict(cache, args.quiet);
+        return Ok(());
+    }
+
     progress.step(1, "importing");
     let limits = drafter_io::Limits { max_triangles: args.max_triangles };
-    // The input's digest (for the report) beside the import: 9 ms of one core on the dragon's 16 MB.
-    let (imported, digest) =
-        rayon::join(|| drafter_io::import_bytes_within(&input_path, &bytes, &limits), || sha2::Sha256::digest(&bytes));
-    let imported = imported?;
-    // The scene holds what it needs of the file (a glTF's buffers, for the writer's pass-through):
-    // the file's bytes (16 MB for the dragon) are not kept through the bake, where memory peaks.
-    drop(bytes);
-    config.input = InputInfo {
-        name: input_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-        format: format!("{:?}", imported.scene.format).to_lowercase(),
-        sha256: digest.iter().map(|b| format!("{b:02x}")).collect(),
-    };
-
     let mut on_stage = |i: usize| progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
-    let mut baked = drafter_bake::bake_observed(&imported.scene, &config, &mut on_stage).map_err(|e| match e {
-        BakeError::Config(_) | BakeError::Input(_) => {
-            anyhow::Error::from(BadInput(format!("{}: {e}", input_path.display())))
-        }
-        internal => anyhow::Error::from(internal),
-    })?;
-    baked.report.diagnostics.extend(imported.diagnostics.iter().cloned());
+    let baked = drafter_catalog::bake_bytes(&input_path, bytes, &config, &limits, &mut on_stage)?;
 
     // Every file the command writes is staged first and renamed into place together, so a failure
     // in any of them leaves all of them as they were.
-    let report_json = args.report.as_ref().map(|_| serde_json::to_vec_pretty(&baked.report)).transpose()?;
+    let report_json = serde_json::to_vec_pretty(&baked.report)?;
     let mut extra: Vec<(PathBuf, &[u8])> = Vec::new();
-    if let (Some(path), Some(json)) = (&args.report, &report_json) {
-        extra.push((path.clone(), json));
+    if let Some(path) = &args.report {
+        extra.push((path.clone(), &report_json));
     }
     if let Some(dir) = &args.textures_out {
         std::fs::create_dir_all(dir).map_err(|e| IoFailure(format!("{}: cannot create: {e}", dir.display())))?;
@@ -206,88 +267,100 @@ pub fn run(args: Args) -> Result<()> {
             extra.push((dir.join(format!("{}.png", image.name)), &image.png));
         }
     }
-    write_outputs(&output, &baked.written, &config.container, &extra)?;
+    let bin = baked.written.bin.as_deref();
+    drafter_catalog::output::write_outputs(&output, &baked.written.main, bin, &config.container, &extra)?;
+    if let (Some(cache), Some(key)) = (&cache, &key) {
+        let payloads: [&[u8]; 3] = [&baked.written.main, bin.unwrap_or_default(), &report_json];
+        if let Err(e) = cache.put(key, &payloads, &drafter_catalog::batch::guard) {
+            eprintln!("drafter: warning: {}: cannot store in the cache: {e}", cache.root().display());
+        }
+        evict(cache, args.quiet);
+    }
     progress.finish();
     if args.json {
         out!("{}", serde_json::to_string_pretty(&baked.report)?);
     }
 
     if !args.quiet {
-        let r = &baked.report;
-        eprintln!(
-            "baked {} → {}: {} parts, {} triangles, {} bytes in {:.0} ms ({})",
-            input_path.display(),
-            output.display(),
-            r.parts.len(),
-            r.triangles,
-            r.output_bytes,
-            started.elapsed().as_secs_f64() * 1e3,
-            r.stages.iter().map(|s| format!("{} {:.0} ms", s.name, s.ms)).collect::<Vec<_>>().join(", ")
-        );
-        let b = &r.sections;
-        let share = |x: u64| 100.0 * x as f64 / b.total.max(1) as f64;
-        eprintln!(
-            "  bytes: geometry {:.1}%, normals {:.1}%, Khronos edges {:.1}%, hierarchies {:.1}%, labels {:.1}%, \
-             textures {:.1}%, JSON {:.1}%, other {:.1}%",
-            share(b.geometry),
-            share(b.normals),
-            share(b.khronos_edges),
-            share(b.hierarchies),
-            share(b.labels),
-            share(b.textures),
-            share(b.json),
-            share(b.other)
-        );
-        if let Some(c) = &r.compression {
-            eprintln!("  compressed with {c}");
-        }
-        if let Some(s) = &r.split {
-            eprintln!(
-                "  16-bit indices: {} primitive(s) over 65,535 vertices written as {} ({} of {} vertices repeated at seams)",
-                s.split_primitives,
-                s.chunks,
-                drafter_core::thousands(s.duplicated_vertices),
-                drafter_core::thousands(s.vertices)
-            );
-        }
-        if let Some(t) = &r.textures {
-            let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
-            eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);
-        }
-        if args.verbose {
-            for d in &r.diagnostics {
-                eprintln!("  note: {}: {}: {}", d.kind.label(), drafter_core::thousands(d.count), d.first_example);
-            }
-        } else {
-            let summaries = drafter_core::summarize(&r.diagnostics);
-            let folded = summaries.iter().any(|s| s.entries > 1);
-            for s in &summaries {
-                eprintln!("  note: {s}");
-            }
-            if folded {
-                eprintln!("  (--verbose lists every place)");
-            }
-        }
+        print_summary(&input_path, &output, &baked.report, started, args.verbose);
     }
     Ok(())
+}
+
+/// Keeps the cache within `--cache-max`, saying what went where anything did.
+pub(crate) fn evict(cache: &Cache, quiet: bool) {
+    let evicted = cache.evict();
+    if !quiet && evicted.entries > 0 {
+        eprintln!(
+            "  cache: evicted {} least recently used entries ({} bytes) to stay within {} bytes",
+            evicted.entries,
+            evicted.bytes,
+            cache.max_bytes.unwrap_or_default()
+        );
+    }
+}
+
+fn print_summary(input_path: &Path, output: &Path, r: &drafter_bake::BakeReport, started: Instant, verbose: bool) {
+    eprintln!(
+        "baked {} → {}: {} parts, {} triangles, {} bytes in {:.0} ms ({})",
+        input_path.display(),
+        output.display(),
+        r.parts.len(),
+        r.triangles,
+        r.output_bytes,
+        started.elapsed().as_secs_f64() * 1e3,
+        r.stages.iter().map(|s| format!("{} {:.0} ms", s.name, s.ms)).collect::<Vec<_>>().join(", ")
+    );
+    let b = &r.sections;
+    let share = |x: u64| 100.0 * x as f64 / b.total.max(1) as f64;
+    eprintln!(
+        "  bytes: geometry {:.1}%, normals {:.1}%, Khronos edges {:.1}%, hierarchies {:.1}%, labels {:.1}%, \
+         textures {:.1}%, JSON {:.1}%, other {:.1}%",
+        share(b.geometry),
+        share(b.normals),
+        share(b.khronos_edges),
+        share(b.hierarchies),
+        share(b.labels),
+        share(b.textures),
+        share(b.json),
+        share(b.other)
+    );
+    if let Some(c) = &r.compression {
+        eprintln!("  compressed with {c}");
+    }
+    if let Some(s) = &r.split {
+        eprintln!(
+            "  16-bit indices: {} primitive(s) over 65,535 vertices written as {} ({} of {} vertices repeated at seams)",
+            s.split_primitives,
+            s.chunks,
+            drafter_core::thousands(s.duplicated_vertices),
+            drafter_core::thousands(s.vertices)
+        );
+    }
+    if let Some(t) = &r.textures {
+        let list: Vec<String> = t.images.iter().map(|i| format!("{} {} B", i.name, i.bytes)).collect();
+        eprintln!("  textures: {} ({} images, {} B in all)", list.join(", "), t.images.len(), t.total_bytes);
+    }
+    if verbose {
+        for d in &r.diagnostics {
+            eprintln!("  note: {}: {}: {}", d.kind.label(), drafter_core::thousands(d.count), d.first_example);
+        }
+    } else {
+        let summaries = drafter_core::summarize(&r.diagnostics);
+        let folded = summaries.iter().any(|s| s.entries > 1);
+        for s in &summaries {
+            eprintln!("  note: {s}");
+        }
+        if folded {
+            eprintln!("  (--verbose lists every place)");
+        }
+    }
 }
 
 fn default_output(input: Option<&Path>) -> PathBuf {
     match input.and_then(Path::file_stem) {
         Some(stem) => PathBuf::from(format!("{}.baked.glb", stem.to_string_lossy())),
         None => PathBuf::from(SAMPLE_OUTPUT),
-    }
-}
-
-fn container_for(output: &Path) -> Result<Container> {
-    let extension = output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    match extension.as_str() {
-        "glb" => Ok(Container::Glb),
-        "gltf" => {
-            let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            Ok(Container::Gltf { bin_uri: format!("{stem}.bin") })
-        }
-        _ => Err(BadInput(format!("{}: output must end in .glb or .gltf", output.display())).into()),
     }
 }
 
@@ -354,74 +427,6 @@ fn check_output(
     Ok(())
 }
 
-/// The bake's files, each staged as a temporary file beside its target and synced, then renamed
-/// into place together: a failure in any of them (a full disk, a report path in a missing folder)
-/// leaves every target as it was. The .bin of a .gltf is renamed before the .gltf that names it,
-/// and the main file last.
-fn write_outputs(
-    output: &Path,
-    written: &drafter_format::Written,
-    container: &Container,
-    extra: &[(PathBuf, &[u8])],
-) -> Result<()> {
-    let mut staged = Vec::new();
-    for (path, bytes) in extra {
-        staged.push(Staged::new(path, bytes)?);
-    }
-    if let (Container::Gltf { bin_uri }, Some(bin)) = (container, &written.bin) {
-        staged.push(Staged::new(&output.with_file_name(bin_uri), bin)?);
-    }
-    staged.push(Staged::new(output, &written.main)?);
-    commit(staged)
-}
-
-/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over `path`, so a
-/// reader never sees a partial file and a failure leaves none behind.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    commit(vec![Staged::new(path, bytes)?])
-}
-
-/// A file written in full beside its target, not yet renamed over it. Dropped before
-/// [`commit`], it removes its temporary file (and a signal removes it too, see `interrupt`).
-struct Staged {
-    temp: PathBuf,
-    target: PathBuf,
-    _guard: crate::interrupt::TempFileGuard,
-}
-
-impl Staged {
-    fn new(path: &Path, bytes: &[u8]) -> Result<Self> {
-        let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let temp = folder.join(format!(".{name}.{}.tmp", std::process::id()));
-        // A signal from here on removes the temporary file before the process exits.
-        let staged = Self { _guard: crate::interrupt::TempFileGuard::new(&temp), temp, target: path.to_path_buf() };
-        let written = (|| -> std::io::Result<()> {
-            let mut file = std::fs::File::create(&staged.temp)?;
-            file.write_all(bytes)?;
-            file.sync_all()
-        })();
-        written.map_err(|e| IoFailure(format!("{}: cannot write: {e}", path.display())))?;
-        Ok(staged)
-    }
-}
-
-impl Drop for Staged {
-    fn drop(&mut self) {
-        // After a successful rename there is nothing left to remove.
-        let _ = std::fs::remove_file(&self.temp);
-    }
-}
-
-/// Renames every staged file over its target, in order; the ones not reached are removed.
-fn commit(staged: Vec<Staged>) -> Result<()> {
-    for file in staged {
-        std::fs::rename(&file.temp, &file.target)
-            .map_err(|e| IoFailure(format!("{}: cannot write: {e}", file.target.display())))?;
-    }
-    Ok(())
-}
-
 /// A bar over the bake's steps with the current stage's name, on a terminal only, and only once a
 /// bake has run for a second (`DRAFTER_PROGRESS_DELAY_MS` changes the delay, for tests): short
 /// bakes print nothing but their summary, and redirected output never gets escape codes.
@@ -473,4 +478,25 @@ impl Drop for Progress {
     fn drop(&mut self) {
         self.finish();
     }
+}
+
+/// A size: bytes, or a number with K, M, G or T (powers of 1024; `KB`, `KiB` and `GB` read alike).
+pub(crate) fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let digits = t.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(t.len());
+    let (number, unit) = t.split_at(digits);
+    let number: f64 = number.parse().map_err(|_| format!("{text:?} is not a size (e.g. 512M, 8G)"))?;
+    let shift = match unit.trim().to_ascii_uppercase().trim_end_matches("IB").trim_end_matches('B') {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(format!("{text:?}: unknown unit {unit:?} (use K, M, G or T)")),
+    };
+    let bytes = number * (1u64 << shift) as f64;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("{text:?} is not a size of at least one byte"));
+    }
+    Ok(bytes as u64)
 }

@@ -1,9 +1,11 @@
 //! One module per subcommand, each with `Args` (clap derive) and `run(Args) -> anyhow::Result<()>`.
 
 pub mod bake;
+pub mod batch;
 pub mod bench;
 pub mod bench_silhouettes;
 pub mod bench_sweep;
+pub mod cache;
 pub mod inspect;
 pub mod render;
 pub mod view;

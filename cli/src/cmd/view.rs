@@ -64,9 +64,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     // Saves and exports from the window go through the bake's atomic writer: a signal during a
     // save leaves the previous file intact and no temporary file.
-    crate::interrupt::install();
+    drafter_catalog::interrupt::install();
     let writer = |path: &std::path::Path, bytes: &[u8]| {
-        crate::cmd::bake::write_atomically(path, bytes).map_err(|e| crate::exit::one_line(&e))
+        drafter_catalog::output::write_atomically(path, bytes).map_err(|e| e.to_string())
     };
     drafter_viewer::window::run(model, &args.file, options, &writer).map_err(|e| match e {
         WindowError::NoDisplay(_) => anyhow::Error::from(BadInput(e.to_string())),

@@ -1,16 +1,42 @@
 //! Ctrl-C, SIGTERM and SIGHUP during a write: the temporary files of the atomic writes in progress
-//! (a bake stages all its outputs before it renames any) are removed before the process exits (with 128 + the signal's number, as a shell reports it), so
-//! an interrupted bake leaves nothing behind, and the previous output, which only the final rename
-//! replaces, stays intact.
+//! (a bake stages all its outputs before it renames any; a cache entry is written under the
+//! cache's `tmp/`) are removed before the process exits (with 128 + the signal's number, as a shell
+//! reports it), so an interrupted bake leaves nothing behind, and the previous output, which only
+//! the final rename replaces, stays intact.
 //!
-//! One of the crate's two `unsafe` places (the other is `gpu_env`): a POSIX signal handler may
-//! only call async-signal-safe functions, so it reads the registered paths from atomic pointers
-//! and calls `unlink` and `_exit` (both async-signal-safe), nothing else.
+//! A batch asks for a graceful stop first ([`set_graceful`]): the first signal only sets a flag
+//! ([`stop_requested`]), the batch admits no more files, and the files being baked finish and are
+//! written; a second signal removes the temporary files and exits at once.
+//!
+//! Installed by the `drafter` binary only: a library that embeds the bake (the Python package)
+//! keeps its host's signal handling, and a registered path is then simply never used.
+//!
+//! The crate's one `unsafe` place: a POSIX signal handler may only call async-signal-safe
+//! functions, so it reads the registered paths from atomic pointers and calls `unlink` and `_exit`
+//! (both async-signal-safe), nothing else.
 #![allow(unsafe_code)]
 
 use std::ffi::CString;
 use std::path::Path;
-use std::sync::atomic::{AtomicPtr, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicPtr, Ordering};
+
+/// Set by [`set_graceful`]: the first signal asks for a stop instead of exiting.
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+/// The signal that asked for a stop (0: none).
+static STOP_SIGNAL: AtomicI32 = AtomicI32::new(0);
+
+/// The first signal only requests a stop ([`stop_requested`]); the next one exits.
+pub fn set_graceful(graceful: bool) {
+    GRACEFUL.store(graceful, Ordering::SeqCst);
+}
+
+/// The signal that requested a graceful stop, if one did.
+pub fn stop_requested() -> Option<i32> {
+    match STOP_SIGNAL.load(Ordering::SeqCst) {
+        0 => None,
+        signal => Some(signal),
+    }
+}
 
 /// Slots for the temporary files to remove if a signal arrives (null: free). A bake stages its
 /// main file, a .gltf's .bin, the report and one PNG per texture at once; a file past the last
@@ -18,6 +44,11 @@ use std::sync::atomic::{AtomicPtr, Ordering};
 static TEMP_FILES: [AtomicPtr<libc::c_char>; 64] = [const { AtomicPtr::new(std::ptr::null_mut()) }; 64];
 
 extern "C" fn on_signal(signal: libc::c_int) {
+    if GRACEFUL.load(Ordering::SeqCst)
+        && STOP_SIGNAL.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst).is_ok()
+    {
+        return;
+    }
     // SAFETY: each path is null or a NUL-terminated string leaked by `TempFileGuard::new`, so never
     // freed; unlink and _exit are async-signal-safe.
     unsafe {

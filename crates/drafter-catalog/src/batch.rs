@@ -1,0 +1,455 @@
+//! Many files in one run: files bake side by side on the stages' own thread pool, admitted in
+//! order under a memory budget; one bad file never stops the others.
+//!
+//! **Admission.** Each file's peak is estimated before its bake ([`crate::estimate`]); a file is
+//! admitted when the estimates of the files running plus its own fit the budget, or when nothing
+//! else runs (a file larger than the whole budget runs alone). Admission is first come, first
+//! served (tickets), so a large file waiting for room is not overtaken by small ones forever. Files
+//! are taken largest first (their size with a glTF's external buffers), which keeps both cores busy
+//! to the end instead of finishing on one large file.
+//!
+//! **Cache.** With a cache, a file whose key has an intact entry is written from it without
+//! running a stage or waiting for admission; a baked file is stored after its output is written.
+//!
+//! **Stopping.** `stop()` is polled before each file and while a file waits for room: the files
+//! running finish and are written, the rest are reported as skipped.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+use drafter_bake::BakeConfig;
+use serde::Serialize;
+
+use crate::cache::{Cache, Miss};
+use crate::discover::Item;
+use crate::job::{self, Error};
+
+/// What happened to one file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    Baked,
+    /// Written from the cache.
+    Cached,
+    Failed,
+    /// Not started: the batch was stopped.
+    Skipped,
+}
+
+/// How the cache served a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CacheUse {
+    /// No cache.
+    Off,
+    Hit,
+    Miss,
+    /// An entry failed its check (truncated, corrupted), was removed, and the file was baked.
+    Rebuilt,
+    /// No key: an external file the input names could not be read.
+    Uncacheable,
+}
+
+/// One file's line in the batch report (`--report`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Record {
+    pub input: String,
+    pub output: String,
+    pub status: Status,
+    pub cache: CacheUse,
+    /// Wall time of this file: reading, hashing, waiting for admission excluded, baking, writing.
+    pub ms: f64,
+    pub bytes_in: u64,
+    pub bytes_out: u64,
+    /// The peak memory the admission reserved (0 for a file that was not baked).
+    pub estimated_peak_bytes: u64,
+    /// The one-line reason of a failure.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// The exit code the failure alone would have had (2 input, 3 I/O, 1 internal).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exit_code: Option<u8>,
+    /// A problem that did not fail the file (the cache could not be written).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
+}
+
+impl Record {
+    fn new(input: &Path, output: &Path) -> Self {
+        Record {
+            input: input.display().to_string(),
+            output: output.display().to_string(),
+            status: Status::Skipped,
+            cache: CacheUse::Off,
+            ms: 0.0,
+            bytes_in: 0,
+            bytes_out: 0,
+            estimated_peak_bytes: 0,
+            error: None,
+            exit_code: None,
+            warning: None,
+        }
+    }
+
+    fn fail(&mut self, e: &Error) {
+        self.status = Status::Failed;
+        self.error = Some(e.to_string().replace('\n', " "));
+        self.exit_code = Some(e.exit_code());
+    }
+}
+
+/// A reservation of the memory budget, released when dropped.
+pub struct Permit<'a> {
+    budget: Option<&'a Budget>,
+    bytes: u64,
+}
+
+impl std::fmt::Debug for Permit<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Permit({} bytes)", self.bytes)
+    }
+}
+
+impl Permit<'_> {
+    /// A permit outside any budget (a single bake).
+    pub fn unbounded(bytes: u64) -> Permit<'static> {
+        Permit { budget: None, bytes }
+    }
+}
+
+impl Drop for Permit<'_> {
+    fn drop(&mut self) {
+        if let Some(budget) = self.budget {
+            let mut state = budget.state.lock().unwrap_or_else(|e| e.into_inner());
+            state.in_use -= self.bytes;
+            state.running -= 1;
+            budget.changed.notify_all();
+        }
+    }
+}
+
+/// The memory budget shared by a batch's files.
+#[derive(Debug)]
+pub struct Budget {
+    total: u64,
+    state: Mutex<BudgetState>,
+    changed: Condvar,
+}
+
+#[derive(Debug, Default)]
+struct BudgetState {
+    in_use: u64,
+    running: usize,
+    /// Tickets handed out and the one to be admitted next.
+    issued: u64,
+    serving: u64,
+    /// The most reserved at once.
+    peak: u64,
+}
+
+impl Budget {
+    pub fn new(total: u64) -> Self {
+        Budget { total, state: Mutex::new(BudgetState::default()), changed: Condvar::new() }
+    }
+
+    /// Waits until `bytes` fit (or nothing else runs) and this caller is next in line; `None` if
+    /// `stop()` turns true first. A request over the whole budget reserves the whole budget.
+    pub fn admit(&self, bytes: u64, stop: &dyn Fn() -> bool) -> Option<Permit<'_>> {
+        let bytes = bytes.min(self.total);
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let ticket = state.issued;
+        state.issued += 1;
+        loop {
+            if stop() {
+                // Later tickets must not wait for this one.
+                if state.serving == ticket {
+                    state.serving += 1;
+                }
+                self.changed.notify_all();
+                return None;
+            }
+            if state.serving >= ticket && (state.in_use + bytes <= self.total || state.running == 0) {
+                state.serving = state.serving.max(ticket + 1);
+                state.in_use += bytes;
+                state.running += 1;
+                state.peak = state.peak.max(state.in_use);
+                self.changed.notify_all();
+                return Some(Permit { budget: Some(self), bytes });
+            }
+            // A timeout, so that a stop request is seen while waiting.
+            state = self.changed.wait_timeout(state, Duration::from_millis(50)).unwrap_or_else(|e| e.into_inner()).0;
+        }
+    }
+
+    pub fn peak(&self) -> u64 {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).peak
+    }
+}
+
+/// Bakes `input` into `output` (a .glb or .gltf), through `cache` when given: a hit writes the
+/// stored bytes without running a stage; otherwise `admit` is asked for the bake's estimated
+/// peak, and `None` from it skips the file. The record says what happened; nothing is partial.
+pub fn bake_file<'b>(
+    input: &Path,
+    output: &Path,
+    config: &BakeConfig,
+    limits: &drafter_io::Limits,
+    cache: Option<&Cache>,
+    admit: &dyn Fn(u64) -> Option<Permit<'b>>,
+) -> Record {
+    let started = Instant::now();
+    let mut record = Record::new(input, output);
+    let result = bake_file_inner(input, output, config, limits, cache, admit, &mut record);
+    if let Err(e) = result {
+        record.fail(&e);
+    }
+    record.ms = started.elapsed().as_secs_f64() * 1e3;
+    record
+}
+
+fn bake_file_inner<'b>(
+    input: &Path,
+    output: &Path,
+    config: &BakeConfig,
+    limits: &drafter_io::Limits,
+    cache: Option<&Cache>,
+    admit: &dyn Fn(u64) -> Option<Permit<'b>>,
+    record: &mut Record,
+) -> Result<(), Error> {
+    let mut config = config.clone();
+    config.container = crate::output::container_for(output)?;
+    let bytes = job::read_input(input)?;
+    record.bytes_in = bytes.len() as u64;
+    let key = cache.map(|c| (c, crate::cache::key_of(input, &bytes, &config)));
+    if let Some((cache, key)) = key {
+        record.cache = CacheUse::Uncacheable;
+        if let Some(key) = key {
+            match cache.get(&key) {
+                Ok(payloads) => {
+                    let bin = payloads.get(1).filter(|b| !b.is_empty()).map(Vec::as_slice);
+                    crate::output::write_outputs(output, &payloads[0], bin, &config.container, &[])?;
+                    record.bytes_out = (payloads[0].len() + bin.map_or(0, <[u8]>::len)) as u64;
+                    record.status = Status::Cached;
+                    record.cache = CacheUse::Hit;
+                    return Ok(());
+                }
+                Err(Miss::Absent) => record.cache = CacheUse::Miss,
+                Err(Miss::Corrupt(_)) => record.cache = CacheUse::Rebuilt,
+            }
+        }
+    }
+    let estimate = crate::estimate::peak_bytes(input, &bytes);
+    let Some(_permit) = admit(estimate) else {
+        record.status = Status::Skipped;
+        return Ok(());
+    };
+    record.estimated_peak_bytes = estimate;
+    let baked = job::bake_bytes(input, bytes, &config, limits, &mut |_| {})?;
+    let bin = baked.written.bin.as_deref();
+    crate::output::write_outputs(output, &baked.written.main, bin, &config.container, &[])?;
+    record.bytes_out = (baked.written.main.len() + bin.map_or(0, <[u8]>::len)) as u64;
+    record.status = Status::Baked;
+    if let Some((cache, Some(key))) = key {
+        let report = serde_json::to_vec(&baked.report).unwrap_or_default();
+        let payloads: [&[u8]; 3] = [&baked.written.main, bin.unwrap_or_default(), &report];
+        if let Err(e) = cache.put(&key, &payloads, &guard) {
+            record.warning = Some(format!("{}: cannot store in the cache: {e}", cache.root().display()));
+        }
+    }
+    Ok(())
+}
+
+/// Registers a temporary file with the signal handler ([`crate::interrupt`]).
+pub fn guard(path: &Path) -> Box<dyn Send> {
+    Box::new(crate::interrupt::TempFileGuard::new(path))
+}
+
+/// Options of a batch.
+#[derive(Debug)]
+pub struct Options {
+    pub config: BakeConfig,
+    pub limits: drafter_io::Limits,
+    pub cache: Option<Cache>,
+    /// Bytes of estimated peak memory the running files may reserve together.
+    pub memory_budget: u64,
+    /// Files baked at once, at most.
+    pub workers: usize,
+}
+
+/// Follows a batch (a progress bar).
+pub trait Observer: Sync {
+    /// The batch holds `files` files of `bytes` in all.
+    fn begin(&self, _files: usize, _bytes: u64) {}
+    /// `item` was taken; `bytes` is its size as counted in [`Summary::bytes_total`].
+    fn started(&self, _item: &Item, _bytes: u64) {}
+    fn finished(&self, _item: &Item, _bytes: u64, _record: &Record) {}
+}
+
+/// No progress shown.
+#[derive(Debug)]
+pub struct Quiet;
+impl Observer for Quiet {}
+
+/// The batch report (`--report`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub files: Vec<Record>,
+    pub baked: usize,
+    pub cached: usize,
+    pub failed: usize,
+    pub skipped: usize,
+    pub wall_ms: f64,
+    pub bytes_total: u64,
+    pub memory_budget: u64,
+    /// The most estimated peak memory admitted at once.
+    pub peak_admitted_bytes: u64,
+    pub workers: usize,
+}
+
+/// Bakes `items` into `out_dir`, `options.workers` files at a time under the memory budget.
+pub fn run(
+    items: &[Item],
+    out_dir: &Path,
+    options: &Options,
+    stop: &(dyn Fn() -> bool + Sync),
+    observer: &dyn Observer,
+) -> Summary {
+    let started = Instant::now();
+    let sizes: Vec<u64> = items.iter().map(|i| input_size(&i.input)).collect();
+    // Largest first; ties in the given order.
+    let mut order: Vec<usize> = (0..items.len()).collect();
+    order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
+    observer.begin(items.len(), sizes.iter().sum());
+    let budget = Budget::new(options.memory_budget.max(1));
+    let next = AtomicUsize::new(0);
+    let records: Vec<Mutex<Option<Record>>> = items.iter().map(|_| Mutex::new(None)).collect();
+    let workers = options.workers.clamp(1, items.len().max(1));
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(&index) = order.get(k) else { break };
+                    let item = &items[index];
+                    let output = out_dir.join(&item.relative_output);
+                    let record = if stop() {
+                        Record::new(&item.input, &output)
+                    } else {
+                        observer.started(item, sizes[index]);
+                        let record = match output.parent().map(std::fs::create_dir_all) {
+                            Some(Err(e)) => {
+                                let mut record = Record::new(&item.input, &output);
+                                let folder = output.parent().unwrap_or(out_dir);
+                                record.fail(&Error::Io(format!("{}: cannot create: {e}", folder.display())));
+                                record
+                            }
+                            _ => bake_file(
+                                &item.input,
+                                &output,
+                                &options.config,
+                                &options.limits,
+                                options.cache.as_ref(),
+                                &|bytes| budget.admit(bytes, stop),
+                            ),
+                        };
+                        observer.finished(item, sizes[index], &record);
+                        record
+                    };
+                    *records[index].lock().unwrap_or_else(|e| e.into_inner()) = Some(record);
+                }
+            });
+        }
+    });
+    let files: Vec<Record> = records
+        .into_iter()
+        .zip(items)
+        .map(|(r, item)| {
+            r.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .unwrap_or_else(|| Record::new(&item.input, &out_dir.join(&item.relative_output)))
+        })
+        .collect();
+    let count = |s: Status| files.iter().filter(|r| r.status == s).count();
+    Summary {
+        baked: count(Status::Baked),
+        cached: count(Status::Cached),
+        failed: count(Status::Failed),
+        skipped: count(Status::Skipped),
+        wall_ms: started.elapsed().as_secs_f64() * 1e3,
+        bytes_total: sizes.iter().sum(),
+        memory_budget: options.memory_budget,
+        peak_admitted_bytes: budget.peak(),
+        workers,
+        files,
+    }
+}
+
+/// A file's size for ordering and progress: a .gltf's own bytes plus the external buffers it names.
+fn input_size(path: &Path) -> u64 {
+    let own = std::fs::metadata(path).map_or(0, |m| m.len());
+    let is_gltf = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+    if !is_gltf || own > 64 << 20 {
+        return own;
+    }
+    let Ok(text) = std::fs::read(path) else { return own };
+    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(&text) else { return own };
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let buffers = doc.get("buffers").and_then(serde_json::Value::as_array);
+    own + buffers
+        .into_iter()
+        .flatten()
+        .filter_map(|b| b.get("uri")?.as_str())
+        .filter(|uri| !uri.starts_with("data:"))
+        .filter_map(|uri| drafter_core::uri::relative_path(uri).ok())
+        .map(|relative: PathBuf| std::fs::metadata(folder.join(relative)).map_or(0, |m| m.len()))
+        .sum::<u64>()
+}
+
+/// A safe default budget: half the memory available now (`/proc/meminfo`), or 2 GiB where that
+/// cannot be read.
+pub fn default_memory_budget() -> u64 {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib * 1024)
+    });
+    available.map_or(2 << 30, |a| a / 2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn admission_never_exceeds_the_budget_and_a_large_request_runs_alone() {
+        let budget = Budget::new(100);
+        let never = || false;
+        let running = std::sync::atomic::AtomicU64::new(0);
+        let worst = std::sync::atomic::AtomicU64::new(0);
+        let requests: Vec<u64> = (0..200).map(|i| [10, 35, 60, 150, 1][i % 5]).collect();
+        let next = AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            for _ in 0..6 {
+                s.spawn(|| {
+                    while let Some(&bytes) = requests.get(next.fetch_add(1, Ordering::SeqCst)) {
+                        let permit = budget.admit(bytes, &never).unwrap();
+                        let now = running.fetch_add(permit.bytes, Ordering::SeqCst) + permit.bytes;
+                        worst.fetch_max(now, Ordering::SeqCst);
+                        std::thread::sleep(Duration::from_micros(200));
+                        running.fetch_sub(permit.bytes, Ordering::SeqCst);
+                    }
+                });
+            }
+        });
+        assert!(worst.load(Ordering::SeqCst) <= 100);
+        assert_eq!(budget.peak(), worst.load(Ordering::SeqCst).max(budget.peak()));
+        assert!(budget.peak() <= 100);
+        // A stop request releases a waiter.
+        let held = budget.admit(100, &never).unwrap();
+        assert!(budget.admit(50, &|| true).is_none());
+        drop(held);
+        assert!(budget.admit(50, &never).is_some());
+    }
+}

@@ -1,0 +1,455 @@
+//! A content-addressed cache of baked files (`--cache DIR`, `DRAFTER_CACHE`).
+//!
+//! **Key.** BLAKE3 over: this cache's layout version, drafter's build ([`BUILD_ID`]: the package
+//! version and the commit it was built from), the extension's format version, the input's file name
+//! (the output records it), the effective configuration in a canonical form, the digest of the
+//! input's bytes, and the URI and digest of every external file a glTF input names (buffers and
+//! images, resolved by drafter-io's confined rule). The configuration's canonical form is its
+//! `Debug` text: derived, so it lists every field of every stage's options with floats in their
+//! shortest round-trip form, and an option added later can never be left out of the key. A bake is
+//! byte-identical at any thread count (an invariant of drafter-bake), so the key decides the bytes.
+//!
+//! **Entries.** One file per key, `entries/KK/KEY` (KK its first two hex digits): a header (magic,
+//! layout version, payload count, then per payload its length and BLAKE3 digest) and the payloads
+//! (the main file, a .gltf's .bin, the bake report's JSON). A read checks the size against the
+//! header and every digest, so a truncated or corrupted entry is removed and rebuilt, never
+//! served.
+//!
+//! **Concurrency.** An entry is written whole under `tmp/` (a name unique to the host, process and
+//! write) and renamed into place: rename is atomic on local file systems and on NFS, so readers see
+//! an entry whole or not at all, and two processes or machines that bake the same key at once
+//! write the same bytes, the last rename winning. No locks, no daemon. A hit marks the entry used
+//! by setting its modification time; [`Cache::evict`] removes the least recently used entries
+//! past the size bound, and temporary files older than an hour (left by a killed process).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, SystemTime};
+
+use serde::Serialize;
+
+/// drafter's build as the key sees it: the package version, and the commit the build came from
+/// where it was built from a git checkout (`build.rs`), since outputs change between commits of
+/// the same version.
+pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("DRAFTER_BUILD_COMMIT"));
+
+const MAGIC: &[u8; 8] = b"DRFTCACH";
+const LAYOUT: u32 = 1;
+/// Payloads per entry: main file, .bin, report.
+const MAX_PAYLOADS: u32 = 4;
+/// Temporary files older than this are a killed writer's and are removed by [`Cache::evict`].
+const STALE_TEMP: Duration = Duration::from_secs(3600);
+
+/// A cache key: 32 bytes of BLAKE3, written as 64 hex digits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Key(pub [u8; 32]);
+
+impl std::fmt::Display for Key {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for b in self.0 {
+            write!(f, "{b:02x}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Hashes `bytes` with BLAKE3, on the thread pool for large inputs (about twice as fast on 2 cores
+/// from a few megabytes on).
+pub fn digest(bytes: &[u8]) -> [u8; 32] {
+    let mut hasher = blake3::Hasher::new();
+    if bytes.len() >= 1 << 20 {
+        hasher.update_rayon(bytes);
+    } else {
+        hasher.update(bytes);
+    }
+    *hasher.finalize().as_bytes()
+}
+
+/// The key of baking `bytes` read from `path` with `config` (its `input` field is ignored: the
+/// bake fills it from the file). `None` when an external file the input names cannot be read: the
+/// bake then decides (it fails, or the file is not one the importer follows), and nothing is
+/// cached for it.
+pub fn key_of(path: &Path, bytes: &[u8], config: &drafter_bake::BakeConfig) -> Option<Key> {
+    let mut config = config.clone();
+    config.input = drafter_format::InputInfo { name: String::new(), format: String::new(), sha256: String::new() };
+    let mut h = blake3::Hasher::new();
+    h.update(b"drafter-cache-key\0");
+    h.update(&LAYOUT.to_le_bytes());
+    for text in [BUILD_ID, drafter_format::FORMAT_VERSION, &crate::job::input_name(path), &format!("{config:?}")] {
+        h.update(&(text.len() as u64).to_le_bytes());
+        h.update(text.as_bytes());
+    }
+    h.update(&digest(bytes));
+    for uri in external_uris(bytes) {
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let content = drafter_io::read_buffer_uri(folder, &uri).ok()?;
+        h.update(&(uri.len() as u64).to_le_bytes());
+        h.update(uri.as_bytes());
+        h.update(&digest(&content));
+    }
+    Some(Key(*h.finalize().as_bytes()))
+}
+
+/// The URIs of files a glTF (or a GLB's JSON) names beside it, buffers then images, in document
+/// order; data URIs are part of the bytes already. Empty for other formats.
+fn external_uris(bytes: &[u8]) -> Vec<String> {
+    let json = if drafter_core::glb::is_glb(bytes) {
+        match drafter_core::glb::split(bytes) {
+            Ok(chunks) => chunks.json,
+            Err(_) => return Vec::new(),
+        }
+    } else {
+        bytes
+    };
+    let start = json.iter().position(|b| !b.is_ascii_whitespace());
+    if start.is_none_or(|i| json[i] != b'{') {
+        return Vec::new();
+    }
+    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else { return Vec::new() };
+    let mut uris = Vec::new();
+    for key in ["buffers", "images"] {
+        for item in doc.get(key).and_then(serde_json::Value::as_array).into_iter().flatten() {
+            if let Some(uri) = item.get("uri").and_then(serde_json::Value::as_str)
+                && !uri.starts_with("data:")
+            {
+                uris.push(uri.to_owned());
+            }
+        }
+    }
+    uris
+}
+
+/// What `drafter cache stats` prints.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Stats {
+    pub entries: u64,
+    pub bytes: u64,
+    /// Temporary files of writes in progress or of killed writers.
+    pub temporary_files: u64,
+    /// Seconds since the least and the most recently used entry was last used.
+    pub oldest_use_s: Option<u64>,
+    pub newest_use_s: Option<u64>,
+}
+
+/// What [`Cache::evict`] removed.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Evicted {
+    pub entries: u64,
+    pub bytes: u64,
+    pub stale_temporary_files: u64,
+}
+
+/// A cache folder.
+#[derive(Debug, Clone)]
+pub struct Cache {
+    root: PathBuf,
+    /// Size bound in bytes for [`Cache::evict`] (`--cache-max`); `None`: unbounded.
+    pub max_bytes: Option<u64>,
+}
+
+/// Why an entry was not served.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Miss {
+    /// No entry.
+    Absent,
+    /// An entry that failed its check (truncated, corrupted); it was removed.
+    Corrupt(String),
+}
+
+static WRITES: AtomicU64 = AtomicU64::new(0);
+
+impl Cache {
+    /// Opens (creating) the cache folder `root`.
+    pub fn open(root: &Path, max_bytes: Option<u64>) -> std::io::Result<Self> {
+        std::fs::create_dir_all(root.join("entries"))?;
+        std::fs::create_dir_all(root.join("tmp"))?;
+        Ok(Self { root: root.to_path_buf(), max_bytes })
+    }
+
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    fn entry_path(&self, key: &Key) -> PathBuf {
+        let hex = key.to_string();
+        self.root.join("entries").join(&hex[..2]).join(hex)
+    }
+
+    /// The payloads stored under `key`, checked against their digests; a hit marks the entry used.
+    pub fn get(&self, key: &Key) -> Result<Vec<Vec<u8>>, Miss> {
+        let path = self.entry_path(key);
+        let bytes = match std::fs::read(&path) {
+            Ok(bytes) => bytes,
+            Err(_) => return Err(Miss::Absent),
+        };
+        match decode(&bytes) {
+            Ok(payloads) => {
+                // Last use, for eviction; a failure (a read-only cache) only costs LRU order.
+                if let Ok(file) = std::fs::File::options().write(true).open(&path) {
+                    let _ = file.set_modified(SystemTime::now());
+                }
+                Ok(payloads)
+            }
+            Err(why) => {
+                // Removed so that the rebuilt entry replaces it; a concurrent writer's fresh entry
+                // renamed in between would be removed too, and is then written again.
+                let _ = std::fs::remove_file(&path);
+                Err(Miss::Corrupt(why))
+            }
+        }
+    }
+
+    /// Stores `payloads` under `key`: written whole under `tmp/`, synced, renamed into place.
+    /// `guard` registers the temporary file for removal should the process be interrupted.
+    pub fn put(&self, key: &Key, payloads: &[&[u8]], guard: &dyn Fn(&Path) -> Box<dyn Send>) -> std::io::Result<()> {
+        let target = self.entry_path(key);
+        if let Some(folder) = target.parent() {
+            std::fs::create_dir_all(folder)?;
+        }
+        let temp = self.root.join("tmp").join(format!(
+            "{}.{}.{}.{}.tmp",
+            key,
+            hostname(),
+            std::process::id(),
+            WRITES.fetch_add(1, Ordering::Relaxed)
+        ));
+        let _guard = guard(&temp);
+        let written = (|| {
+            let mut file = std::fs::File::create(&temp)?;
+            file.write_all(&encode_header(payloads))?;
+            for p in payloads {
+                file.write_all(p)?;
+            }
+            file.sync_all()?;
+            std::fs::rename(&temp, &target)
+        })();
+        if written.is_err() {
+            let _ = std::fs::remove_file(&temp);
+        }
+        written
+    }
+
+    /// Every entry with its size and last use.
+    fn entries(&self) -> Vec<(PathBuf, u64, SystemTime)> {
+        let mut out = Vec::new();
+        let Ok(folders) = std::fs::read_dir(self.root.join("entries")) else { return out };
+        for folder in folders.flatten() {
+            let Ok(files) = std::fs::read_dir(folder.path()) else { continue };
+            for file in files.flatten() {
+                if let Ok(meta) = file.metadata()
+                    && meta.is_file()
+                {
+                    out.push((file.path(), meta.len(), meta.modified().unwrap_or(SystemTime::UNIX_EPOCH)));
+                }
+            }
+        }
+        out
+    }
+
+    pub fn stats(&self) -> Stats {
+        let entries = self.entries();
+        let now = SystemTime::now();
+        let age = |t: SystemTime| now.duration_since(t).unwrap_or_default().as_secs();
+        Stats {
+            entries: entries.len() as u64,
+            bytes: entries.iter().map(|e| e.1).sum(),
+            temporary_files: std::fs::read_dir(self.root.join("tmp")).map_or(0, |d| d.count() as u64),
+            oldest_use_s: entries.iter().map(|e| e.2).min().map(age),
+            newest_use_s: entries.iter().map(|e| e.2).max().map(age),
+        }
+    }
+
+    /// Removes the least recently used entries until the cache holds at most `max_bytes`, and
+    /// temporary files older than an hour.
+    pub fn evict(&self) -> Evicted {
+        let mut evicted = Evicted::default();
+        let now = SystemTime::now();
+        if let Ok(temps) = std::fs::read_dir(self.root.join("tmp")) {
+            for temp in temps.flatten() {
+                let stale = temp
+                    .metadata()
+                    .and_then(|m| m.modified())
+                    .is_ok_and(|t| now.duration_since(t).unwrap_or_default() > STALE_TEMP);
+                if stale && std::fs::remove_file(temp.path()).is_ok() {
+                    evicted.stale_temporary_files += 1;
+                }
+            }
+        }
+        let Some(max) = self.max_bytes else { return evicted };
+        let mut entries = self.entries();
+        let mut total: u64 = entries.iter().map(|e| e.1).sum();
+        // Oldest use first; ties by path, so two evictions of one state agree.
+        entries.sort_by(|a, b| a.2.cmp(&b.2).then_with(|| a.0.cmp(&b.0)));
+        for (path, bytes, _) in entries {
+            if total <= max {
+                break;
+            }
+            if std::fs::remove_file(&path).is_ok() {
+                total -= bytes;
+                evicted.entries += 1;
+                evicted.bytes += bytes;
+            }
+        }
+        evicted
+    }
+
+    /// Removes every entry and temporary file; returns the number of entries removed.
+    pub fn clear(&self) -> std::io::Result<u64> {
+        let count = self.entries().len() as u64;
+        for folder in ["entries", "tmp"] {
+            let path = self.root.join(folder);
+            match std::fs::remove_dir_all(&path) {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(e),
+            }
+            std::fs::create_dir_all(&path)?;
+        }
+        Ok(count)
+    }
+}
+
+fn hostname() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|h| h.trim().chars().filter(char::is_ascii_alphanumeric).collect())
+        .unwrap_or_default()
+}
+
+fn encode_header(payloads: &[&[u8]]) -> Vec<u8> {
+    let mut header = Vec::with_capacity(16 + payloads.len() * 40);
+    header.extend_from_slice(MAGIC);
+    header.extend_from_slice(&LAYOUT.to_le_bytes());
+    header.extend_from_slice(&(payloads.len() as u32).to_le_bytes());
+    for p in payloads {
+        header.extend_from_slice(&(p.len() as u64).to_le_bytes());
+        header.extend_from_slice(&digest(p));
+    }
+    header
+}
+
+/// The payloads of an entry, or why it is not a whole, intact one.
+fn decode(bytes: &[u8]) -> Result<Vec<Vec<u8>>, String> {
+    let read_u32 = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    if bytes.get(..8) != Some(MAGIC.as_slice()) || read_u32(8) != Some(LAYOUT) {
+        return Err("not an entry of this cache layout".into());
+    }
+    let count = read_u32(12).ok_or("truncated header")?;
+    if count > MAX_PAYLOADS {
+        return Err(format!("{count} payloads"));
+    }
+    let mut at = 16 + count as usize * 40;
+    let header = bytes.get(16..at).ok_or("truncated header")?;
+    let mut payloads = Vec::with_capacity(count as usize);
+    for record in header.chunks_exact(40) {
+        let mut len = [0u8; 8];
+        len.copy_from_slice(&record[..8]);
+        let len = u64::from_le_bytes(len);
+        let end = usize::try_from(len).ok().and_then(|l| at.checked_add(l)).filter(|&e| e <= bytes.len());
+        let end = end.ok_or("truncated")?;
+        let payload = &bytes[at..end];
+        if digest(payload) != record[8..40] {
+            return Err("a payload does not match its digest".into());
+        }
+        payloads.push(payload.to_vec());
+        at = end;
+    }
+    if at != bytes.len() {
+        return Err("trailing bytes".into());
+    }
+    Ok(payloads)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("drafter-cache-test-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    fn no_guard(_: &Path) -> Box<dyn Send> {
+        Box::new(())
+    }
+
+    #[test]
+    fn an_entry_round_trips_and_a_damaged_one_is_never_served() {
+        let dir = scratch("damage");
+        let cache = Cache::open(&dir, None).unwrap();
+        let key = Key([7; 32]);
+        assert_eq!(cache.get(&key), Err(Miss::Absent));
+        cache.put(&key, &[b"main bytes", b"", b"{\"report\":1}"], &no_guard).unwrap();
+        assert_eq!(cache.get(&key).unwrap(), vec![b"main bytes".to_vec(), vec![], b"{\"report\":1}".to_vec()]);
+        let path = cache.entry_path(&key);
+        let whole = std::fs::read(&path).unwrap();
+        // Every truncation, and a flip of every byte, is detected.
+        for cut in 0..whole.len() {
+            std::fs::write(&path, &whole[..cut]).unwrap();
+            assert!(matches!(cache.get(&key), Err(Miss::Corrupt(_))), "cut at {cut}");
+            assert!(!path.exists(), "a damaged entry is removed");
+        }
+        for at in 0..whole.len() {
+            let mut damaged = whole.clone();
+            damaged[at] ^= 0x10;
+            std::fs::write(&path, &damaged).unwrap();
+            assert!(matches!(cache.get(&key), Err(Miss::Corrupt(_))), "flip at {at}");
+        }
+        let mut longer = whole.clone();
+        longer.push(0);
+        std::fs::write(&path, &longer).unwrap();
+        assert!(matches!(cache.get(&key), Err(Miss::Corrupt(_))));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn eviction_removes_the_least_recently_used_first() {
+        let dir = scratch("lru");
+        let cache = Cache::open(&dir, Some(2 * (56 + 100))).unwrap();
+        let payload = [1u8; 100];
+        for k in 0..4u8 {
+            cache.put(&Key([k; 32]), &[&payload], &no_guard).unwrap();
+            let t = SystemTime::UNIX_EPOCH + Duration::from_secs(1_000_000 + u64::from(k));
+            std::fs::File::options()
+                .write(true)
+                .open(cache.entry_path(&Key([k; 32])))
+                .unwrap()
+                .set_modified(t)
+                .unwrap();
+        }
+        // Entry 0 used last: it stays, 1 and 2 (the oldest uses) go.
+        assert!(cache.get(&Key([0; 32])).is_ok());
+        let evicted = cache.evict();
+        assert_eq!(evicted.entries, 2);
+        assert!(cache.get(&Key([0; 32])).is_ok());
+        assert_eq!(cache.get(&Key([1; 32])), Err(Miss::Absent));
+        assert_eq!(cache.get(&Key([2; 32])), Err(Miss::Absent));
+        assert!(cache.get(&Key([3; 32])).is_ok());
+        assert_eq!(cache.stats().entries, 2);
+        assert_eq!(cache.clear().unwrap(), 2);
+        assert_eq!(cache.stats().entries, 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_key_follows_the_bytes_the_name_the_config_and_external_files() {
+        let dir = scratch("key");
+        std::fs::create_dir_all(&dir).unwrap();
+        let gltf = br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"a.bin","byteLength":4}]}"#;
+        std::fs::write(dir.join("a.bin"), [1, 2, 3, 4]).unwrap();
+        let config = drafter_bake::BakeConfig::default();
+        let path = dir.join("m.gltf");
+        let base = key_of(&path, gltf, &config).unwrap();
+        assert_eq!(key_of(&path, gltf, &config), Some(base), "deterministic");
+        std::fs::write(dir.join("a.bin"), [1, 2, 3, 5]).unwrap();
+        assert_ne!(key_of(&path, gltf, &config), Some(base), "an external buffer is part of the key");
+        assert_ne!(key_of(&dir.join("n.gltf"), gltf, &config), Some(base), "the name is written into the output");
+        let mut other = config.clone();
+        other.gradient.q += 1;
+        assert_ne!(key_of(&path, gltf, &other), Some(base), "every option is part of the key");
+        std::fs::remove_file(dir.join("a.bin")).unwrap();
+        assert_eq!(key_of(&path, gltf, &config), None, "a missing external file is not cached");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

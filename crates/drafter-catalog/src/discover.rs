@@ -1,0 +1,169 @@
+//! What a batch bakes: files, folders (every file of a supported format, recursively) and
+//! manifests, each with the output path that mirrors its relative path under the output folder.
+
+use std::path::{Path, PathBuf};
+
+/// Extensions of the formats drafter reads (compared without case: CAD tools write `.STL`).
+pub const EXTENSIONS: [&str; 6] = ["gltf", "glb", "obj", "stl", "off", "ply"];
+
+/// One input of a batch and where its output goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Item {
+    pub input: PathBuf,
+    /// The input's path relative to what named it (its folder, the manifest's folder), with the
+    /// extension replaced by `.glb`: the output's path under the output folder.
+    pub relative_output: PathBuf,
+}
+
+/// Why the inputs could not be listed (bad input: exit 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct DiscoverError(pub String);
+
+/// Lists the files to bake from `inputs` (files or folders) and `manifests`, in a stable order
+/// (the order given; a folder's files sorted by path). `skip` is a folder never entered (the
+/// output folder, when it lies inside an input folder). Two inputs whose outputs would be the same
+/// file are refused, as is a path that does not exist.
+pub fn discover(inputs: &[PathBuf], manifests: &[PathBuf], skip: Option<&Path>) -> Result<Vec<Item>, DiscoverError> {
+    let skip = skip.and_then(|s| s.canonicalize().ok());
+    let mut items = Vec::new();
+    for input in inputs {
+        add(input, None, skip.as_deref(), &mut items)?;
+    }
+    for manifest in manifests {
+        let text = std::fs::read_to_string(manifest)
+            .map_err(|e| DiscoverError(format!("{}: cannot read manifest: {e}", manifest.display())))?;
+        let base = manifest.parent().unwrap_or(Path::new(""));
+        for (line, entry) in manifest_entries(manifest, &text)? {
+            let path = base.join(&entry);
+            let relative = (Path::new(&entry).is_relative()).then(|| PathBuf::from(&entry));
+            add(&path, relative.as_deref(), skip.as_deref(), &mut items)
+                .map_err(|e| DiscoverError(format!("{}:{line}: {e}", manifest.display())))?;
+        }
+    }
+    let mut seen = std::collections::HashMap::new();
+    for item in &items {
+        if let Some(first) = seen.insert(item.relative_output.clone(), item.input.clone()) {
+            return Err(DiscoverError(format!(
+                "{} and {} would both be written to {}; bake them in separate runs or rename one",
+                first.display(),
+                item.input.display(),
+                item.relative_output.display()
+            )));
+        }
+    }
+    Ok(items)
+}
+
+/// The entries of a manifest with their line numbers: a `.toml` file's `inputs = [...]`, or one
+/// path per line (blank lines and lines starting with `#` skipped).
+fn manifest_entries(path: &Path, text: &str) -> Result<Vec<(usize, String)>, DiscoverError> {
+    let is_toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_toml {
+        return Ok(text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+            .map(|(i, l)| (i, l.to_owned()))
+            .collect());
+    }
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Manifest {
+        inputs: Vec<String>,
+    }
+    let manifest: Manifest = toml::from_str(text)
+        .map_err(|e| DiscoverError(format!("{}: {}", path.display(), e.to_string().replace('\n', " "))))?;
+    // A TOML array has no line of its own per entry: entries are numbered from 1 instead.
+    Ok(manifest.inputs.into_iter().enumerate().map(|(i, s)| (i + 1, s)).collect())
+}
+
+fn add(path: &Path, relative: Option<&Path>, skip: Option<&Path>, items: &mut Vec<Item>) -> Result<(), DiscoverError> {
+    let meta = std::fs::metadata(path).map_err(|e| DiscoverError(format!("{}: {e}", path.display())))?;
+    if meta.is_dir() {
+        let mut files = Vec::new();
+        walk(path, skip, &mut files).map_err(|e| DiscoverError(format!("{}: {e}", path.display())))?;
+        files.sort();
+        let prefix = relative.map(Path::to_path_buf).unwrap_or_default();
+        for file in files {
+            let below = file.strip_prefix(path).unwrap_or(&file);
+            let relative_output = prefix.join(below).with_extension("glb");
+            items.push(Item { input: file, relative_output });
+        }
+    } else {
+        // A file named directly is baked whatever its extension (the importer decides).
+        let relative =
+            relative.map(Path::to_path_buf).unwrap_or_else(|| path.file_name().map(PathBuf::from).unwrap_or_default());
+        items.push(Item {
+            input: path.to_path_buf(),
+            relative_output: without_parent_steps(&relative).with_extension("glb"),
+        });
+    }
+    Ok(())
+}
+
+/// A manifest's `../x.obj` is written as `x.obj` under the output folder, never above it.
+fn without_parent_steps(path: &Path) -> PathBuf {
+    path.components().filter(|c| matches!(c, std::path::Component::Normal(_))).collect()
+}
+
+/// Every file of a supported format below `folder`: hidden files and folders (names starting with
+/// `.`, such as a bake's temporary files) and `skip` are left out; symbolic links to folders are
+/// not followed (no cycles).
+fn walk(folder: &Path, skip: Option<&Path>, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+    if skip.is_some_and(|s| folder.canonicalize().is_ok_and(|c| c == s)) {
+        return Ok(());
+    }
+    for entry in std::fs::read_dir(folder)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        if name.to_string_lossy().starts_with('.') {
+            continue;
+        }
+        let path = entry.path();
+        let kind = entry.file_type()?;
+        if kind.is_dir() {
+            walk(&path, skip, out)?;
+        } else if (kind.is_file() || kind.is_symlink() && path.is_file()) && is_supported(&path) {
+            out.push(path);
+        }
+    }
+    Ok(())
+}
+
+pub fn is_supported(path: &Path) -> bool {
+    path.extension().is_some_and(|e| EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folders_mirror_manifests_resolve_and_collisions_are_refused() {
+        let dir = std::env::temp_dir().join(format!("drafter-discover-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for file in ["in/a.obj", "in/sub/b.STL", "in/sub/c.txt", "in/.hidden.obj", "in/out/old.glb", "x.ply"] {
+            let path = dir.join(file);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, b"x").unwrap();
+        }
+        let items = discover(&[dir.join("in")], &[], Some(&dir.join("in/out"))).unwrap();
+        let outputs: Vec<_> = items.iter().map(|i| i.relative_output.clone()).collect();
+        assert_eq!(outputs, [PathBuf::from("a.glb"), PathBuf::from("sub/b.glb")]);
+
+        std::fs::write(dir.join("list.txt"), "# catalog\nin/sub\n\nx.ply\n").unwrap();
+        let items = discover(&[], &[dir.join("list.txt")], None).unwrap();
+        let outputs: Vec<_> = items.iter().map(|i| i.relative_output.clone()).collect();
+        assert_eq!(outputs, [PathBuf::from("in/sub/b.glb"), PathBuf::from("x.glb")]);
+        std::fs::write(dir.join("list.toml"), "inputs = [\"in/a.obj\", \"missing.obj\"]\n").unwrap();
+        let err = discover(&[], &[dir.join("list.toml")], None).unwrap_err();
+        assert!(err.0.contains("list.toml:2") && err.0.contains("missing.obj"), "{err}");
+
+        std::fs::write(dir.join("in/a.stl"), b"x").unwrap();
+        let err = discover(&[dir.join("in")], &[], Some(&dir.join("in/out"))).unwrap_err();
+        assert!(err.0.contains("a.glb"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
