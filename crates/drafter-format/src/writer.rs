@@ -293,6 +293,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     };
     if from_source {
         keep_node_tree(&mut doc);
+        drop_earlier_records(&mut doc);
     }
     let mut notes = Vec::new();
     // Node index of each instance: the source node, or the synthesized node i.
@@ -915,6 +916,32 @@ fn keep_node_tree(doc: &mut Doc) {
     }
     for (s, scene) in doc.array_mut("scenes").iter_mut().enumerate() {
         keep_listed(scene, "nodes", &scenes[s], &keep_root[s]);
+    }
+}
+
+/// A source baked before carries this format's records on its meshes and primitives, and the
+/// Khronos edges on its primitives: they describe the earlier bake's triangles, so they go, and
+/// this bake writes its own where it has them (the root's record and the nodes' part records are
+/// replaced whole anyway). Left in place, a record this bake did not replace contradicted the one
+/// beside it: a mesh without silhouette candidates now kept the earlier candidates' count over
+/// primitives that encode none, a file that did not read back (drafter-fuzz, issue 47). The
+/// accessors they named are then unreferenced, and the compaction drops them.
+fn drop_earlier_records(doc: &mut Doc) {
+    fn remove_extension(object: &mut Value, name: &str) {
+        let Value::Object(object) = object else { return };
+        let Some(Value::Object(extensions)) = object.get_mut("extensions") else { return };
+        extensions.remove(name);
+        if extensions.is_empty() {
+            object.remove("extensions");
+        }
+    }
+    for mesh in doc.existing_mut("meshes") {
+        remove_extension(mesh, EXTENSION);
+        let Some(primitives) = mesh.get_mut("primitives").and_then(Value::as_array_mut) else { continue };
+        for primitive in primitives {
+            remove_extension(primitive, EXTENSION);
+            remove_extension(primitive, EDGE_VISIBILITY_EXTENSION);
+        }
     }
 }
 
