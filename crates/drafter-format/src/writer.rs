@@ -919,12 +919,13 @@ fn keep_node_tree(doc: &mut Doc) {
     }
 }
 
-/// A source baked before carries this format's records on its meshes and primitives, and the
-/// Khronos edges on its primitives: they describe the earlier bake's triangles, so they go, and
-/// this bake writes its own where it has them (the root's record and the nodes' part records are
-/// replaced whole anyway). Left in place, a record this bake did not replace contradicted the one
-/// beside it: a mesh without silhouette candidates now kept the earlier candidates' count over
-/// primitives that encode none, a file that did not read back (drafter-fuzz, issue 47). The
+/// A source baked before carries this format's records on its nodes, meshes and primitives, and
+/// the Khronos edges on its primitives: they describe the earlier bake, so they go, and this bake
+/// writes its own where it has them (the root's record is replaced whole anyway). Left in place, a
+/// record this bake did not replace contradicted the file or was not read at all (drafter-fuzz,
+/// issue 47): a mesh without silhouette candidates now kept the earlier candidates' count over
+/// primitives that encode none; a node that is no instance now (its parent lost its `children`)
+/// kept the earlier part records, whatever they had become. Either file did not read back. The
 /// accessors they named are then unreferenced, and the compaction drops them.
 fn drop_earlier_records(doc: &mut Doc) {
     fn remove_extension(object: &mut Value, name: &str) {
@@ -934,6 +935,9 @@ fn drop_earlier_records(doc: &mut Doc) {
         if extensions.is_empty() {
             object.remove("extensions");
         }
+    }
+    for node in doc.existing_mut("nodes") {
+        remove_extension(node, EXTENSION);
     }
     for mesh in doc.existing_mut("meshes") {
         remove_extension(mesh, EXTENSION);
