@@ -71,6 +71,10 @@ pub struct Record {
     /// The exit code the failure alone would have had (2 input, 3 I/O, 1 internal).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exit_code: Option<u8>,
+    /// With a cache: the output already held this key's bytes (its receipt matched), so it was
+    /// left as it was.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub up_to_date: bool,
     /// A problem that did not fail the file (the cache could not be written).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warning: Option<String>,
@@ -89,6 +93,7 @@ impl Record {
             estimated_peak_bytes: 0,
             error: None,
             exit_code: None,
+            up_to_date: false,
             warning: None,
         }
     }
@@ -223,13 +228,26 @@ fn bake_file_inner<'b>(
     let bytes = job::read_input(input)?;
     record.bytes_in = bytes.len() as u64;
     let key = cache.map(|c| (c, crate::cache::key_of(input, &bytes, &config)));
+    let bin_path = match &config.container {
+        drafter_format::Container::Gltf { bin_uri } => Some(output.with_file_name(bin_uri)),
+        drafter_format::Container::Glb => None,
+    };
+    let outputs: Vec<&Path> = std::iter::once(output).chain(bin_path.as_deref()).collect();
     if let Some((cache, key)) = key {
         record.cache = CacheUse::Uncacheable;
         if let Some(key) = key {
+            if cache.receipt_matches(&outputs, &key) {
+                record.bytes_out = outputs.iter().map(|p| std::fs::metadata(p).map_or(0, |m| m.len())).sum();
+                record.status = Status::Cached;
+                record.cache = CacheUse::Hit;
+                record.up_to_date = true;
+                return Ok(());
+            }
             match cache.get(&key) {
                 Ok(payloads) => {
                     let bin = payloads.get(1).filter(|b| !b.is_empty()).map(Vec::as_slice);
                     crate::output::write_outputs(output, &payloads[0], bin, &config.container, &[])?;
+                    cache.write_receipt(&outputs, &key);
                     record.bytes_out = (payloads[0].len() + bin.map_or(0, <[u8]>::len)) as u64;
                     record.status = Status::Cached;
                     record.cache = CacheUse::Hit;
@@ -257,6 +275,7 @@ fn bake_file_inner<'b>(
         if let Err(e) = cache.put(&key, &payloads, &guard) {
             record.warning = Some(format!("{}: cannot store in the cache: {e}", cache.root().display()));
         }
+        cache.write_receipt(&outputs, &key);
     }
     Ok(())
 }

@@ -15,6 +15,13 @@
 //! header and every digest, so a truncated or corrupted entry is removed and rebuilt, never
 //! served.
 //!
+//! **Receipts.** After a batch writes an output, it records the key and the output file's identity
+//! (size, modification and change times, inode, device) under `receipts/`, keyed by the host and
+//! the output's absolute path. A rerun whose key is unchanged and whose output still has that
+//! identity leaves the output as it is: the file holds the bytes of that key, so an unchanged input
+//! costs its hash and two `stat`s. An output edited, replaced or removed since no longer matches,
+//! and is written again (from the entry, checked).
+//!
 //! **Concurrency.** An entry is written whole under `tmp/` (a name unique to the host, process and
 //! write) and renamed into place: rename is atomic on local file systems and on NFS, so readers see
 //! an entry whole or not at all, and two processes or machines that bake the same key at once
@@ -230,6 +237,49 @@ impl Cache {
         written
     }
 
+    fn receipt_path(&self, output: &Path) -> PathBuf {
+        let absolute = std::path::absolute(output).unwrap_or_else(|_| output.to_path_buf());
+        let mut h = blake3::Hasher::new();
+        h.update(hostname().as_bytes());
+        h.update(b"\0");
+        h.update(absolute.as_os_str().as_encoded_bytes());
+        let hex = Key(*h.finalize().as_bytes()).to_string();
+        self.root.join("receipts").join(&hex[..2]).join(hex)
+    }
+
+    /// Whether the files `outputs` (a main file and a .gltf's .bin) are still the ones written
+    /// for `key` and recorded by [`Cache::write_receipt`].
+    pub fn receipt_matches(&self, outputs: &[&Path], key: &Key) -> bool {
+        let Ok(recorded) = std::fs::read_to_string(self.receipt_path(outputs[0])) else { return false };
+        let mut now = key.to_string();
+        for output in outputs {
+            match identity(output) {
+                Some(id) => now.push_str(&id),
+                None => return false,
+            }
+        }
+        recorded == now
+    }
+
+    /// Records that `outputs` now hold the bytes of `key` (a hint: a failure only costs a rewrite
+    /// next time).
+    pub fn write_receipt(&self, outputs: &[&Path], key: &Key) {
+        let path = self.receipt_path(outputs[0]);
+        let mut text = key.to_string();
+        for output in outputs {
+            match identity(output) {
+                Some(id) => text.push_str(&id),
+                None => return,
+            }
+        }
+        let temp =
+            path.with_extension(format!("{}.{}.tmp", std::process::id(), WRITES.fetch_add(1, Ordering::Relaxed)));
+        let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).and_then(|()| std::fs::write(&temp, text));
+        if written.and_then(|()| std::fs::rename(&temp, &path)).is_err() {
+            let _ = std::fs::remove_file(&temp);
+        }
+    }
+
     /// Every entry with its size and last use.
     fn entries(&self) -> Vec<(PathBuf, u64, SystemTime)> {
         let mut out = Vec::new();
@@ -297,7 +347,7 @@ impl Cache {
     /// Removes every entry and temporary file; returns the number of entries removed.
     pub fn clear(&self) -> std::io::Result<u64> {
         let count = self.entries().len() as u64;
-        for folder in ["entries", "tmp"] {
+        for folder in ["entries", "tmp", "receipts"] {
             let path = self.root.join(folder);
             match std::fs::remove_dir_all(&path) {
                 Ok(()) => {}
@@ -308,6 +358,23 @@ impl Cache {
         }
         Ok(count)
     }
+}
+
+/// A file's identity for receipts: size, modification and change times in nanoseconds, inode and
+/// device. Writing or replacing the file changes at least one of them.
+fn identity(path: &Path) -> Option<String> {
+    use std::os::unix::fs::MetadataExt;
+    let m = std::fs::metadata(path).ok()?;
+    Some(format!(
+        "\n{} {}.{} {}.{} {} {}",
+        m.len(),
+        m.mtime(),
+        m.mtime_nsec(),
+        m.ctime(),
+        m.ctime_nsec(),
+        m.ino(),
+        m.dev()
+    ))
 }
 
 fn hostname() -> String {
