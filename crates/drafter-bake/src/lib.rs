@@ -248,7 +248,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     let baked_textures = if request.is_empty() {
         None
     } else {
-        Some(textures::bake(&request, metal_parts, config.textures.metallic_threshold)?)
+        Some(textures::bake_memoized(&request, metal_parts, config.textures.metallic_threshold)?)
     };
     timed("textures", start.elapsed());
 

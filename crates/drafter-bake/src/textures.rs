@@ -36,6 +36,7 @@ use crate::BakeError;
 use crate::config::TexturesStage;
 
 /// What the stage baked: the images to embed, in record order.
+#[derive(Clone, Debug)]
 pub(crate) struct BakedTextures {
     pub embedded: EmbeddedTextures,
     pub summary: TexturesSummary,
@@ -121,7 +122,40 @@ pub(crate) fn request(records: &[PartRecord], metal: &[u32], stage: &TexturesSta
     }
 }
 
-/// The curve a part record names (records are written from `TransferCurve`, so the name is known).
+/// Requests remembered by [`bake_memoized`]: a batch's files mostly ask for the same few.
+const MEMO_ENTRIES: usize = 8;
+
+/// [`bake`], remembered for the process: the images are a function of the request, the metal parts
+/// and the threshold alone (the stage's own determinism), so a process that bakes many files (a
+/// batch, the Python package) computes and encodes each distinct set once. The lookup key is the
+/// arguments' `Debug` text, which lists every option. On a small part the stage is most of the bake
+/// (9 of 13 ms for a 318-triangle OFF file on the 2-core machine); the bytes written do not change.
+pub(crate) fn bake_memoized(
+    request: &TextureRequest,
+    metal_parts: Vec<u32>,
+    threshold: f32,
+) -> Result<BakedTextures, BakeError> {
+    use std::sync::{Arc, Mutex};
+    static MEMO: Mutex<Vec<(String, Arc<BakedTextures>)>> = Mutex::new(Vec::new());
+    let key = format!("{request:?}|{metal_parts:?}|{threshold:?}");
+    let found = {
+        let memo = MEMO.lock().unwrap_or_else(|e| e.into_inner());
+        memo.iter().find(|(k, _)| *k == key).map(|(_, v)| Arc::clone(v))
+    };
+    if let Some(baked) = found {
+        return Ok((*baked).clone());
+    }
+    let baked = bake(request, metal_parts, threshold)?;
+    let mut memo = MEMO.lock().unwrap_or_else(|e| e.into_inner());
+    if !memo.iter().any(|(k, _)| *k == key) {
+        if memo.len() == MEMO_ENTRIES {
+            memo.remove(0);
+        }
+        memo.push((key, Arc::new(baked.clone())));
+    }
+    Ok(baked)
+}
+
 /// Bakes `request` and encodes every texture level as PNG, with the extension's record.
 pub(crate) fn bake(
     request: &TextureRequest,
