@@ -225,9 +225,17 @@ fn bake_file_inner<'b>(
 ) -> Result<(), Error> {
     let mut config = config.clone();
     config.container = crate::output::container_for(output)?;
-    let bytes = job::read_input(input)?;
-    record.bytes_in = bytes.len() as u64;
-    let key = cache.map(|c| (c, crate::cache::key_of(input, &bytes, &config)));
+    // With a cache, the key first, without reading the file into memory: an output still up to
+    // date then costs the input's hash alone.
+    let key = match cache {
+        Some(c) => {
+            let key = crate::cache::key_of_file(input, &config)
+                .map_err(|source| drafter_io::ImportError::Io { path: input.to_path_buf(), source })?;
+            Some((c, key))
+        }
+        None => None,
+    };
+    record.bytes_in = std::fs::metadata(input).map_or(0, |m| m.len());
     let bin_path = match &config.container {
         drafter_format::Container::Gltf { bin_uri } => Some(output.with_file_name(bin_uri)),
         drafter_format::Container::Glb => None,
@@ -258,6 +266,8 @@ fn bake_file_inner<'b>(
             }
         }
     }
+    let bytes = job::read_input(input)?;
+    record.bytes_in = bytes.len() as u64;
     let estimate = crate::estimate::peak_bytes(input, &bytes);
     let Some(_permit) = admit(estimate) else {
         record.status = Status::Skipped;

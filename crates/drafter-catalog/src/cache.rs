@@ -78,6 +78,20 @@ pub fn digest(bytes: &[u8]) -> [u8; 32] {
 /// bake then decides (it fails, or the file is not one the importer follows), and nothing is
 /// cached for it.
 pub fn key_of(path: &Path, bytes: &[u8], config: &drafter_bake::BakeConfig) -> Option<Key> {
+    key_from(path, &digest(bytes), &external_uris(json_of(bytes)), config)
+}
+
+/// [`key_of`] without reading the file into memory: the input is hashed through a memory map on
+/// the thread pool (blake3's), and only a glTF's JSON is read. The same key as [`key_of`] of the
+/// file's bytes. `Err` when the file cannot be read.
+pub fn key_of_file(path: &Path, config: &drafter_bake::BakeConfig) -> std::io::Result<Option<Key>> {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update_mmap_rayon(path)?;
+    let json = json_of_file(path)?;
+    Ok(key_from(path, hasher.finalize().as_bytes(), &external_uris(&json), config))
+}
+
+fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &drafter_bake::BakeConfig) -> Option<Key> {
     let mut config = config.clone();
     config.input = drafter_format::InputInfo { name: String::new(), format: String::new(), sha256: String::new() };
     let mut h = blake3::Hasher::new();
@@ -87,10 +101,10 @@ pub fn key_of(path: &Path, bytes: &[u8], config: &drafter_bake::BakeConfig) -> O
         h.update(&(text.len() as u64).to_le_bytes());
         h.update(text.as_bytes());
     }
-    h.update(&digest(bytes));
-    for uri in external_uris(bytes) {
+    h.update(input_digest);
+    for uri in uris {
         let folder = path.parent().unwrap_or(Path::new(""));
-        let content = drafter_io::read_buffer_uri(folder, &uri).ok()?;
+        let content = drafter_io::read_buffer_uri(folder, uri).ok()?;
         h.update(&(uri.len() as u64).to_le_bytes());
         h.update(uri.as_bytes());
         h.update(&digest(&content));
@@ -98,17 +112,46 @@ pub fn key_of(path: &Path, bytes: &[u8], config: &drafter_bake::BakeConfig) -> O
     Some(Key(*h.finalize().as_bytes()))
 }
 
-/// The URIs of files a glTF (or a GLB's JSON) names beside it, buffers then images, in document
-/// order; data URIs are part of the bytes already. Empty for other formats.
-fn external_uris(bytes: &[u8]) -> Vec<String> {
-    let json = if drafter_core::glb::is_glb(bytes) {
-        match drafter_core::glb::split(bytes) {
-            Ok(chunks) => chunks.json,
-            Err(_) => return Vec::new(),
-        }
+/// The JSON of a glTF's bytes: a GLB's first chunk, or the bytes themselves (empty for a GLB whose
+/// container is malformed: the import refuses it anyway).
+fn json_of(bytes: &[u8]) -> &[u8] {
+    if drafter_core::glb::is_glb(bytes) {
+        drafter_core::glb::split(bytes).map_or(&[], |chunks| chunks.json)
     } else {
         bytes
-    };
+    }
+}
+
+/// What [`json_of`] gives for the file at `path`, reading no more than it: a GLB's header and JSON
+/// chunk, a text file that starts like JSON whole, nothing of any other file.
+fn json_of_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut file = std::fs::File::open(path)?;
+    let size = file.metadata()?.len();
+    let mut head = Vec::with_capacity(20);
+    (&mut file).take(20).read_to_end(&mut head)?;
+    if drafter_core::glb::is_glb(&head) && head.len() == 20 {
+        // The header's length and the JSON chunk's as `glb::split` checks them; a container sound
+        // here but refused there (or the reverse) only costs a key that a single bake of the same
+        // file would not share, and such a file fails its bake anyway.
+        let word = |at: usize| u64::from(u32::from_le_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]));
+        let json_length = word(12);
+        if word(8) != size || &head[16..20] != b"JSON" || 20 + json_length > size {
+            return Ok(Vec::new());
+        }
+        let mut json = Vec::with_capacity(json_length as usize);
+        file.take(json_length).read_to_end(&mut json)?;
+        return Ok(json);
+    }
+    if head.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
+        return std::fs::read(path);
+    }
+    Ok(Vec::new())
+}
+
+/// The URIs of files a glTF's JSON names beside it, buffers then images, in document order; data
+/// URIs are part of the bytes already. Empty for anything that is not a JSON object.
+fn external_uris(json: &[u8]) -> Vec<String> {
     let start = json.iter().position(|b| !b.is_ascii_whitespace());
     if start.is_none_or(|i| json[i] != b'{') {
         return Vec::new();
@@ -515,6 +558,12 @@ mod tests {
         let mut other = config.clone();
         other.gradient.q += 1;
         assert_ne!(key_of(&path, gltf, &other), Some(base), "every option is part of the key");
+        std::fs::write(&path, gltf).unwrap();
+        assert_eq!(key_of_file(&path, &config).unwrap(), key_of(&path, gltf, &config), "from the file, the same key");
+        let sample: &[u8] = include_bytes!("../../../samples/assembly.glb");
+        let glb = dir.join("assembly.glb");
+        std::fs::write(&glb, sample).unwrap();
+        assert_eq!(key_of_file(&glb, &config).unwrap(), key_of(&glb, sample, &config));
         std::fs::remove_file(dir.join("a.bin")).unwrap();
         assert_eq!(key_of(&path, gltf, &config), None, "a missing external file is not cached");
         std::fs::remove_dir_all(&dir).unwrap();
