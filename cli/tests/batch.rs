@@ -233,14 +233,14 @@ fn sigint_at_random_points_of_a_200_file_batch_leaves_no_partial_file_and_a_cons
         std::fs::write(path, tetrahedron(k)).unwrap();
     }
     let reference = dir.join("ref");
+    let started = std::time::Instant::now();
     let full = common::drafter().arg("bake").arg(&input).arg("-o").arg(&reference).arg("-q").output().unwrap();
+    let whole = started.elapsed();
     assert!(full.status.success());
-    let expected = files_below(&reference);
-    assert_eq!(expected.len(), 200);
+    assert_eq!(files_below(&reference).len(), 200);
 
-    let cache = dir.join("cache");
-    let out = dir.join("out");
-    // Random points (a fixed seed): one signal lets the running files finish; two exit at once.
+    // Random points of the batch (a fixed seed), each trial on a fresh output folder and cache: one
+    // signal lets the running files finish, two exit at once.
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = || {
         state ^= state << 13;
@@ -250,7 +250,10 @@ fn sigint_at_random_points_of_a_200_file_batch_leaves_no_partial_file_and_a_cons
     };
     let mut interrupted = 0;
     for trial in 0..8 {
-        let delay = Duration::from_millis(20 + next() % 400);
+        let out = dir.join(format!("out{trial}"));
+        let cache = dir.join(format!("cache{trial}"));
+        let span = whole.as_micros() as u64;
+        let delay = Duration::from_micros(span / 50 + next() % (span * 9 / 10));
         let twice = trial % 2 == 1;
         let mut child = common::drafter()
             .arg("bake")
@@ -282,43 +285,40 @@ fn sigint_at_random_points_of_a_200_file_batch_leaves_no_partial_file_and_a_cons
         // No partial output, no temporary file anywhere; every output written is whole.
         assert!(hidden_or_temporary(&out).is_empty(), "trial {trial}: {:?}", hidden_or_temporary(&out));
         assert!(files_below(&cache.join("tmp")).is_empty(), "trial {trial}: cache temporary files left");
-        for file in files_below(&out) {
+        let written = files_below(&out);
+        for file in &written {
             let twin = reference.join(file.strip_prefix(&out).unwrap());
-            assert!(
-                std::fs::read(&file).unwrap() == std::fs::read(&twin).unwrap(),
-                "trial {trial}: {}",
-                file.display()
-            );
+            assert!(std::fs::read(file).unwrap() == std::fs::read(&twin).unwrap(), "trial {trial}: {}", file.display());
+        }
+        // The cache is consistent: a rerun serves every entry it holds (none damaged), bakes the
+        // rest, and leaves every output as a full bake would.
+        let stats = common::run(&["cache", "stats", "--json", "--cache", cache.to_str().unwrap()]);
+        let stats: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
+        let entries = stats["entries"].as_u64().unwrap();
+        let rerun = common::drafter()
+            .arg("bake")
+            .arg(&input)
+            .arg("-o")
+            .arg(&out)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert!(rerun.status.success(), "trial {trial}");
+        let r: serde_json::Value = serde_json::from_slice(&rerun.stdout).unwrap();
+        let count = |value: &str| r["files"].as_array().unwrap().iter().filter(|f| f["cache"] == value).count() as u64;
+        assert_eq!(count("rebuilt"), 0, "trial {trial}: no entry was damaged");
+        assert_eq!(count("hit"), entries, "trial {trial}: every entry served");
+        assert_eq!(count("miss"), 200 - entries, "trial {trial}: the rest baked");
+        let all = files_below(&out);
+        assert_eq!(all.len(), 200);
+        for file in all {
+            let twin = reference.join(file.strip_prefix(&out).unwrap());
+            assert!(std::fs::read(&file).unwrap() == std::fs::read(&twin).unwrap(), "trial {trial}");
         }
     }
     assert!(interrupted >= 4, "the signals arrived mid-batch ({interrupted} of 8)");
-    // The cache is consistent: a rerun serves every entry it holds (none damaged) and picks up
-    // where the interrupted runs stopped.
-    let stats = common::run(&["cache", "stats", "--json", "--cache", cache.to_str().unwrap()]);
-    let stats: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
-    let entries = stats["entries"].as_u64().unwrap();
-    assert!(entries > 0 && entries < 200 || interrupted < 8, "{stats}");
-    let rerun = common::drafter()
-        .arg("bake")
-        .arg(&input)
-        .arg("-o")
-        .arg(&out)
-        .arg("--cache")
-        .arg(&cache)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(rerun.status.success());
-    let r: serde_json::Value = serde_json::from_slice(&rerun.stdout).unwrap();
-    let count =
-        |field: &str, value: &str| r["files"].as_array().unwrap().iter().filter(|f| f[field] == value).count() as u64;
-    assert_eq!(count("cache", "rebuilt"), 0, "no entry was damaged");
-    assert_eq!(count("cache", "hit"), entries);
-    assert_eq!(files_below(&out).len(), 200);
-    for file in files_below(&out) {
-        let twin = reference.join(file.strip_prefix(&out).unwrap());
-        assert!(std::fs::read(&file).unwrap() == std::fs::read(&twin).unwrap());
-    }
 }
 
 #[test]
