@@ -322,6 +322,53 @@ fn sigint_at_random_points_of_a_200_file_batch_leaves_no_partial_file_and_a_cons
 }
 
 #[test]
+fn two_processes_filling_one_cache_at_once_agree() {
+    let dir = common::scratch("batch-two-processes");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    for k in 0..60 {
+        std::fs::write(input.join(format!("t{k:02}.off")), tetrahedron(k)).unwrap();
+    }
+    let reference = dir.join("ref");
+    assert!(common::drafter().arg("bake").arg(&input).arg("-o").arg(&reference).arg("-q").status().unwrap().success());
+    let cache = dir.join("cache");
+    let spawn = |out: &str| {
+        common::drafter()
+            .arg("bake")
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.join(out))
+            .arg("--cache")
+            .arg(&cache)
+            .arg("-q")
+            .spawn()
+            .unwrap()
+    };
+    let (mut a, mut b) = (spawn("a"), spawn("b"));
+    assert!(a.wait().unwrap().success() && b.wait().unwrap().success());
+    for out in ["a", "b"] {
+        for file in files_below(&dir.join(out)) {
+            let twin = reference.join(file.file_name().unwrap());
+            assert!(std::fs::read(&file).unwrap() == std::fs::read(&twin).unwrap(), "{}", file.display());
+        }
+    }
+    assert!(files_below(&cache.join("tmp")).is_empty());
+    // Every entry is whole: a third run into a fresh folder serves all 60 from the cache.
+    let third = common::drafter()
+        .arg("bake")
+        .arg(&input)
+        .arg("-o")
+        .arg(dir.join("c"))
+        .arg("--cache")
+        .arg(&cache)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let r: serde_json::Value = serde_json::from_slice(&third.stdout).unwrap();
+    assert_eq!(r["cached"].as_u64(), Some(60), "{r}");
+}
+
+#[test]
 fn a_batch_refuses_what_it_cannot_do_before_baking() {
     let dir = common::scratch("batch-refusals");
     let models = common::shared_models();
