@@ -47,10 +47,17 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    // Before anything else, while the process has one thread (see the modules' docs).
-    drafter_bake::heap::keep_freed_memory();
-    gpu_env::quiet_device_select();
+    // Parsing starts no thread; the heap policy is set before any other (see the modules' docs):
+    // a batch bakes files side by side, so its threads get heaps of their own.
     let cli = Cli::parse();
+    match &cli.command {
+        Command::Bake(args) if cmd::bake::is_batch(args) => {
+            let cores = std::thread::available_parallelism().map_or(1, usize::from);
+            drafter_bake::heap::keep_freed_memory_in(2 * cores + args.jobs.unwrap_or(cores));
+        }
+        _ => drafter_bake::heap::keep_freed_memory(),
+    }
+    gpu_env::quiet_device_select();
     let result = std::panic::catch_unwind(|| match cli.command {
         Command::Bake(args) => cmd::bake::run(args),
         Command::Cache(args) => cmd::cache::run(args),

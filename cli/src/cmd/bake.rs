@@ -152,6 +152,11 @@ pub fn run(args: Args) -> Result<()> {
     single(&args, config)
 }
 
+/// Several inputs, a folder or a manifest: a batch (`batch.rs`).
+pub fn is_batch(args: &Args) -> bool {
+    args.inputs.len() > 1 || !args.manifest.is_empty() || args.inputs.first().is_some_and(|p| p.is_dir())
+}
+
 /// The configuration the options ask for: `--config`, then the flags over it.
 fn config_from_args(args: &Args) -> Result<BakeConfig> {
     let mut config = BakeConfig::default();
