@@ -423,15 +423,11 @@ fn input_size(path: &Path) -> u64 {
         return own;
     }
     let Ok(text) = std::fs::read(path) else { return own };
-    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(&text) else { return own };
     let folder = path.parent().unwrap_or(Path::new(""));
-    let buffers = doc.get("buffers").and_then(serde_json::Value::as_array);
-    own + buffers
+    own + crate::cache::gltf_file_uris(&text)
+        .0
         .into_iter()
-        .flatten()
-        .filter_map(|b| b.get("uri")?.as_str())
-        .filter(|uri| !uri.starts_with("data:"))
-        .filter_map(|uri| drafter_core::uri::relative_path(uri).ok())
+        .filter_map(|uri| drafter_core::uri::relative_path(&uri).ok())
         .map(|relative: PathBuf| std::fs::metadata(folder.join(relative)).map_or(0, |m| m.len()))
         .sum::<u64>()
 }

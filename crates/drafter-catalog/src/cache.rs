@@ -81,12 +81,12 @@ pub fn key_of(path: &Path, bytes: &[u8], config: &drafter_bake::BakeConfig) -> O
     key_from(path, &digest(bytes), &external_uris(json_of(bytes)), config)
 }
 
-/// [`key_of`] without reading the file into memory: the input is hashed through a memory map on
-/// the thread pool (blake3's), and only a glTF's JSON is read. The same key as [`key_of`] of the
+/// [`key_of`] without holding the file in memory: the input is hashed in blocks ([`hash_file`]),
+/// and only a glTF's JSON is kept. The same key as [`key_of`] of the
 /// file's bytes. `Err` when the file cannot be read.
 pub fn key_of_file(path: &Path, config: &drafter_bake::BakeConfig) -> std::io::Result<Option<Key>> {
     let mut hasher = blake3::Hasher::new();
-    hasher.update_mmap_rayon(path)?;
+    hash_file(&mut hasher, path)?;
     let json = json_of_file(path)?;
     Ok(key_from(path, hasher.finalize().as_bytes(), &external_uris(&json), config))
 }
@@ -110,6 +110,38 @@ fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &draf
         h.update(&digest(&content));
     }
     Some(Key(*h.finalize().as_bytes()))
+}
+
+/// Feeds the file at `path` to `hasher` in blocks of 4 MB through one reused buffer: each block on
+/// the thread pool (as [`digest`] does) once it is large enough. Measured against a memory map of
+/// the whole file (blake3's `update_mmap_rayon`) on the shared models, whose page faults cost more
+/// than the copy.
+fn hash_file(hasher: &mut blake3::Hasher, path: &Path) -> std::io::Result<()> {
+    use std::io::Read;
+    const BLOCK: usize = 4 << 20;
+    let mut file = std::fs::File::open(path)?;
+    let size = file.metadata()?.len();
+    let mut buffer = vec![0u8; BLOCK.min(usize::try_from(size).unwrap_or(BLOCK)).max(1)];
+    loop {
+        let mut filled = 0;
+        while filled < buffer.len() {
+            match file.read(&mut buffer[filled..]) {
+                Ok(0) => break,
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e),
+            }
+        }
+        let block = &buffer[..filled];
+        if block.len() >= 1 << 20 {
+            hasher.update_rayon(block);
+        } else {
+            hasher.update(block);
+        }
+        if filled < buffer.len() {
+            return Ok(());
+        }
+    }
 }
 
 /// The JSON of a glTF's bytes: a GLB's first chunk, or the bytes themselves (empty for a GLB whose
@@ -152,22 +184,34 @@ fn json_of_file(path: &Path) -> std::io::Result<Vec<u8>> {
 /// The URIs of files a glTF's JSON names beside it, buffers then images, in document order; data
 /// URIs are part of the bytes already. Empty for anything that is not a JSON object.
 fn external_uris(json: &[u8]) -> Vec<String> {
+    let (buffers, images) = gltf_file_uris(json);
+    buffers.into_iter().chain(images).collect()
+}
+
+/// The buffer and image URIs of a glTF's JSON that name files (not data URIs), in document order.
+/// Only these members are decoded (the rest of the document is skipped, not built), since a batch
+/// reads them for every glTF it is given. Empty for anything that is not such a JSON object.
+pub(crate) fn gltf_file_uris(json: &[u8]) -> (Vec<String>, Vec<String>) {
+    #[derive(serde::Deserialize)]
+    struct Document {
+        #[serde(default)]
+        buffers: Vec<Item>,
+        #[serde(default)]
+        images: Vec<Item>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Item {
+        #[serde(default)]
+        uri: Option<String>,
+    }
     let start = json.iter().position(|b| !b.is_ascii_whitespace());
     if start.is_none_or(|i| json[i] != b'{') {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     }
-    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else { return Vec::new() };
-    let mut uris = Vec::new();
-    for key in ["buffers", "images"] {
-        for item in doc.get(key).and_then(serde_json::Value::as_array).into_iter().flatten() {
-            if let Some(uri) = item.get("uri").and_then(serde_json::Value::as_str)
-                && !uri.starts_with("data:")
-            {
-                uris.push(uri.to_owned());
-            }
-        }
-    }
-    uris
+    let Ok(doc) = serde_json::from_slice::<Document>(json) else { return (Vec::new(), Vec::new()) };
+    let files =
+        |items: Vec<Item>| items.into_iter().filter_map(|i| i.uri).filter(|u| !u.starts_with("data:")).collect();
+    (files(doc.buffers), files(doc.images))
 }
 
 /// What `drafter cache stats` prints.
