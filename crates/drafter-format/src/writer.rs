@@ -373,7 +373,11 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
                 }
                 None => None,
             };
-            let edges = out.primitive_edges[m].get(g).and_then(Option::as_ref);
+            // The draft requires a non-zero value in the bitfield (CesiumJS stops rendering on an
+            // all-zero one): a primitive with nothing to draw gets no extension, whatever the caller
+            // passed (drafter-bake passes none; `tests/edge_extension.rs` there checks both).
+            let edges =
+                out.primitive_edges[m].get(g).and_then(Option::as_ref).filter(|e| e.visibility.iter().any(|&b| b != 0));
             let mut hard_edge_classes = None;
             if let Some(edges) = edges {
                 let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
