@@ -24,6 +24,9 @@
 //! [lines]
 //! enabled = true
 //! crease_angle_deg = 30.0    # sharper edges are creases (hard edges, drawn white)
+//! crease_min_edges = 4       # a chain of creases alone with fewer edges (0 keeps all)...
+//! crease_min_length = 0.01   # ...and shorter than this fraction of the mesh's diagonal...
+//! strong_crease_deg = 60.0   # ...and no crease sharper than this is a speck (scan noise)
 //! hierarchies = true         # store silhouette hierarchies where they beat brute force
 //!
 //! [textures]                 # NPR lookup textures embedded as PNG (see `crate::textures`)
@@ -151,6 +154,16 @@ pub struct LinesStage {
     /// Dihedral angle above which an edge is a crease. Default
     /// [`drafter_lines::DEFAULT_CREASE_ANGLE_DEG`] (30°); range [0, 180].
     pub crease_angle_deg: f32,
+    /// A chain of creases alone shorter than this many edges, with no crease sharper than
+    /// `strong_crease_deg`, is scan noise and drawn as silhouettes only (drafter-lines' `classify`
+    /// docs). Default [`drafter_lines::DEFAULT_CREASE_MIN_EDGES`] (4); 0 keeps every crease.
+    pub crease_min_edges: u32,
+    /// Fraction of the mesh's bounding diagonal; a short chain at least this long is kept. Default
+    /// [`drafter_lines::DEFAULT_CREASE_MIN_LENGTH`] (0.01).
+    pub crease_min_length: f32,
+    /// Degrees; a short chain with a crease sharper than this is kept. Default
+    /// [`drafter_lines::DEFAULT_STRONG_CREASE_DEG`] (60°); range [0, 180].
+    pub strong_crease_deg: f32,
     /// Build and store silhouette hierarchies where they beat brute force (drafter-lines decides by
     /// candidate count and a cost model). Default true.
     pub hierarchies: bool,
@@ -158,7 +171,14 @@ pub struct LinesStage {
 
 impl Default for LinesStage {
     fn default() -> Self {
-        Self { enabled: true, crease_angle_deg: drafter_lines::DEFAULT_CREASE_ANGLE_DEG, hierarchies: true }
+        Self {
+            enabled: true,
+            crease_angle_deg: drafter_lines::DEFAULT_CREASE_ANGLE_DEG,
+            crease_min_edges: drafter_lines::DEFAULT_CREASE_MIN_EDGES,
+            crease_min_length: drafter_lines::DEFAULT_CREASE_MIN_LENGTH,
+            strong_crease_deg: drafter_lines::DEFAULT_STRONG_CREASE_DEG,
+            hierarchies: true,
+        }
     }
 }
 
@@ -305,6 +325,9 @@ struct SegmentSection {
 struct LinesSection {
     enabled: Option<bool>,
     crease_angle_deg: Option<f32>,
+    crease_min_edges: Option<u32>,
+    crease_min_length: Option<f32>,
+    strong_crease_deg: Option<f32>,
     hierarchies: Option<bool>,
 }
 
@@ -370,6 +393,21 @@ impl BakeConfig {
                 return Err(BakeError::Config(format!("lines.crease_angle_deg = {a} is outside [0, 180]")));
             }
             self.lines.crease_angle_deg = a;
+        }
+        if let Some(n) = l.crease_min_edges {
+            self.lines.crease_min_edges = n;
+        }
+        if let Some(f) = l.crease_min_length {
+            if !(f.is_finite() && f >= 0.0) {
+                return Err(BakeError::Config(format!("lines.crease_min_length = {f} must be a fraction >= 0")));
+            }
+            self.lines.crease_min_length = f;
+        }
+        if let Some(a) = l.strong_crease_deg {
+            if !(0.0..=180.0).contains(&a) {
+                return Err(BakeError::Config(format!("lines.strong_crease_deg = {a} is outside [0, 180]")));
+            }
+            self.lines.strong_crease_deg = a;
         }
         if let Some(h) = l.hierarchies {
             self.lines.hierarchies = h;

@@ -480,7 +480,13 @@ fn compute_lines(
             labels[inst.mesh.index()] = Some(table.labels());
         }
     }
-    let options = LineOptions { crease_angle_deg: stage.crease_angle_deg, ..LineOptions::default() };
+    let options = LineOptions {
+        crease_angle_deg: stage.crease_angle_deg,
+        crease_min_edges: stage.crease_min_edges,
+        crease_min_length: stage.crease_min_length,
+        strong_crease_deg: stage.strong_crease_deg,
+        ..LineOptions::default()
+    };
     let mut results: Vec<_> = scene
         .meshes
         .par_iter()
@@ -820,7 +826,7 @@ fn settings_echo(config: &BakeConfig) -> serde_json::Value {
         "segment": {"mode": config.segment.mode, "regionAngleDeg": config.segment.region_angle_deg},
         "obb": {"method": config.obb.method.name()},
         "normals": {"enabled": config.normals.enabled},
-        "lines": {"enabled": config.lines.enabled, "creaseAngleDeg": config.lines.crease_angle_deg, "hierarchies": config.lines.hierarchies},
+        "lines": {"enabled": config.lines.enabled, "creaseAngleDeg": config.lines.crease_angle_deg, "creaseMinEdges": config.lines.crease_min_edges, "creaseMinLength": config.lines.crease_min_length, "strongCreaseDeg": config.lines.strong_crease_deg, "hierarchies": config.lines.hierarchies},
         "textures": {"enabled": config.textures.enabled, "styles": config.textures.styles, "metallicThreshold": config.textures.metallic_threshold},
         "gradient": {"q": config.gradient.q, "f": config.gradient.f, "p": config.gradient.p, "transfer": config.transfer},
         "partOverrides": config.overrides.len(),

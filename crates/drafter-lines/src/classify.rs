@@ -11,10 +11,24 @@
 //!    faces are slivers that close T-junctions of CAD tessellations; drawing their edges would draw
 //!    seams, and their missing normal makes the front/back test meaningless;
 //! 5. dihedral angle (the angle between the two face normals) above
-//!    [`LineOptions::crease_angle_deg`]: [`EdgeClass::Crease`];
+//!    [`LineOptions::crease_angle_deg`]: [`EdgeClass::Crease`], unless the crease is a speck (below);
 //! 6. dihedral angle at or below [`LineOptions::coplanar_angle_deg`]: [`EdgeClass::Coplanar`]
 //!    (hidden: a silhouette between coplanar faces is invisible);
 //! 7. otherwise: [`EdgeClass::SilhouetteCandidate`].
+//!
+//! **Specks.** Range scans are covered in creases of a few edges each that are noise, not features
+//! (the dragon: 686 isolated crease edges and 1,061 chains of 2 or 3 at 30°). Hard edges are joined
+//! into chains through their welded vertices; a chain made of creases alone, with fewer than
+//! [`LineOptions::crease_min_edges`] edges, shorter than [`LineOptions::crease_min_length`] of the
+//! mesh's bounding diagonal, none of whose dihedral angles exceeds
+//! [`LineOptions::strong_crease_deg`], is a speck: its edges are silhouette candidates instead (their
+//! faces are not coplanar), so silhouettes stay exact. A crease that touches a boundary, a part
+//! border, a non-manifold edge or a longer chain is kept (weak creases continue a feature:
+//! hysteresis by length), and so is a short one sharper than the strong angle or long against the
+//! model (a coarse CAD fillet's facet line is one long edge). CAD tessellations keep their feature
+//! lines; what they lose are the same kind of specks, single edges of 30–39° on curved faces
+//! (GearboxAssy: 2,846 of 30,534; every shared model is counted in `docs/bench.md`, "Crease
+//! specks").
 //!
 //! Face normals are computed in `f64` from the welded `f32` positions ((b − a) × (c − a), normalised),
 //! so the dihedral angles do not depend on the weld representative's rounding. Candidates keep their
@@ -42,6 +56,15 @@ pub const DEFAULT_CREASE_ANGLE_DEG: f32 = 30.0;
 /// by about 1e-5 rad ≈ 6e-4°) while keeping the finest real tessellation (≥ 0.01°) as candidates.
 pub const DEFAULT_COPLANAR_ANGLE_DEG: f32 = 1e-3;
 
+/// Default of [`LineOptions::crease_min_edges`]: isolated crease chains of 1 to 3 edges are specks.
+pub const DEFAULT_CREASE_MIN_EDGES: u32 = 4;
+
+/// Default of [`LineOptions::strong_crease_deg`]: twice the default crease angle.
+pub const DEFAULT_STRONG_CREASE_DEG: f32 = 60.0;
+
+/// Default of [`LineOptions::crease_min_length`]: 1% of the mesh's bounding diagonal.
+pub const DEFAULT_CREASE_MIN_LENGTH: f32 = 0.01;
+
 /// Options of [`classify_edges`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LineOptions {
@@ -52,11 +75,27 @@ pub struct LineOptions {
     /// Default [`DEFAULT_COPLANAR_ANGLE_DEG`]; range `[0, crease_angle_deg]`; a negative value makes
     /// even exactly coplanar faces candidates.
     pub coplanar_angle_deg: f32,
+    /// A chain of creases alone (no other hard edge touching it) with fewer edges than this is a
+    /// speck unless it holds a crease sharper than [`Self::strong_crease_deg`] (module docs).
+    /// Default [`DEFAULT_CREASE_MIN_EDGES`]; 0 or 1 keeps every crease.
+    pub crease_min_edges: u32,
+    /// A short chain holding a crease sharper than this, in degrees, is kept. Default
+    /// [`DEFAULT_STRONG_CREASE_DEG`].
+    pub strong_crease_deg: f32,
+    /// A short chain at least this long, as a fraction of the mesh's bounding diagonal, is kept (a
+    /// coarse CAD fillet's facet line is one long edge). Default [`DEFAULT_CREASE_MIN_LENGTH`].
+    pub crease_min_length: f32,
 }
 
 impl Default for LineOptions {
     fn default() -> Self {
-        Self { crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG, coplanar_angle_deg: DEFAULT_COPLANAR_ANGLE_DEG }
+        Self {
+            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
+            coplanar_angle_deg: DEFAULT_COPLANAR_ANGLE_DEG,
+            crease_min_edges: DEFAULT_CREASE_MIN_EDGES,
+            strong_crease_deg: DEFAULT_STRONG_CREASE_DEG,
+            crease_min_length: DEFAULT_CREASE_MIN_LENGTH,
+        }
     }
 }
 
@@ -320,6 +359,8 @@ fn classify(
         })
         .collect();
 
+    let mut per_edge = per_edge;
+    drop_specks(topology, &face_normals, options, &mut per_edge);
     let mut counts = EdgeClassCounts::default();
     for &(class, _, inconsistent) in &per_edge {
         counts.add(class);
@@ -348,6 +389,81 @@ fn classify(
         (Vec::new(), Vec::new())
     };
     Ok(FeatureEdges { classes, dihedral_deg, face_normals, candidates, candidate_normals, candidate_points, counts })
+}
+
+/// Turns the creases of speck chains into silhouette candidates (module docs). Chains are the
+/// connected components of the hard edges through their welded vertices (union-find over the
+/// vertices, in edge order: the result depends on the topology alone).
+fn drop_specks(
+    topology: &Topology,
+    face_normals: &[Option<DVec3>],
+    options: &LineOptions,
+    per_edge: &mut [(EdgeClass, f32, bool)],
+) {
+    if options.crease_min_edges <= 1 || !per_edge.iter().any(|p| p.0 == EdgeClass::Crease) {
+        return;
+    }
+    fn root(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            let up = parent[parent[v as usize] as usize];
+            parent[v as usize] = up;
+            v = up;
+        }
+        v
+    }
+    let mut parent: Vec<u32> = (0..topology.welded_positions.len() as u32).collect();
+    for (e, p) in per_edge.iter().enumerate() {
+        if p.0.is_hard() {
+            let [a, b] = topology.edges[e];
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            if ra != rb {
+                parent[ra.max(rb) as usize] = ra.min(rb);
+            }
+        }
+    }
+    // Per chain (its root vertex): hard edges, whether all are creases, whether one is strong.
+    #[derive(Clone, Copy, Default)]
+    struct Chain {
+        edges: u32,
+        length: f64,
+        other_hard: bool,
+        strong: bool,
+    }
+    let (lo, hi) = topology
+        .welded_positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let min_length = f64::from(options.crease_min_length) * f64::from((hi - lo).length());
+    let mut chains: std::collections::HashMap<u32, Chain> = std::collections::HashMap::new();
+    let strong = AngleTest::new(f64::from(options.strong_crease_deg));
+    for (e, p) in per_edge.iter().enumerate() {
+        if !p.0.is_hard() {
+            continue;
+        }
+        let [a, b] = topology.edges[e];
+        let chain = chains.entry(root(&mut parent, a)).or_default();
+        chain.edges = chain.edges.saturating_add(1);
+        chain.length +=
+            f64::from(topology.welded_positions[a as usize].distance(topology.welded_positions[b as usize]));
+        if p.0 == EdgeClass::Crease {
+            let faces = topology.faces_of_edge(e);
+            let angle = face_normals[faces[0] as usize]
+                .zip(face_normals[faces[1] as usize])
+                .map(|(n1, n2)| (n1.cross(n2).length(), n1.dot(n2)));
+            chain.strong |= angle.is_some_and(|(sine, cosine)| strong.above(sine, cosine));
+        } else {
+            chain.other_hard = true;
+        }
+    }
+    for (e, p) in per_edge.iter_mut().enumerate() {
+        if p.0 != EdgeClass::Crease {
+            continue;
+        }
+        let chain = chains[&root(&mut parent, topology.edges[e][0])];
+        if !chain.other_hard && !chain.strong && chain.edges < options.crease_min_edges && chain.length < min_length {
+            p.0 = EdgeClass::SilhouetteCandidate;
+        }
+    }
 }
 
 /// Whether face `f` traverses edge `e` from its smaller to its larger welded vertex.
@@ -403,6 +519,114 @@ mod tests {
         ];
         // Two triangles sharing the diagonal 0-2.
         (p, vec![[0, 1, 2], [0, 2, 3]])
+    }
+
+    /// A closed cube whose faces are `n` × `n` grids: its interior edges are coplanar, its cube
+    /// edges 90° creases.
+    fn grid_cube(n: u32) -> Topology {
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        let axes = [Vec3::X, Vec3::Y, Vec3::Z];
+        for (k, &normal) in axes.iter().enumerate() {
+            for sign in [-1.0f32, 1.0] {
+                let (u, v) = (axes[(k + 1) % 3], axes[(k + 2) % 3]);
+                let (u, v) = if sign > 0.0 { (u, v) } else { (v, u) };
+                let base = positions.len() as u32;
+                for j in 0..=n {
+                    for i in 0..=n {
+                        let (a, b) = (i as f32 / n as f32 * 2.0 - 1.0, j as f32 / n as f32 * 2.0 - 1.0);
+                        positions.push(normal * sign + u * a + v * b);
+                    }
+                }
+                for j in 0..n {
+                    for i in 0..n {
+                        let q = base + j * (n + 1) + i;
+                        triangles.push([q, q + 1, q + n + 2]);
+                        triangles.push([q, q + n + 2, q + n + 1]);
+                    }
+                }
+            }
+        }
+        Topology::from_triangles(&positions, &triangles, Weld::Exact)
+    }
+
+    /// Chains of creases alone: short and weak ones become candidates; four edges, a touching
+    /// boundary, a length over the fraction or a crease past the strong angle keep them.
+    #[test]
+    fn specks_are_short_weak_chains_of_creases_alone() {
+        let topo = grid_cube(12);
+        let normals = face_normals(&topo);
+        // The cube's own edges are strong creases; every other edge is coplanar.
+        let base: Vec<(EdgeClass, f32, bool)> = (0..topo.edges.len())
+            .map(|e| {
+                let f = topo.faces_of_edge(e);
+                let angle = normals[f[0] as usize].unwrap().angle_between(normals[f[1] as usize].unwrap());
+                (if angle > 0.5 { EdgeClass::Crease } else { EdgeClass::Coplanar }, f32::NAN, false)
+            })
+            .collect();
+        let cube_edges = base.iter().filter(|p| p.0 == EdgeClass::Crease).count();
+        // Interior edges of the +Z face, chosen by their vertices' grid positions.
+        let on_top = |e: usize| topo.edges[e].iter().all(|&v| topo.welded_positions[v as usize].z == 1.0);
+        let interior = |e: usize| {
+            topo.edges[e].iter().all(|&v| {
+                topo.welded_positions[v as usize].abs().max_element() < 1.0 - 1e-6
+                    || topo.welded_positions[v as usize].z == 1.0
+                        && topo.welded_positions[v as usize].truncate().abs().max_element() < 1.0 - 1e-6
+            })
+        };
+        let top: Vec<usize> = (0..topo.edges.len()).filter(|&e| on_top(e) && interior(e)).collect();
+        // A chain of `k` connected top edges starting at edge `start`.
+        let chain = |start: usize, k: usize| {
+            let mut chosen = vec![start];
+            while chosen.len() < k {
+                let last = topo.edges[*chosen.last().unwrap()];
+                let next = top.iter().copied().find(|&e| {
+                    !chosen.contains(&e)
+                        && topo.edges[e][0] == last[1]
+                        && !chosen.iter().any(|&c| topo.edges[c].contains(&topo.edges[e][1]))
+                });
+                chosen.push(next.expect("a continuing edge"));
+            }
+            chosen
+        };
+        let options = LineOptions { crease_min_length: 1.0, ..LineOptions::default() };
+        let run = |marked: &[usize], options: &LineOptions| {
+            let mut per_edge = base.clone();
+            for &e in marked {
+                per_edge[e].0 = EdgeClass::Crease;
+            }
+            drop_specks(&topo, &normals, options, &mut per_edge);
+            per_edge.iter().filter(|p| p.0 == EdgeClass::Crease).count() - cube_edges
+        };
+        let far_apart = |a: usize, b: usize| topo.edges[a].iter().all(|v| !topo.edges[b].contains(v));
+        let singles: Vec<usize> = top.iter().copied().fold(Vec::new(), |mut acc, e| {
+            if acc.len() < 5 && acc.iter().all(|&a| far_apart(a, e)) {
+                acc.push(e);
+            }
+            acc
+        });
+        assert_eq!(singles.len(), 5);
+        assert_eq!(run(&singles, &options), 0, "isolated weak creases are specks");
+        assert_eq!(run(&chain(top[40], 3), &options), 0, "three edges: a speck");
+        assert_eq!(run(&chain(top[40], 4), &options), 4, "four edges: a feature");
+        assert_eq!(run(&singles, &LineOptions { crease_min_edges: 0, ..options }), 5, "the rule off");
+        assert_eq!(
+            run(&singles, &LineOptions { crease_min_length: 0.01, ..options }),
+            5,
+            "long against the cube's diagonal"
+        );
+        assert_eq!(
+            run(&singles, &LineOptions { strong_crease_deg: -1.0, ..options }),
+            5,
+            "sharper than the strong angle"
+        );
+        // A crease touching a cube edge (another hard edge) continues it.
+        let touching: Vec<usize> = (0..topo.edges.len())
+            .filter(|&e| on_top(e) && !interior(e) && base[e].0 != EdgeClass::Crease)
+            .take(1)
+            .collect();
+        assert_eq!(touching.len(), 1);
+        assert_eq!(run(&touching, &options), 1);
     }
 
     #[test]
