@@ -67,9 +67,9 @@
 //!    the mesh's triangles *and* its bounding-box diagonal is below
 //!    [`SegmentOptions::merge_diagonal_fraction`] of the mesh's (here and below, the mesh's
 //!    *robust* diagonal, `drafter_core::robust_diagonal`: a few far-away vertices do not count).
-//!    A **closed solid** (no boundary
-//!    edge, no unpaired fan, enclosed volume above 1e-6 of its diagonal cubed) is never small: it
-//!    is a part in its own right whatever its size (a 12-triangle washer stays a washer).
+//!    A **closed solid** (no boundary edge, no unpaired fan, enclosed volume above 1e-6 of its
+//!    diagonal cubed) is never small: it is a part in its own right whatever its size (a
+//!    12-triangle washer stays a washer).
 //! 2. Where a small part touches is probed at the welded vertices of its *free* edges (boundary
 //!    edges and unpaired fans: where a fragment was cut off, its edge lies on what it was cut
 //!    from), or at all its vertices if it has none. A neighbour *shares* a probe when it uses the
