@@ -425,6 +425,12 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     }
     let root_ext = serde_json::to_value(&root)?;
     let root = doc.json.entry("extensions").or_insert_with(|| json!({}));
+    if !root.is_object() {
+        // The source's was `null` or another non-object (which glTF does not allow, and serde
+        // takes as "none"): left as it was, the file had no root record and did not read back
+        // (drafter-fuzz, issue 47's campaign).
+        *root = json!({});
+    }
     if let Value::Object(map) = root {
         map.insert(EXTENSION.into(), root_ext);
     }
