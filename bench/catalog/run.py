@@ -121,6 +121,11 @@ def main():
     print(f"  cached rerun (outputs up to date): {med['batch+cache cold'] / med['batch+cache warm']:.0f}x faster than the cold run; "
           f"outputs written from the cache: {med['batch+cache cold'] / med['batch+cache served']:.1f}x")
     print(f"  batch peak RSS {max(peaks) / 1024:.0f} MB (runs: {' '.join(str(p // 1024) for p in peaks)}) under --memory {args.memory}")
+    for budget in ["600M", "1G"]:
+        out = scratch / f"tight{budget}"
+        wall, kb = peak_kb([drafter, "bake", str(models), "-o", str(out), "-q", "--memory", budget, "--report", str(scratch / "tight.json")])
+        admitted = json.loads((scratch / "tight.json").read_text())["peak_admitted_bytes"] >> 20
+        print(f"  --memory {budget}: peak RSS {kb / 1024:.0f} MB, at most {admitted} MB of estimates admitted at once, {wall:.3f} s")
     print(f"  outputs compared with single bakes: {compared}, different: {mismatches}")
 
     if pathlib.Path(args.python).exists():
