@@ -56,6 +56,23 @@ fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) 
     }
 }
 
+/// The input of `bake` and `inspect`: a file's path and bytes, or bytes named `name` (format
+/// detection and provenance; `input` when unnamed).
+fn source(
+    path: Option<PathBuf>,
+    data: Option<Vec<u8>>,
+    name: Option<String>,
+) -> Result<(PathBuf, Vec<u8>), drafter_catalog::Error> {
+    match (path, data) {
+        (Some(path), None) => {
+            let bytes = drafter_catalog::job::read_input(&path)?;
+            Ok((path, bytes))
+        }
+        (None, Some(data)) => Ok((PathBuf::from(name.unwrap_or_else(|| "input".into())), data)),
+        _ => Err(drafter_catalog::Error::Input("give a path or bytes".into())),
+    }
+}
+
 fn limits(max_triangles: Option<u64>) -> drafter_io::Limits {
     drafter_io::Limits { max_triangles: max_triangles.unwrap_or(drafter_io::DEFAULT_MAX_TRIANGLES) }
 }
@@ -79,14 +96,7 @@ fn bake(
     let limits = limits(max_triangles);
     let main = py.detach(|| {
         on_threads(threads, || {
-            let (path, bytes) = match (path, data) {
-                (Some(path), None) => {
-                    let bytes = drafter_catalog::job::read_input(&path)?;
-                    (path, bytes)
-                }
-                (None, Some(data)) => (PathBuf::from(name.unwrap_or_else(|| "input".into())), data),
-                _ => return Err(drafter_catalog::Error::Input("give a path or bytes".into())),
-            };
+            let (path, bytes) = source(path, data, name)?;
             drafter_catalog::bake_bytes(&path, bytes, &config, &limits, &mut |_| {}).map(|b| b.written.main)
         })
     })?;
@@ -201,14 +211,7 @@ fn inspect(
 ) -> PyResult<String> {
     let limits = limits(max_triangles);
     let report = py.detach(|| {
-        let (path, bytes) = match (path, data) {
-            (Some(path), None) => {
-                let bytes = drafter_catalog::job::read_input(&path)?;
-                (path, bytes)
-            }
-            (None, Some(data)) => (PathBuf::from(name.unwrap_or_else(|| "input".into())), data),
-            _ => return Err(drafter_catalog::Error::Input("give a path or bytes".into())),
-        };
+        let (path, bytes) = source(path, data, name)?;
         drafter_catalog::inspect::inspect_bytes(&path, &bytes, &limits, drafter_core::Weld::default())
     });
     let report = report.map_err(|e| to_py(&e))?;

@@ -169,6 +169,19 @@ pub struct LinesStage {
     pub hierarchies: bool,
 }
 
+impl LinesStage {
+    /// The classification options of drafter-lines this stage asks for.
+    pub fn line_options(&self) -> drafter_lines::LineOptions {
+        drafter_lines::LineOptions {
+            crease_angle_deg: self.crease_angle_deg,
+            crease_min_edges: self.crease_min_edges,
+            crease_min_length: self.crease_min_length,
+            strong_crease_deg: self.strong_crease_deg,
+            ..drafter_lines::LineOptions::default()
+        }
+    }
+}
+
 impl Default for LinesStage {
     fn default() -> Self {
         Self {

@@ -35,7 +35,7 @@ use drafter_format::{
     HardEdgeClass, InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges,
     ProjectorRecord, RootExtension, StoredNormals, TextureImage, VertexData, Written,
 };
-use drafter_lines::{EdgeClass, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions};
+use drafter_lines::{EdgeClass, HierarchyChoice, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
@@ -480,13 +480,7 @@ fn compute_lines(
             labels[inst.mesh.index()] = Some(table.labels());
         }
     }
-    let options = LineOptions {
-        crease_angle_deg: stage.crease_angle_deg,
-        crease_min_edges: stage.crease_min_edges,
-        crease_min_length: stage.crease_min_length,
-        strong_crease_deg: stage.strong_crease_deg,
-        ..LineOptions::default()
-    };
+    let options = stage.line_options();
     let mut results: Vec<_> = scene
         .meshes
         .par_iter()

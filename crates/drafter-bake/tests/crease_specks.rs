@@ -70,13 +70,7 @@ fn the_dragon_keeps_no_crease_specks() {
     let imported = drafter_io::import(&path).expect("dragon");
     let topology = Topology::build(&imported.scene.meshes[0], Weld::default());
     let stage = drafter_bake::LinesStage::default();
-    let options = LineOptions {
-        crease_angle_deg: stage.crease_angle_deg,
-        crease_min_edges: stage.crease_min_edges,
-        crease_min_length: stage.crease_min_length,
-        strong_crease_deg: stage.strong_crease_deg,
-        ..LineOptions::default()
-    };
+    let options = stage.line_options();
     let before = chains(&topology, &LineOptions { crease_min_edges: 0, ..options });
     let after = chains(&topology, &options);
     let isolated = |c: &Chains| c.short.iter().filter(|s| s.0 == 1).count();
