@@ -34,11 +34,13 @@ def _bake_chunk(pairs: Sequence[Tuple[str, str]], options: dict, cpus: int) -> L
     return [dict(drafter.bake_file(i, o, threads=cpus, **options), node=node) for i, o in pairs]
 
 
-def _options(config, cache, cache_max, max_triangles) -> dict:
+def _options(config, cache, max_triangles) -> dict:
+    """The per-file options of the tasks. The cache's size bound is not among them: eviction lists
+    the whole cache, so the driver runs it once at the end instead of every task after every file."""
     if isinstance(config, os.PathLike):
         with open(config, encoding="utf-8") as f:
             config = f.read()
-    return {"config": config, "cache": None if cache is None else os.fspath(cache), "cache_max": cache_max, "max_triangles": max_triangles}
+    return {"config": config, "cache": None if cache is None else os.fspath(cache), "max_triangles": max_triangles}
 
 
 def bake_catalog(
@@ -85,7 +87,7 @@ def bake_catalog(
         retry_exceptions=False,
         runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}},
     )
-    options = _options(config, cache, cache_max, max_triangles)
+    options = _options(config, cache, max_triangles)
     refs = [task.remote([pairs[k] for k in chunk], options, cpus) for chunk in chunks]
     records: List[Optional[dict]] = [None] * len(pairs)
     for chunk, ref in zip(chunks, refs):
@@ -95,6 +97,8 @@ def bake_catalog(
             results = [_lost(pairs[k], e) for k in chunk]
         for k, record in zip(chunk, results):
             records[k] = record
+    if cache is not None and cache_max is not None:
+        drafter.cache_evict(cache, cache_max)
     summary = _summary(records, started, len(chunks))
     if report is not None:
         _write_atomically(os.fspath(report), json.dumps(summary, indent=2).encode())
@@ -104,8 +108,9 @@ def bake_catalog(
 def bake_dataset(dataset: Any, out_dir: Any, *, column: str = "path", cpus_per_task: int = 1, **kwargs) -> Any:
     """Bakes the files named by ``column`` of a Ray Dataset into ``out_dir`` (their file names under
     it), returning a Dataset of the per-file records (as JSON text in column ``record``). The
-    options are ``bake_catalog``'s: ``config``, ``cache``, ``cache_max``, ``max_triangles``."""
-    options = _options(kwargs.pop("config", None), kwargs.pop("cache", None), kwargs.pop("cache_max", None), kwargs.pop("max_triangles", None))
+    options are ``bake_catalog``'s: ``config``, ``cache``, ``max_triangles`` (bound the cache with
+    ``drafter.cache_evict`` once the dataset is consumed)."""
+    options = _options(kwargs.pop("config", None), kwargs.pop("cache", None), kwargs.pop("max_triangles", None))
     if kwargs:
         raise TypeError(f"unknown options: {sorted(kwargs)}")
     out_dir = os.fspath(out_dir)

@@ -130,7 +130,9 @@ fn bake_file(
             }
             let admit = |bytes| Some(Permit::unbounded(bytes));
             let record = batch::bake_file(&input, &output, &config, &limits, cache.as_ref(), &admit);
-            if let Some(cache) = &cache {
+            // Eviction lists the whole cache: only when a bound was asked for (a caller baking
+            // many files passes none and evicts once at the end, as drafter.ray does).
+            if let Some(cache) = cache.as_ref().filter(|c| c.max_bytes.is_some()) {
                 cache.evict();
             }
             record
