@@ -402,3 +402,61 @@ fn a_batch_refuses_what_it_cannot_do_before_baking() {
     assert_eq!(missing.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("missing"));
 }
+
+/// An input refused for its content is refused again by the same build, options and limits: the
+/// cache replays its one-line reason instead of parsing the file again, and other limits miss.
+#[test]
+fn refusals_are_replayed_from_the_cache_with_the_same_reason() {
+    let dir = common::scratch("batch-refusals");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    let sample = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb")).unwrap();
+    std::fs::write(input.join("good.glb"), &sample).unwrap();
+    std::fs::write(input.join("truncated.glb"), &sample[..sample.len() / 3]).unwrap();
+    let many = common::gltf_triangle(|j| j["accessors"][1]["count"] = serde_json::json!(3_000_000_000u64));
+    std::fs::write(input.join("many.gltf"), many).unwrap();
+    let cache = dir.join("cache");
+    let run = |extra: &[&str]| {
+        let output = common::drafter()
+            .arg("bake")
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.join("out"))
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--json")
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(4), "{}", String::from_utf8_lossy(&output.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let mut files: Vec<(String, String, String, u64)> = r["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|f| f["status"] == "failed")
+            .map(|f| {
+                let name = f["input"].as_str().unwrap().rsplit('/').next().unwrap().to_string();
+                (
+                    name,
+                    f["cache"].as_str().unwrap().to_string(),
+                    f["error"].as_str().unwrap().to_string(),
+                    f["exit_code"].as_u64().unwrap(),
+                )
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let first = run(&[]);
+    assert_eq!(first.len(), 2);
+    assert!(first.iter().all(|f| f.1 == "miss" && f.3 == 2), "{first:?}");
+    let second = run(&[]);
+    for (a, b) in first.iter().zip(&second) {
+        assert_eq!(b.1, "hit", "{b:?}");
+        assert_eq!((&a.0, &a.2, a.3), (&b.0, &b.2, b.3), "the same reason and exit code");
+    }
+    // The triangle limit decides a refusal too: other limits are other keys.
+    let other = run(&["--max-triangles", "1000000"]);
+    assert!(other.iter().all(|f| f.1 == "miss"), "{other:?}");
+}

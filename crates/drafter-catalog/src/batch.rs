@@ -264,6 +264,13 @@ fn bake_file_inner<'b>(
                 Err(Miss::Absent) => record.cache = CacheUse::Miss,
                 Err(Miss::Corrupt(_)) => record.cache = CacheUse::Rebuilt,
             }
+            if record.cache == CacheUse::Miss
+                && let Ok(reason) = cache.get(&crate::cache::failure_key(&key, limits))
+            {
+                record.cache = CacheUse::Hit;
+                let reason = reason.first().map(|r| String::from_utf8_lossy(r).into_owned()).unwrap_or_default();
+                return Err(Error::Input(reason));
+            }
         }
     }
     let bytes = job::read_input(input)?;
@@ -274,7 +281,20 @@ fn bake_file_inner<'b>(
         return Ok(());
     };
     record.estimated_peak_bytes = estimate;
-    let baked = job::bake_bytes(input, bytes, &config, limits, &mut |_| {})?;
+    let baked = match job::bake_bytes(input, bytes, &config, limits, &mut |_| {}) {
+        Ok(baked) => baked,
+        Err(e) => {
+            // The input's fault is decided by what the key covers: stored, so that a rerun replays
+            // it (the two Draco files of the shared models cost 3 ms each to parse and refuse).
+            if let Some((cache, Some(key))) = key
+                && e.is_content_fault()
+            {
+                let reason = e.to_string();
+                let _ = cache.put(&crate::cache::failure_key(&key, limits), &[reason.as_bytes()], &guard);
+            }
+            return Err(e);
+        }
+    };
     let bin = baked.written.bin.as_deref();
     crate::output::write_outputs(output, &baked.written.main, bin, &config.container, &[])?;
     record.bytes_out = (baked.written.main.len() + bin.map_or(0, <[u8]>::len)) as u64;

@@ -50,6 +50,17 @@ impl Error {
         }
     }
 
+    /// Whether the input's content (with the configuration and limits) is at fault, so that the
+    /// same input fails the same way again: import and bake refusals, not a file that could not be
+    /// read.
+    pub fn is_content_fault(&self) -> bool {
+        match self {
+            Error::Import(drafter_io::ImportError::Io { .. }) => false,
+            Error::Import(_) | Error::Input(_) => true,
+            Error::Io(_) | Error::Internal(_) => false,
+        }
+    }
+
     /// A word for reports: `input`, `io` or `internal`.
     pub fn kind(&self) -> &'static str {
         match self.exit_code() {

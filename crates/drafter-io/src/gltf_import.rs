@@ -343,14 +343,26 @@ fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Res
     Ok(out)
 }
 
-/// The bytes a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused: the rule of
+/// What a glTF buffer or image URI refers to: the bytes of a data URI, or a file.
+#[derive(Debug)]
+pub enum UriSource {
+    Data(Vec<u8>),
+    /// A file inside the glTF's folder: its canonical path, and the path the URI gives (for
+    /// messages).
+    File {
+        path: std::path::PathBuf,
+        relative: std::path::PathBuf,
+    },
+}
+
+/// What a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused: the rule of
 /// what may be followed is drafter-core's (`drafter_core::uri`); the joined path is then
 /// canonicalized and must stay inside the canonical folder, so a symbolic link cannot lead out of
-/// it either. drafter-format's loader of baked files (`external_buffers`) calls this too, so the
-/// importer and every reader of baked files follow the same URIs.
-pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
+/// it either. [`read_buffer_uri`] reads what this resolves; the cache's key hashes the file
+/// without reading it into memory.
+pub fn resolve_buffer_uri(folder: &Path, uri: &str) -> Result<UriSource, String> {
     let relative = match uri::resolve(uri)? {
-        UriTarget::Data(bytes) => return Ok(bytes),
+        UriTarget::Data(bytes) => return Ok(UriSource::Data(bytes)),
         UriTarget::Relative(relative) => relative,
     };
     let unreadable = |e: std::io::Error| format!("cannot read file {}: {e}", relative.display());
@@ -363,7 +375,19 @@ pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
     if !uri::inside(&canonical_folder, &canonical) {
         return Err(format!("URI {uri:?} leads out of the file's folder (through a symbolic link)"));
     }
-    std::fs::read(&canonical).map_err(unreadable)
+    Ok(UriSource::File { path: canonical, relative })
+}
+
+/// The bytes a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused
+/// ([`resolve_buffer_uri`]'s rule). drafter-format's loader of baked files (`external_buffers`)
+/// calls this too, so the importer and every reader of baked files follow the same URIs.
+pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
+    match resolve_buffer_uri(folder, uri)? {
+        UriSource::Data(bytes) => Ok(bytes),
+        UriSource::File { path, relative } => {
+            std::fs::read(&path).map_err(|e| format!("cannot read file {}: {e}", relative.display()))
+        }
+    }
 }
 
 /// Reads accessor `accessor` as `N`-component float vectors, de-quantising integer types

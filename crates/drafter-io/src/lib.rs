@@ -21,7 +21,8 @@ use std::path::Path;
 use drafter_core::{Diagnostic, Diagnostics, Scene, SourceFormat};
 
 pub use error::{ImportError, ParseError, Place};
-pub use gltf_import::read_buffer_uri;
+pub use gltf_import::{UriSource, read_buffer_uri, resolve_buffer_uri};
+pub use obj::{material_libraries as obj_material_libraries, open_material_library as open_obj_material_library};
 pub use raw::RawMesh;
 
 /// A successfully imported file.

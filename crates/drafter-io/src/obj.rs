@@ -98,12 +98,48 @@ pub(crate) fn import(path: &Path, bytes: &[u8], diagnostics: &mut Diagnostics) -
     Ok(scene)
 }
 
-fn load_material_library(folder: &Path, mtl: &Path) -> tobj::MTLLoadResult {
+/// The material libraries an OBJ's text names (`mtllib` lines, tobj's rule: the rest of the line
+/// after the first space, trimmed), in order: the files besides the OBJ that its import reads, for
+/// the cache's key. Names that lead out of the folder are listed too (the import refuses them).
+pub fn material_libraries(bytes: &[u8]) -> Vec<std::path::PathBuf> {
+    // Only the lines holding the word are decoded: a batch's cache keys every OBJ it is given.
+    let mut libraries = Vec::new();
+    if memchr::memmem::find(bytes, b"mtllib").is_none() {
+        return libraries;
+    }
+    let utf8 = std::str::from_utf8(bytes).is_ok();
+    let mut searched = 0;
+    while let Some(found) = memchr::memmem::find(&bytes[searched..], b"mtllib").map(|at| searched + at) {
+        let start = memchr::memrchr(b'\n', &bytes[..found]).map_or(0, |at| at + 1);
+        let end = memchr::memchr(b'\n', &bytes[found..]).map_or(bytes.len(), |at| found + at);
+        searched = end;
+        let line = &bytes[start..end];
+        // As the import reads the file: UTF-8, else Latin-1 byte for character.
+        let line: String = if utf8 {
+            String::from_utf8_lossy(line).into_owned()
+        } else {
+            line.iter().map(|&b| char::from(b)).collect()
+        };
+        let line = line.strip_suffix('\r').unwrap_or(&line);
+        if line.split_whitespace().next() == Some("mtllib") {
+            libraries.push(std::path::PathBuf::from(line.split_once(' ').unwrap_or_default().1.trim()));
+        }
+    }
+    libraries
+}
+
+/// Opens a material library named by the OBJ in `folder`: only a relative path that stays inside
+/// the folder.
+pub fn open_material_library(folder: &Path, mtl: &Path) -> Option<std::fs::File> {
     let inside = mtl.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
     if !inside {
-        return Err(tobj::LoadError::OpenFileFailed);
+        return None;
     }
-    let file = std::fs::File::open(folder.join(mtl)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+    std::fs::File::open(folder.join(mtl)).ok()
+}
+
+fn load_material_library(folder: &Path, mtl: &Path) -> tobj::MTLLoadResult {
+    let file = open_material_library(folder, mtl).ok_or(tobj::LoadError::OpenFileFailed)?;
     tobj::load_mtl_buf(&mut std::io::BufReader::new(file))
 }
 
