@@ -42,7 +42,9 @@ enum Command {
     /// Measure: `bench FILE` charts every stage's speed against accuracy; `bench render FILE` prints
     /// frame time per style as a ratio to phong.
     Bench(cmd::bench::Args),
-    /// Show a model in a window: turn, zoom, pan, switch styles, pick parts, take screenshots.
+    /// Show a model in a window: turn, zoom, pan, switch styles, take screenshots; select parts and
+    /// edit their gradients (anchor, scale, direction, q/f/p), save them into the file (Ctrl+S) or
+    /// export them as bake overrides (Ctrl+E).
     View(cmd::view::Args),
 }
 

@@ -4,7 +4,8 @@
 //! a click selects a part (printed and shown in the title), `P` saves a screenshot; parts are
 //! edited in place (Lux et al. 2013 §4: anchor, scale, direction and projector-line tools, gradient
 //! keys, undo, `Ctrl`+`S` saves into the file, `Ctrl`+`E` exports the edits as bake overrides); see
-//! `drafter_viewer::window`. Without a display it fails with one line (exit code 2).
+//! `drafter_viewer::window` and `--help` ([`KEYS`]). Without a display it fails with one line (exit
+//! code 2).
 
 use std::path::PathBuf;
 
@@ -15,7 +16,35 @@ use drafter_viewer::{Enhancements, RenderOptions, View};
 use crate::cmd::render::{ShadowArg, StyleArg, load};
 use crate::exit::BadInput;
 
+/// `drafter view --help`'s text after the options: the window's keys, the editing gestures, saving
+/// and exporting (the README's "Editing the illustration" has the long form).
+const KEYS: &str = "\
+Window:
+  left drag turns the object, wheel zooms, right or middle drag pans; 1-7 or S style, E edges,
+  L lines, H shadow, O orthographic, R reset the view, P screenshot PNG beside the model, F1 panel;
+  Esc or Q quits (with unsaved edits it asks first: Esc again quits without saving).
+
+Editing the parts' gradients (Lux et al. 2013 \u{a7}4; baked files only):
+  click                select a part (on a selected part: make it the reference); Shift+click adds
+                       or removes; Ctrl+drag lassoes (Ctrl+Shift adds)
+  A, then drag         anchor: move the gradient across the part (a click centres it)
+  X, then drag         scale: away from the anchor stretches the gradient, towards it shortens it
+                       (a drag from the anchor's dot pulls the projector's end)
+  D, then drag         direction: turn it about the anchor (one running towards you tilts
+                       towards the drag)
+  V, then drag         draw the projector: anchor at the start, direction and scale along the line
+  the same key again   back to turning the object
+  [ ]  , .  - =        q down/up, f down/up, p down/up;  T transfer curve, Y style hint, G flat grey
+  Ctrl+Z, Ctrl+Y       undo, redo
+  Ctrl+S               save: the edited part records are written into FILE (atomically; its mode and
+                       owner kept; a read-only file is refused, with a message in the window)
+  Ctrl+E               export: write <stem>.edits.toml beside FILE, for
+                       `drafter bake SOURCE --config <stem>.edits.toml` (nothing when no part is edited)
+
+Without a display it exits with code 2 and one line.";
+
 #[derive(Debug, clap::Args)]
+#[command(after_help = KEYS)]
 pub struct Args {
     /// The model to show: a baked .glb/.gltf, or any glTF, OBJ, STL, OFF, PLY.
     pub file: PathBuf,
@@ -63,10 +92,11 @@ pub fn run(args: Args) -> Result<()> {
         eprintln!("  note: {notice}");
     }
     // Saves and exports from the window go through the bake's atomic writer: a signal during a
-    // save leaves the previous file intact and no temporary file.
+    // save leaves the previous file intact and no temporary file. An existing file keeps its mode
+    // and owner, and one the user cannot write is refused, as editors do.
     drafter_catalog::interrupt::install();
     let writer = |path: &std::path::Path, bytes: &[u8]| {
-        drafter_catalog::output::write_atomically(path, bytes).map_err(|e| e.to_string())
+        drafter_catalog::output::replace_in_place(path, bytes).map_err(|e| e.to_string())
     };
     drafter_viewer::window::run(model, &args.file, options, &writer).map_err(|e| match e {
         WindowError::NoDisplay(_) => anyhow::Error::from(BadInput(e.to_string())),

@@ -1,6 +1,8 @@
 //! Atomic writes: every file is written in full to a temporary file beside its target, synced,
 //! then renamed over it, so a reader never sees a partial file and a failure (a full disk, a
-//! signal: [`crate::interrupt`]) leaves every target as it was.
+//! signal: [`crate::interrupt`]) leaves every target as it was. [`replace_in_place`] is the
+//! editor's save (`drafter view`): the file keeps its mode and, where it can, its owner, and a file
+//! the user cannot write is refused rather than replaced.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -56,6 +58,42 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     commit(vec![Staged::new(path, bytes)?])
 }
 
+/// Saves `bytes` over an existing file as an editor does (`drafter view`'s `Ctrl`+`S` and
+/// `Ctrl`+`E`), atomically: a symbolic link is followed (the link stays, its target is replaced);
+/// a file without any write permission (mode 0444, even for root, as vim's read-only files) or one
+/// this user cannot open for writing is refused and left as it was; otherwise the new bytes are
+/// staged beside it, given the file's owner and group where the user may (root; a group the user
+/// is in) and then its mode, and renamed over it. A path that does not exist yet is written as
+/// [`write_atomically`] writes (the umask's mode).
+pub fn replace_in_place(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let io = |what: &str, e: std::io::Error| Error::Io(format!("{}: {what}: {e}", path.display()));
+    let target = match std::fs::canonicalize(path) {
+        Ok(target) => target,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return write_atomically(path, bytes),
+        Err(e) => return Err(io("cannot write", e)),
+    };
+    let metadata = std::fs::metadata(&target).map_err(|e| io("cannot write", e))?;
+    if !metadata.is_file() {
+        return Err(Error::Input(format!("{}: not a regular file; not replaced", path.display())));
+    }
+    let mode = metadata.permissions().mode() & 0o7777;
+    if metadata.permissions().readonly() {
+        return Err(Error::Io(format!("{}: read-only (mode {mode:04o}); not replaced", path.display())));
+    }
+    // Opening for writing (no truncation, nothing written) asks the kernel what it would allow:
+    // the mode bits, ACLs, a read-only mount.
+    std::fs::OpenOptions::new().write(true).open(&target).map_err(|e| io("cannot write", e))?;
+    let staged = Staged::new(&target, bytes)?;
+    // Owner first: a change of owner clears the set-id bits, which the mode then restores.
+    if std::os::unix::fs::chown(&staged.temp, Some(metadata.uid()), Some(metadata.gid())).is_err() {
+        let _ = std::os::unix::fs::chown(&staged.temp, None, Some(metadata.gid()));
+    }
+    std::fs::set_permissions(&staged.temp, std::fs::Permissions::from_mode(mode))
+        .map_err(|e| io("cannot keep its mode", e))?;
+    commit(vec![staged])
+}
+
 /// A bake's files: `extra` first (a report, textures), then a .gltf's .bin, then the main file,
 /// all staged before any is renamed, so a failure in any of them leaves every target as it was.
 pub fn write_outputs(
@@ -86,5 +124,79 @@ pub fn container_for(output: &Path) -> Result<Container, Error> {
             Ok(Container::Gltf { bin_uri: format!("{stem}.bin") })
         }
         _ => Err(Error::Input(format!("{}: output must end in .glb or .gltf", output.display()))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::os::unix::fs::PermissionsExt;
+
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("drafter-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("scratch");
+        dir
+    }
+
+    fn mode(path: &Path) -> u32 {
+        std::fs::metadata(path).expect("exists").permissions().mode() & 0o7777
+    }
+
+    fn set_mode(path: &Path, mode: u32) {
+        std::fs::set_permissions(path, std::fs::Permissions::from_mode(mode)).expect("chmod");
+    }
+
+    fn leftovers(dir: &Path) -> Vec<String> {
+        let names = std::fs::read_dir(dir).expect("dir").map(|e| e.expect("entry").file_name());
+        names.map(|n| n.to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect()
+    }
+
+    #[test]
+    fn a_save_keeps_the_files_mode_and_owner() {
+        use std::os::unix::fs::MetadataExt;
+        let dir = scratch("mode");
+        for m in [0o600, 0o640, 0o664, 0o700] {
+            let file = dir.join(format!("m{m:o}.glb"));
+            std::fs::write(&file, b"before").expect("write");
+            set_mode(&file, m);
+            let owner = std::fs::metadata(&file).map(|m| (m.uid(), m.gid())).expect("stat");
+            replace_in_place(&file, b"after").expect("saved");
+            assert_eq!(std::fs::read(&file).expect("read"), b"after");
+            assert_eq!(mode(&file), m, "mode {m:o} kept");
+            assert_eq!(std::fs::metadata(&file).map(|m| (m.uid(), m.gid())).expect("stat"), owner);
+        }
+        // Through a symbolic link: the target is replaced, the link stays a link.
+        let link = dir.join("link.glb");
+        std::os::unix::fs::symlink("m600.glb", &link).expect("symlink");
+        replace_in_place(&link, b"via the link").expect("saved");
+        assert!(std::fs::symlink_metadata(&link).expect("lstat").file_type().is_symlink());
+        assert_eq!(std::fs::read(dir.join("m600.glb")).expect("read"), b"via the link");
+        assert_eq!(mode(&dir.join("m600.glb")), 0o600);
+        // A new file (an export's first write) is simply written.
+        replace_in_place(&dir.join("new.toml"), b"x").expect("written");
+        assert_eq!(std::fs::read(dir.join("new.toml")).expect("read"), b"x");
+        assert!(leftovers(&dir).is_empty(), "{:?}", leftovers(&dir));
+        std::fs::remove_dir_all(&dir).expect("clean");
+    }
+
+    #[test]
+    fn a_save_refuses_a_read_only_file_and_leaves_it_as_it_was() {
+        let dir = scratch("read-only");
+        let file = dir.join("locked.glb");
+        std::fs::write(&file, b"before").expect("write");
+        set_mode(&file, 0o444);
+        // Refused even when the process could write it (root): the file says it is read-only.
+        let err = replace_in_place(&file, b"after").expect_err("a read-only file is not replaced");
+        assert!(err.to_string().contains("read-only (mode 0444)"), "{err}");
+        assert_eq!(std::fs::read(&file).expect("read"), b"before");
+        assert_eq!(mode(&file), 0o444);
+        // Not a regular file: refused.
+        let err = replace_in_place(&dir, b"x").expect_err("a folder is not replaced");
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+        assert!(leftovers(&dir).is_empty(), "{:?}", leftovers(&dir));
+        set_mode(&file, 0o644);
+        std::fs::remove_dir_all(&dir).expect("clean");
     }
 }
