@@ -4,12 +4,20 @@
 //! values, the file reads back with only those two part records changed, and a headless render of
 //! the saved file differs from the original's only on those two parts' pixels.
 //!
-//! Xvfb and xdotool are installed by scripts/test; without them this test fails (it never skips).
+//! A second session checks what a user is told in the window: a save over a read-only file is
+//! refused (the title says why, the file stays), a save keeps a 0600 file 0600, `Esc` with unsaved
+//! edits asks before quitting, and `Ctrl`+`E` on a plain OBJ writes nothing and says so.
+//!
+//! Xvfb and xdotool are installed by scripts/test; without them these tests fail (they never skip).
+//! The sessions take turns (one window at a time on a 2-core machine), and the second waits for
+//! what it expects (the title, the log) rather than for fixed times.
 
 mod common;
 
+use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use drafter_format::PartRecord;
@@ -18,6 +26,11 @@ use drafter_viewer::{Model, RenderOptions, Renderer, Style, View};
 const SIZE: (u32, u32) = (800, 600);
 /// Time for the window to draw after an input on lavapipe (a frame is ~0.2 s at this size).
 const SETTLE: Duration = Duration::from_millis(1200);
+/// The longest wait for a window to show what an input should change (a loaded machine).
+const PATIENCE: Duration = Duration::from_secs(60);
+
+/// One window session at a time.
+static WINDOWS: Mutex<()> = Mutex::new(());
 
 /// A virtual X server on a free display, stopped on drop.
 struct Xvfb {
@@ -142,6 +155,7 @@ fn a_scripted_session_selects_drags_raises_q_and_saves_only_those_parts() {
     let (a, b) = (by_size[0].0, by_size[1].0);
     let (pa, pb) = (inside(&ids, a).expect("a point inside"), inside(&ids, b).expect("a point inside"));
 
+    let _turn = WINDOWS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let x = Xvfb::start();
     let log = dir.join("view.log");
     let mut view = common::drafter()
@@ -193,7 +207,7 @@ fn a_scripted_session_selects_drags_raises_q_and_saves_only_those_parts() {
     std::io::Read::read_to_string(view.stderr.as_mut().expect("stderr"), &mut stderr).expect("stderr");
     let stdout = std::fs::read_to_string(&log).expect("log");
     assert!(status.success(), "{status}\nstdout:\n{stdout}\nstderr:\n{stderr}");
-    assert!(stdout.contains("selected 2 part(s):"), "{stdout}");
+    assert!(stdout.contains("selected 2 parts:"), "{stdout}");
     assert!(stdout.contains("tool: anchor"), "{stdout}");
     assert!(stdout.contains("saved: "), "{stdout}\n{stderr}");
     assert_eq!(stdout.matches("screenshot: ").count(), 4, "{stdout}");
@@ -240,4 +254,138 @@ fn a_scripted_session_selects_drags_raises_q_and_saves_only_those_parts() {
         assert!(dir.join(format!("sample-{n}.png")).is_file(), "screenshot {n}");
     }
     let _: PathBuf = dir;
+}
+
+/// `drafter view` on `file` in `x`, its stdout in `log`: the child and its window's id.
+fn open_window(x: &Xvfb, file: &Path, log: &Path) -> (Child, String) {
+    let child = common::drafter()
+        .args(["view", "--size", "800x600"])
+        .arg(file)
+        .env("DISPLAY", &x.display)
+        .stdout(std::fs::File::create(log).expect("log"))
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("drafter view starts");
+    let window = x.xdotool(&["search", "--sync", "--onlyvisible", "--pid", &child.id().to_string()]);
+    let window = window.lines().next().expect("a window").to_owned();
+    (child, window)
+}
+
+/// Waits until `ready` holds, up to [`PATIENCE`]; `what` names it in the failure, with `state()`.
+fn wait_for(what: &str, mut ready: impl FnMut() -> bool, state: impl Fn() -> String) {
+    let started = Instant::now();
+    while !ready() {
+        assert!(started.elapsed() < PATIENCE, "waited {PATIENCE:?} for {what}; {}", state());
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+fn mode(path: &Path) -> u32 {
+    std::fs::metadata(path).expect("stat").permissions().mode() & 0o7777
+}
+
+fn set_mode(path: &Path, mode: u32) {
+    std::fs::set_permissions(path, std::fs::Permissions::from_mode(mode)).expect("chmod");
+}
+
+#[test]
+fn the_window_refuses_a_read_only_file_keeps_a_0600_one_and_asks_before_quitting_unsaved() {
+    let dir = common::scratch("view-save");
+    let file = dir.join("sample.glb");
+    assert!(common::drafter().args(["bake", "-o"]).arg(&file).arg("--quiet").status().expect("bakes").success());
+    let (_, ids) = render(&file);
+    let mut counts = std::collections::BTreeMap::<u32, usize>::new();
+    for id in ids.iter().flatten() {
+        *counts.entry(*id).or_default() += 1;
+    }
+    let part = counts.iter().max_by_key(|&(id, n)| (n, std::cmp::Reverse(id))).map(|(&id, _)| id).expect("a part");
+    let (px, py) = inside(&ids, part).expect("a point inside");
+    let (px, py) = (px.to_string(), py.to_string());
+    let original = std::fs::read(&file).expect("reads");
+    let q = records(&file)[part as usize].gradient.q;
+    set_mode(&file, 0o444);
+
+    let _turn = WINDOWS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let x = Xvfb::start();
+    let log = dir.join("view.log");
+    let (mut view, window) = open_window(&x, &file, &log);
+    let stdout = || std::fs::read_to_string(&log).unwrap_or_default();
+    let title = || x.xdotool(&["getwindowname", &window]);
+    let input = |args: &[&str]| {
+        x.xdotool(&["windowfocus", "--sync", &window]);
+        x.xdotool(args);
+    };
+    let state = || format!("title {:?}\nstdout:\n{}", title(), stdout());
+    // The first frame is drawn (the window's first click picks from it).
+    wait_for("the first frame", || title().contains("drafter — sample.glb"), state);
+    std::thread::sleep(SETTLE);
+    input(&["mousemove", "--window", &window, &px, &py, "click", "1"]);
+    wait_for("the part to be selected", || stdout().contains("selected 1 part:"), state);
+    input(&["key", "bracketright"]);
+    wait_for("an unsaved edit", || title().contains("| unsaved"), state);
+
+    // Ctrl+S on a read-only file: refused, said in the window, the file as it was.
+    input(&["key", "ctrl+s"]);
+    wait_for("the refusal in the window", || title().contains("not saved"), state);
+    assert!(title().contains("read-only (mode 0444); not replaced"), "{}", state());
+    assert_eq!(std::fs::read(&file).expect("reads"), original, "a read-only file was replaced");
+    assert_eq!(mode(&file), 0o444);
+
+    // Esc with the unsaved edit asks and stays open.
+    input(&["key", "Escape"]);
+    wait_for("the question", || title().contains("Unsaved edits (1 part): press Esc again to quit"), state);
+    std::thread::sleep(SETTLE);
+    assert!(view.try_wait().expect("status").is_none(), "Esc quit with unsaved edits; {}", state());
+
+    // Writable by its owner only: the save goes through and the file stays 0600.
+    set_mode(&file, 0o600);
+    input(&["key", "ctrl+s"]);
+    wait_for("the save", || title().contains("saved: sample.glb (1 part record changed)"), state);
+    assert_eq!(mode(&file), 0o600, "a save changed the file's mode");
+    assert_eq!(records(&file)[part as usize].gradient.q, q + 1.0);
+
+    // Another edit, then Esc twice: asked, then quit without saving it.
+    input(&["key", "bracketright"]);
+    wait_for("a second unsaved edit", || title().contains("| unsaved"), state);
+    input(&["key", "Escape"]);
+    wait_for("the question again", || title().contains("Unsaved edits"), state);
+    assert!(view.try_wait().expect("status").is_none(), "Esc quit with unsaved edits; {}", state());
+    input(&["key", "Escape"]);
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = view.try_wait().expect("status") {
+            break status;
+        }
+        assert!(started.elapsed() < PATIENCE, "the second Esc did not quit; {}", state());
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(view.stderr.as_mut().expect("stderr"), &mut stderr).expect("stderr");
+    assert!(status.success(), "{status}\nstdout:\n{}\nstderr:\n{stderr}", stdout());
+    assert!(stderr.contains("read-only (mode 0444)"), "{stderr}");
+    assert_eq!(stdout().matches("Unsaved edits (1 part): press Esc again").count(), 2, "{}", stdout());
+    assert_eq!(records(&file)[part as usize].gradient.q, q + 1.0, "the edit after the save was not saved");
+    assert_eq!(mode(&file), 0o600);
+
+    // Ctrl+E on a plain OBJ: nothing to export, nothing written, and Esc quits at once.
+    let obj = dir.join("plain.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n").expect("obj");
+    let log = dir.join("plain.log");
+    let (mut view, window) = open_window(&x, &obj, &log);
+    let stdout = || std::fs::read_to_string(&log).unwrap_or_default();
+    let title = || x.xdotool(&["getwindowname", &window]);
+    let state = || format!("title {:?}\nstdout:\n{}", title(), stdout());
+    wait_for("the first frame", || title().contains("drafter — plain.obj"), state);
+    x.xdotool(&["windowfocus", "--sync", &window]);
+    x.xdotool(&["key", "ctrl+e"]);
+    wait_for("the export's answer", || title().contains("nothing to export"), state);
+    assert!(stdout().contains("nothing to export: plain.obj is not baked"), "{}", stdout());
+    assert!(!dir.join("plain.edits.toml").exists(), "an edits file was written");
+    x.xdotool(&["windowfocus", "--sync", &window]);
+    x.xdotool(&["key", "Escape"]);
+    let started = Instant::now();
+    while view.try_wait().expect("status").is_none() {
+        assert!(started.elapsed() < PATIENCE, "Esc did not quit without edits; {}", state());
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }

@@ -20,6 +20,18 @@ use glam::{DMat4, DQuat, DVec2, DVec3, DVec4, Mat4};
 /// anchor to give a ratio or an angle), pixels.
 pub const MIN_HANDLE_PX: f64 = 2.0;
 
+/// Radius around the anchor's dot (pixels) where a scale drag grabs the anchor itself: the end of
+/// the projector then follows the cursor's distance from the anchor.
+pub const ANCHOR_GRAB_PX: f64 = 8.0;
+
+/// A direction within this angle of its box's reference normal (degrees) runs along the line of
+/// sight: moving the anchor across the reference plane changes nothing, and a turn about the normal
+/// barely moves it, so the direction tool tilts it instead ([`manipulate`]).
+pub const FACING_DEG: f64 = 20.0;
+
+/// Degrees a facing direction tilts per pixel of a direction drag (100 px: 50°).
+pub const TILT_DEGREES_PER_PIXEL: f64 = 0.5;
+
 /// Step of `f` per key press.
 pub const F_STEP: f32 = 0.05;
 
@@ -118,6 +130,12 @@ impl PartBox {
             .max_by(|a, b| a.dot(toward_viewer).abs().total_cmp(&b.dot(toward_viewer).abs()))
             .unwrap_or(DVec3::Z);
         if axis.dot(toward_viewer) < 0.0 { -axis } else { axis }
+    }
+
+    /// Whether `direction` runs within [`FACING_DEG`] of this box's reference normal as seen from
+    /// `toward_viewer`: then an anchor move across the reference plane changes nothing visible.
+    pub fn faces(&self, direction: DVec3, toward_viewer: DVec3) -> bool {
+        direction.dot(self.reference_normal(toward_viewer)).abs() >= FACING_DEG.to_radians().cos()
     }
 
     /// The box's diagonal length.
@@ -350,13 +368,41 @@ pub fn manipulate(
         }
         Tool::Scale => {
             let (from, to) = ((start - anchor_px).length(), (now - anchor_px).length());
-            if from < MIN_HANDLE_PX || to < MIN_HANDLE_PX {
+            let floor = 1e-6 * r.obb.diagonal().max(f64::MIN_POSITIVE);
+            let scale = if from < ANCHOR_GRAB_PX {
+                // Grabbed on the anchor's dot: the projector's end follows the cursor's distance
+                // from the anchor (in the reference plane where the end is not seen apart from it).
+                let end = view.project(anchor + r.params.direction * r.params.scale);
+                match end.map(|e| (e - anchor_px).length()) {
+                    Some(handle) if handle >= ANCHOR_GRAB_PX => r.params.scale * to / handle,
+                    _ => (view.on_plane(now, anchor, normal)? - anchor).length(),
+                }
+            } else if to < MIN_HANDLE_PX {
+                return None;
+            } else {
+                r.params.scale * to / from
+            };
+            if !scale.is_finite() {
                 return None;
             }
-            let floor = 1e-6 * r.obb.diagonal().max(f64::MIN_POSITIVE);
-            let scale = (r.params.scale * to / from).max(floor);
+            let scale = scale.max(floor);
             for p in &mut out {
                 p.scale = scale;
+            }
+        }
+        Tool::Direction if r.obb.faces(r.params.direction, view.toward_viewer(anchor)) => {
+            // Along the line of sight a turn about the normal barely moves the direction: tilt it
+            // towards the drag instead, by an angle in proportion to the drag's length; every
+            // selected part turns by the same rotation.
+            let drag = now - start;
+            let towards = view.on_plane(anchor_px + drag, anchor, normal)? - anchor;
+            let axis = normal.cross(towards);
+            if drag.length() < MIN_HANDLE_PX || axis.length() <= 1e-12 * towards.length() {
+                return None;
+            }
+            let turn = DQuat::from_axis_angle(axis.normalize(), (drag.length() * TILT_DEGREES_PER_PIXEL).to_radians());
+            for p in &mut out {
+                p.direction = (turn * p.direction).normalize();
             }
         }
         Tool::Direction => {
@@ -668,19 +714,29 @@ impl Editor {
     /// The overrides that re-create every edited part when `drafter bake --config` bakes the source
     /// model with them (appended to the config of the first bake, if it had one): one `[[part]]`
     /// table by id with the projector, gradient, style and tone for every part edited since the
-    /// session began.
-    pub fn overrides_toml(&self, file: &str) -> String {
+    /// session began. `None` when no part has been edited (nothing to export).
+    pub fn overrides_toml(&self, file: &str) -> Option<String> {
         let mut out = format!(
             "# Part edits made in `drafter view` on {file}.\n# Re-create them: drafter bake SOURCE --config THIS_FILE (append these tables to the\n# config of the first bake, if it had one).\n"
         );
-        for (now, first) in self.records.iter().zip(&self.first) {
-            if let Some(now) = now
-                && Some(now) != first.as_ref()
-            {
+        let edited = self.edited();
+        for &id in &edited {
+            if let Some(now) = self.record(id) {
                 out.push_str(&override_table(now));
             }
         }
-        out
+        (!edited.is_empty()).then_some(out)
+    }
+
+    /// The parts whose records differ from the ones the session began with.
+    pub fn edited(&self) -> Vec<u32> {
+        let differs = |(now, first): (&Option<PartRecord>, &Option<PartRecord>)| now.is_some() && now != first;
+        (0..).zip(self.records.iter().zip(&self.first)).filter(|&(_, pair)| differs(pair)).map(|(id, _)| id).collect()
+    }
+
+    /// Whether any part can be edited (an unbaked model has no records).
+    pub fn editable(&self) -> bool {
+        self.records.iter().any(Option::is_some)
     }
 
     fn commit(&mut self, changes: Vec<(u32, PartParams, PartParams)>) -> Vec<u32> {
@@ -741,7 +797,7 @@ pub fn override_table(record: &PartRecord) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use drafter_format::ObbMethod;
 
@@ -762,7 +818,9 @@ mod tests {
         ]
     }
 
-    fn record(id: u32, center: [f64; 3]) -> PartRecord {
+    /// A baked record of a 2 × 1 × 0.5 box at `center` with axes along x, y, z; the projector at
+    /// the centre along +x, scale 2, gradient q 10, f 0.5, p 1.
+    pub(crate) fn record(id: u32, center: [f64; 3]) -> PartRecord {
         let params = PartParams {
             anchor: DVec3::from(center),
             direction: DVec3::X,
@@ -854,8 +912,8 @@ mod tests {
             manipulate(Tool::Scale, &[t], 0, &view, a + DVec2::new(10.0, 0.0), a + DVec2::new(0.0, 25.0)).unwrap();
         assert!((out[0].scale - 5.0).abs() < 1e-12, "{}", out[0].scale);
         assert!(
-            manipulate(Tool::Scale, &[t], 0, &view, a, a + DVec2::new(5.0, 0.0)).is_none(),
-            "no ratio from the anchor"
+            manipulate(Tool::Scale, &[t], 0, &view, a + DVec2::new(10.0, 0.0), a + DVec2::new(1.0, 0.0)).is_none(),
+            "no ratio on the anchor"
         );
         // A quarter turn counter-clockwise on screen (right, then up: y is down) turns +x into +y.
         let out =
@@ -863,6 +921,76 @@ mod tests {
         assert!((out[0].direction - DVec3::Y).length() < 1e-12, "{:?}", out[0].direction);
         let shown = view.project(out[0].direction).unwrap() - view.project(DVec3::ZERO).unwrap();
         assert!(shown.x.abs() < 1e-9 && shown.y < 0.0, "drawn pointing up: {shown:?}");
+    }
+
+    #[test]
+    fn a_scale_drag_from_the_anchor_dot_pulls_the_projectors_end() {
+        for (name, view) in views() {
+            let t = target(0, [0.0, 0.0, 0.0]);
+            let a = view.project(t.params.anchor).unwrap();
+            let end = view.project(t.params.anchor + t.params.direction * t.params.scale).unwrap();
+            let handle = (end - a).length();
+            // Pressed on the dot (3 px off the anchor, inside its 5 px radius), dragged to twice the
+            // handle's length on screen: the scale doubles.
+            let now = a + (end - a) * 2.0;
+            let out = manipulate(Tool::Scale, &[t], 0, &view, a + DVec2::new(3.0, 0.0), now)
+                .unwrap_or_else(|| panic!("{name}: a drag from the dot is ignored"));
+            assert!((out[0].scale - 4.0).abs() < 1e-9, "{name}: scale {} (handle {handle} px)", out[0].scale);
+            // Exactly on the anchor too.
+            assert!(manipulate(Tool::Scale, &[t], 0, &view, a, now).is_some(), "{name}");
+        }
+        // A direction towards the viewer has no length on screen: the end goes to the cursor's
+        // distance in the reference plane.
+        let (_, view) = views().remove(2);
+        let mut t = target(0, [0.0, 0.0, 0.0]);
+        t.params.direction = DVec3::Z;
+        let a = view.project(t.params.anchor).unwrap();
+        let out = manipulate(Tool::Scale, &[t], 0, &view, a, a + DVec2::new(0.0, 50.0)).unwrap();
+        let cursor = view.on_plane(a + DVec2::new(0.0, 50.0), DVec3::ZERO, DVec3::Z).unwrap();
+        assert!((out[0].scale - cursor.length()).abs() < 1e-9, "{} vs {}", out[0].scale, cursor.length());
+    }
+
+    #[test]
+    fn a_direction_drag_turns_at_a_usable_rate_and_tilts_a_direction_facing_the_viewer() {
+        let (_, view) = views().remove(2); // head-on: the box's z axis faces the viewer
+        let mut t = target(0, [0.0, 0.0, 0.0]);
+        let toward = view.toward_viewer(t.params.anchor);
+        assert!(!t.obb.faces(t.params.direction, toward), "+x lies in the reference plane");
+        // A direction 5° off the normal (the case: a turn about the normal moved it 2.5°).
+        t.params.direction = DQuat::from_rotation_y(5f64.to_radians()) * DVec3::Z;
+        assert!(t.obb.faces(t.params.direction, toward));
+        let a = view.project(t.params.anchor).unwrap();
+        let (start, now) = (a + DVec2::new(60.0, 10.0), a + DVec2::new(160.0, 10.0));
+        let out = manipulate(Tool::Direction, &[t], 0, &view, start, now).unwrap();
+        let turned = t.params.direction.angle_between(out[0].direction).to_degrees();
+        assert!((turned - 100.0 * TILT_DEGREES_PER_PIXEL).abs() < 1e-6, "a 100 px drag turned it {turned}°");
+        // Tilted towards the drag (right on screen: +x).
+        assert!(out[0].direction.x > t.params.direction.x + 0.5, "{:?}", out[0].direction);
+        assert!((out[0].direction.length() - 1.0).abs() < 1e-12);
+        // A direction in the plane turns about the anchor: a 100 px drag across, 100 px from it, 45°.
+        let t = target(0, [0.0, 0.0, 0.0]);
+        let out =
+            manipulate(Tool::Direction, &[t], 0, &view, a + DVec2::new(100.0, 0.0), a + DVec2::new(100.0, -100.0))
+                .unwrap();
+        let turned = t.params.direction.angle_between(out[0].direction).to_degrees();
+        assert!((turned - 45.0).abs() < 1e-9, "{turned}°");
+    }
+
+    #[test]
+    fn an_editor_without_edits_has_nothing_to_export() {
+        let mut editor = Editor::new(vec![Some(record(0, [0.0; 3])), None]);
+        assert!(editor.editable());
+        assert_eq!(editor.overrides_toml("x.glb"), None);
+        editor.selection.click(Some(0));
+        editor.adjust(Adjust::Q(1));
+        assert_eq!(editor.edited(), vec![0]);
+        assert!(editor.overrides_toml("x.glb").is_some_and(|t| t.contains("[[part]]")));
+        // Undone: the records are the first ones again, nothing to export.
+        editor.undo();
+        assert_eq!(editor.overrides_toml("x.glb"), None);
+        // An unbaked model (a plain OBJ): no part can be edited.
+        let plain = Editor::new(vec![None, None]);
+        assert!(!plain.editable() && plain.overrides_toml("plain.obj").is_none());
     }
 
     #[test]
@@ -1009,7 +1137,7 @@ mod tests {
         assert!(editor.redo().is_empty());
         editor.mark_saved();
         assert!(editor.unsaved().is_empty());
-        let toml = editor.overrides_toml("x.glb");
+        let toml = editor.overrides_toml("x.glb").expect("edits to export");
         assert_eq!(toml.matches("[[part]]").count(), 2, "{toml}");
         assert!(toml.contains("style = \"gradient\""), "{toml}");
     }

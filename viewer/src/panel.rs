@@ -6,7 +6,10 @@
 //! so undo, save and export treat them alike. A slider that is held changes the selection live and
 //! makes one undo step when released ([`crate::edit::Editor::adjust_live`]). [`paint_overlay`] draws
 //! each selected part's projector (anchor, direction and scale as a line from the anchor) and the
-//! lasso being drawn. [`Overlay`] owns egui's context, its winit input state and its wgpu renderer.
+//! lasso being drawn, under the panel. The window's last message ([`Status`]: a save, a refused
+//! save, an export, the question before quitting with unsaved edits) is shown in the panel, or at
+//! the window's bottom-left corner while the panel is hidden ([`show_status`]). [`Overlay`] owns
+//! egui's context, its winit input state and its wgpu renderer.
 
 use drafter_core::gradient::{MAX_POWER, MAX_QUANTIZATION, MIN_POWER};
 use drafter_format::{PartStyle, TransferCurve};
@@ -19,6 +22,33 @@ pub const PANEL_WIDTH: f32 = 250.0;
 
 /// Selected parts listed by name before the list scrolls.
 const LISTED_ROWS: f32 = 8.0;
+
+/// `n` and `noun`, in the plural unless `n` is 1: "1 part", "2 parts".
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
+}
+
+/// The window's last message: what a save, an export or a quit did or asks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Status {
+    pub text: String,
+    /// A failure (drawn in red).
+    pub error: bool,
+}
+
+impl Status {
+    pub fn info(text: impl Into<String>) -> Self {
+        Status { text: text.into(), error: false }
+    }
+
+    pub fn error(text: impl Into<String>) -> Self {
+        Status { text: text.into(), error: true }
+    }
+
+    fn colour(&self) -> egui::Color32 {
+        if self.error { egui::Color32::from_rgb(200, 30, 30) } else { egui::Color32::from_rgb(20, 110, 40) }
+    }
+}
 
 /// One selected part as the panel lists it.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,6 +73,11 @@ pub struct PanelView {
     pub can_redo: bool,
     /// The style parts without a hint are drawn in.
     pub scene_style: String,
+    /// The last message (a save, an export, a quit that asks first).
+    pub status: Option<Status>,
+    /// Why the current tool may change nothing visible on the reference part (its direction runs
+    /// along the line of sight).
+    pub hint: Option<String>,
 }
 
 /// What the user did in the panel.
@@ -83,7 +118,7 @@ pub fn show(ctx: &egui::Context, view: &PanelView) -> Vec<PanelAction> {
         .show(ctx, |ui| {
             ui.set_width(PANEL_WIDTH - 16.0);
             let unsaved = if view.unsaved > 0 { format!(", {} unsaved", view.unsaved) } else { String::new() };
-            ui.label(format!("{}: {} parts{unsaved}", view.file, view.parts));
+            ui.label(format!("{}: {}{unsaved}", view.file, count(view.parts, "part")));
             ui.horizontal_wrapped(|ui| {
                 ui.label("drag:");
                 let mut tool = view.tool;
@@ -95,6 +130,9 @@ pub fn show(ctx: &egui::Context, view: &PanelView) -> Vec<PanelAction> {
                     actions.push(PanelAction::Tool(tool));
                 }
             });
+            if let Some(hint) = &view.hint {
+                ui.colored_label(egui::Color32::from_rgb(150, 90, 0), hint);
+            }
             ui.separator();
             selection(ui, view, &mut actions);
             ui.separator();
@@ -112,6 +150,9 @@ pub fn show(ctx: &egui::Context, view: &PanelView) -> Vec<PanelAction> {
                     actions.push(PanelAction::Export);
                 }
             });
+            if let Some(status) = &view.status {
+                ui.colored_label(status.colour(), &status.text);
+            }
             egui::CollapsingHeader::new("keys and gestures").default_open(false).show(ui, |ui| {
                 for line in KEY_HELP {
                     ui.label(*line);
@@ -137,7 +178,7 @@ fn selection(ui: &mut egui::Ui, view: &PanelView, actions: &mut Vec<PanelAction>
         ui.label("nothing selected: click a part");
         return;
     }
-    ui.label(format!("{} selected", view.selected.len()));
+    ui.label(format!("{} selected", count(view.selected.len(), "part")));
     egui::ScrollArea::vertical().max_height(LISTED_ROWS * 18.0).show(ui, |ui| {
         for part in &view.selected {
             let mark = if part.reference { "▶ " } else { "  " };
@@ -216,10 +257,22 @@ fn live(response: &egui::Response, changed: bool, adjust: Adjust, actions: &mut 
     }
 }
 
-/// The projector handles of the selection and the lasso in progress, over the frame (window
-/// pixels; egui's points are pixels / `pixels_per_point`).
+/// The window's last message at its bottom-left corner (where the panel is hidden).
+pub fn show_status(ctx: &egui::Context, status: &Status) {
+    egui::Area::new(egui::Id::unique("drafter status"))
+        .anchor(egui::Align2::LEFT_BOTTOM, [8.0, -8.0])
+        .interactable(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.colored_label(status.colour(), &status.text);
+            });
+        });
+}
+
+/// The projector handles of the selection and the lasso in progress, over the frame and under the
+/// panel (window pixels; egui's points are pixels / `pixels_per_point`).
 pub fn paint_overlay(ctx: &egui::Context, handles: &[Handle], lasso: Option<&[DVec2]>) {
-    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("drafter handles")));
+    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("drafter handles")));
     let scale = 1.0 / ctx.pixels_per_point();
     let at = |p: DVec2| egui::pos2(p.x as f32 * scale, p.y as f32 * scale);
     for h in handles {
@@ -401,6 +454,81 @@ mod tests {
             modifiers: Default::default(),
         }];
         assert_eq!(run(&ctx, &view, release), vec![PanelAction::Tool(Some(Tool::Anchor))]);
+    }
+
+    #[test]
+    fn the_panel_counts_in_words_and_shows_the_last_message() {
+        assert_eq!(
+            (count(1, "part"), count(0, "part"), count(2, "part")),
+            ("1 part".into(), "0 parts".into(), "2 parts".into())
+        );
+        let ctx = egui::Context::default();
+        let view = PanelView {
+            file: "a.glb".into(),
+            parts: 1,
+            status: Some(Status::error("not saved: a.glb: read-only (mode 0444); not replaced")),
+            hint: Some("part 0's gradient runs towards you".into()),
+            ..Default::default()
+        };
+        run(&ctx, &view, vec![]);
+        for text in [
+            "a.glb: 1 part",
+            "not saved: a.glb: read-only (mode 0444); not replaced",
+            "part 0's gradient runs towards you",
+        ] {
+            assert!(find_text(&ctx, &view, text).is_some(), "{text:?} is not on the panel");
+        }
+        // With the panel hidden the message is shown at the bottom-left corner.
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 600.0))),
+            ..Default::default()
+        };
+        let status = Status::info("saved: a.glb (1 part record changed)");
+        // Twice: egui lays an area out on its first pass without showing it.
+        ctx.run_pass(input.clone(), |ctx| show_status(ctx, &status)).drop_without_applying_deltas();
+        {
+            let output = ctx.run_pass(input.clone(), |ctx| show_status(ctx, &status));
+            let shown = output.shapes.iter().find_map(|c| match &c.shape {
+                egui::Shape::Text(t) if t.galley.job.text == status.text => Some(t.visual_bounding_rect()),
+                _ => None,
+            });
+            output.drop_without_applying_deltas();
+            let rect = shown.expect("the message is shown");
+            assert!(rect.min.x < 100.0 && rect.max.y > 500.0, "{rect:?}");
+        }
+    }
+
+    #[test]
+    fn the_projector_handles_are_painted_under_the_panel() {
+        let ctx = egui::Context::default();
+        let view = PanelView { file: "a.glb".into(), parts: 2, ..Default::default() };
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(800.0, 600.0))),
+            ..Default::default()
+        };
+        // A handle right across the panel (anchored top right).
+        let handle = Handle { anchor: DVec2::new(500.0, 40.0), end: Some(DVec2::new(790.0, 40.0)), reference: true };
+        let pass = |ctx: &egui::Context| {
+            show(ctx, &view);
+            paint_overlay(ctx, &[handle], None);
+        };
+        // Twice: egui lays a window out on its first pass without showing it.
+        ctx.run_pass(input.clone(), pass).drop_without_applying_deltas();
+        {
+            let output = ctx.run_pass(input.clone(), pass);
+            // Shapes come in paint order: the handle's dot before the panel's text.
+            let dot = output
+                .shapes
+                .iter()
+                .position(|c| matches!(&c.shape, egui::Shape::Circle(d) if d.center == egui::pos2(500.0, 40.0)));
+            let text = output
+                .shapes
+                .iter()
+                .position(|c| matches!(&c.shape, egui::Shape::Text(t) if t.galley.job.text == "a.glb: 2 parts"));
+            output.drop_without_applying_deltas();
+            let (dot, text) = (dot.expect("the handle is painted"), text.expect("the panel is shown"));
+            assert!(dot < text, "the handle (shape {dot}) is painted over the panel (shape {text})");
+        }
     }
 
     /// The rectangle of the panel's widget labelled `text`, from the shapes of a pass.

@@ -15,7 +15,9 @@
 //!   back); its name and parameters are printed and shown in the title, and it is highlighted.
 //! * `P`: save a screenshot PNG (`<file stem>-<n>.png` beside the model, at the window's size with
 //!   2× supersampling; the path is printed).
-//! * `Esc` / `Q`: quit.
+//! * `Esc` / `Q`: quit. With unsaved edits the first `Esc`, `Q` or close only asks (a message in
+//!   the window: press `Esc` again to quit without saving, `Ctrl`+`S` to save); the second quits
+//!   ([`quit_request`]).
 //!
 //! # Editing (Lux et al. 2013 §4; the data and functions are [`crate::edit`])
 //! * left click: select the part under the cursor alone, or, on a selected part, make it the
@@ -33,7 +35,10 @@
 //! * `Ctrl`+`Z` undo, `Ctrl`+`Y` or `Ctrl`+`Shift`+`Z` redo; `Ctrl`+`S` saves the edited part
 //!   records into the file (atomically; every other byte stays), `Ctrl`+`E` writes
 //!   `<file stem>.edits.toml` beside it, the overrides that `drafter bake --config` applies to the
-//!   source model to re-create the edits.
+//!   source model to re-create the edits (nothing is written when no part was edited). A save
+//!   keeps the file's mode and owner and refuses a read-only file (the CLI's writer,
+//!   `drafter_catalog::output::replace_in_place`); what a save or export did, or why it failed, is
+//!   shown in the window ([`crate::panel::Status`]) as well as printed.
 //! * the panel ([`crate::panel`], `F1` shows or hides it) lists the selection and sets its style, q,
 //!   f, p, γ and flat grey, the tool, undo/redo, save and export; events it uses do not reach the
 //!   view. The selection's projectors are drawn over the frame as handles.
@@ -59,7 +64,7 @@ use winit::window::{Window, WindowId};
 use crate::context::{Gpu, RenderError};
 use crate::edit::{Adjust, Editor, PartBox, ScreenView, Tool, parts_in_lasso};
 use crate::model::Model;
-use crate::panel::{self, Handle, Overlay, PanelAction, PanelPart, PanelView};
+use crate::panel::{self, Handle, Overlay, PanelAction, PanelPart, PanelView, Status, count};
 use crate::renderer::Renderer;
 use crate::style::{Enhancements, RenderOptions, ShadowMode, Style, View, ZOOM_RANGE};
 
@@ -202,6 +207,20 @@ impl Action {
     }
 }
 
+/// What a request to quit (`Esc`, `Q`, closing the window) does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quit {
+    Now,
+    /// Unsaved edits and not asked yet: show the question, stay open.
+    Ask,
+}
+
+/// A request to quit with `unsaved` parts not saved, `asked` when the window already asked (and
+/// nothing happened since): it quits when nothing is unsaved or on the second request.
+pub fn quit_request(unsaved: usize, asked: bool) -> Quit {
+    if unsaved == 0 || asked { Quit::Now } else { Quit::Ask }
+}
+
 /// What a key does to the edits (see the module docs); checked before [`action_for_key`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EditCommand {
@@ -259,8 +278,14 @@ pub type Writer = dyn Fn(&Path, &[u8]) -> Result<(), String>;
 /// One line about a part: its name and baked parameters (what a pick shows).
 pub fn describe_part(model: &Model, id: u32) -> String {
     let Some(part) = model.part(id) else { return format!("part {id}: unknown") };
-    let name = if part.name.is_empty() { "(unnamed)" } else { part.name.as_str() };
-    match &part.record {
+    describe_record(id, &part.name, part.record.as_ref())
+}
+
+/// [`describe_part`] from the part's name and record. q, f and p are printed as the bake holds
+/// them (f32: `f 0.45`, not the f64 widening's `0.45000001788139343`).
+pub fn describe_record(id: u32, name: &str, record: Option<&drafter_format::PartRecord>) -> String {
+    let name = if name.is_empty() { "(unnamed)" } else { name };
+    match record {
         Some(r) => {
             let d = r.projector.direction;
             let e = r.obb.half_extents;
@@ -279,12 +304,12 @@ pub fn describe_part(model: &Model, id: u32) -> String {
                 d[1],
                 d[2],
                 r.projector.scale,
-                r.gradient.q,
-                r.gradient.f,
-                r.gradient.p,
+                r.gradient.q as f32,
+                r.gradient.f as f32,
+                r.gradient.p as f32,
                 r.gradient.transfer,
                 r.style.map_or("(scene)", drafter_format::PartStyle::name)
-            ) + &r.flat.map(|g| format!(", flat {g}")).unwrap_or_default()
+            ) + &r.flat.map(|g| format!(", flat {}", g as f32)).unwrap_or_default()
         }
         None => format!("part {id} {name:?}: not baked (bounding-box projector)"),
     }
@@ -337,6 +362,8 @@ pub fn run(model: Model, file: &Path, options: RenderOptions, writer: &Writer) -
         writer,
         drag_frames: None,
         parts_version: 0,
+        status: None,
+        quit_asked: false,
     };
     event_loop.run_app(&mut app).map_err(|e| WindowError::Window(e.to_string()))?;
     match app.error {
@@ -390,6 +417,10 @@ struct App<'a> {
     /// Bumped at every upload of the part table (an edit, a selection): a frame drawn before is
     /// stale.
     parts_version: u64,
+    /// The last message, shown in the window (panel or corner) and the title.
+    status: Option<Status>,
+    /// A quit with unsaved edits asked first ([`quit_request`]); any other input clears it.
+    quit_asked: bool,
 }
 
 impl std::fmt::Debug for App<'_> {
@@ -497,6 +528,7 @@ impl App<'_> {
         let panel_view = self.panel_view();
         let handles = self.handles();
         let lasso = self.lasso.clone();
+        let status = self.status.clone();
         let Some(state) = self.state.as_mut() else { return Ok(()) };
         let show_panel = state.overlay.panel;
         let mut actions = Vec::new();
@@ -504,6 +536,8 @@ impl App<'_> {
         let again = state.overlay.draw(&state.window, &device, &queue, &mut encoder, &view, size, |ctx| {
             if show_panel {
                 actions = panel::show(ctx, &panel_view);
+            } else if let Some(status) = &status {
+                panel::show_status(ctx, status);
             }
             panel::paint_overlay(ctx, &handles, lasso.as_deref());
         });
@@ -545,6 +579,58 @@ impl App<'_> {
             can_undo: self.editor.can_undo(),
             can_redo: self.editor.can_redo(),
             scene_style: self.options.style.to_string(),
+            status: self.status.clone(),
+            hint: self.hint(),
+        }
+    }
+
+    /// With the anchor tool, on a reference part whose direction runs along the line of sight:
+    /// why a drag changes nothing visible, and what does.
+    fn hint(&self) -> Option<String> {
+        if self.tool != Some(Tool::Anchor) {
+            return None;
+        }
+        let id = self.editor.selection.reference?;
+        let record = self.editor.record(id)?;
+        let view = self.screen_view()?;
+        let params = crate::edit::PartParams::from_record(record);
+        let obb = PartBox::from_record(&record.obb);
+        obb.faces(params.direction, view.toward_viewer(params.anchor)).then(|| {
+            format!(
+                "part {id}'s gradient runs towards you: moving its anchor across the part changes nothing from this \
+                 view. D tilts the direction, V draws a new one, or turn the view."
+            )
+        })
+    }
+
+    /// Shows `status` in the window (and its title).
+    fn set_status(&mut self, status: Status) {
+        self.status = Some(status);
+        self.refresh_title();
+    }
+
+    /// `Esc`, `Q` or closing the window: quits, or with unsaved edits asks first.
+    fn request_quit(&mut self, event_loop: &ActiveEventLoop) {
+        let unsaved = self.editor.unsaved().len();
+        match quit_request(unsaved, self.quit_asked) {
+            Quit::Now => event_loop.exit(),
+            Quit::Ask => {
+                let text = format!(
+                    "Unsaved edits ({}): press Esc again to quit without saving, Ctrl+S to save",
+                    count(unsaved, "part")
+                );
+                println!("{text}");
+                self.set_status(Status::error(text));
+                self.quit_asked = true;
+            }
+        }
+    }
+
+    /// Any input but a quit: a quit asks again next time, and its question goes.
+    fn not_quitting(&mut self) {
+        if std::mem::take(&mut self.quit_asked) {
+            self.status = None;
+            self.refresh_title();
         }
     }
 
@@ -615,8 +701,12 @@ impl App<'_> {
             }
         }
         if !failures.is_empty() {
-            eprintln!("drafter: screenshot not saved ({})", failures.join("; "));
+            let text = format!("screenshot not saved ({})", failures.join("; "));
+            eprintln!("drafter: {text}");
+            self.status = Some(Status::error(text));
+            self.refresh_title();
         }
+        let Some(state) = self.state.as_mut() else { return Ok(()) };
         // The screenshot drew at another size: the next frame resizes the targets back and draws
         // the model again.
         state.drawn = None;
@@ -673,7 +763,7 @@ impl App<'_> {
         }
         self.parts_version += 1;
         if !selection.is_empty() {
-            println!("selected {} part(s):", selection.parts.len());
+            println!("selected {}:", count(selection.parts.len(), "part"));
             for &id in &selection.parts {
                 let mark = if selection.reference == Some(id) { " (reference)" } else { "" };
                 println!("  {}{mark}", describe_part(&self.model, id));
@@ -736,11 +826,13 @@ impl App<'_> {
         }
     }
 
-    /// Writes the edited part records into the file (`Ctrl`+`S`); failures are printed, the window
-    /// goes on.
+    /// Writes the edited part records into the file (`Ctrl`+`S`); failures are printed and shown,
+    /// the window goes on.
     fn save(&mut self) {
         if !self.model.baked {
-            eprintln!("drafter: not saved: {} is not a baked file (bake it first)", self.file.display());
+            let text = format!("not saved: {} is not a baked file (bake it first)", self.file_name());
+            eprintln!("drafter: {text}");
+            self.set_status(Status::error(text));
             return;
         }
         let unsaved = self.editor.unsaved();
@@ -752,20 +844,45 @@ impl App<'_> {
         match result {
             Ok(()) => {
                 self.editor.mark_saved();
-                println!("saved: {} ({} part record(s) changed)", self.file.display(), unsaved.len());
-                self.refresh_title();
+                let changed = count(unsaved.len(), "part record");
+                println!("saved: {} ({changed} changed)", self.file.display());
+                self.set_status(Status::info(format!("saved: {} ({changed} changed)", self.file_name())));
             }
-            Err(e) => eprintln!("drafter: not saved: {}: {e}", self.file.display()),
+            Err(e) => {
+                eprintln!("drafter: not saved: {}: {e}", self.file.display());
+                self.set_status(Status::error(format!("not saved: {e}")));
+            }
         }
     }
 
-    /// Writes `<stem>.edits.toml` beside the file (`Ctrl`+`E`).
-    fn export(&self) {
+    /// Writes `<stem>.edits.toml` beside the file (`Ctrl`+`E`); with no part edited, writes nothing
+    /// and says so.
+    fn export(&mut self) {
         let path = edits_path(&self.file);
-        let toml = self.editor.overrides_toml(&self.file_name());
+        let Some(toml) = self.editor.overrides_toml(&self.file_name()) else {
+            let text = if self.editor.editable() {
+                "nothing to export: no part has been edited".to_owned()
+            } else {
+                format!(
+                    "nothing to export: {} is not baked, its parts cannot be edited (bake it first)",
+                    self.file_name()
+                )
+            };
+            println!("{text}");
+            self.set_status(Status::info(text));
+            return;
+        };
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         match (self.writer)(&path, toml.as_bytes()) {
-            Ok(()) => println!("edits: {}", path.display()),
-            Err(e) => eprintln!("drafter: edits not written: {}: {e}", path.display()),
+            Ok(()) => {
+                println!("edits: {}", path.display());
+                let parts = count(self.editor.edited().len(), "part");
+                self.set_status(Status::info(format!("edits of {parts} written to {name}")));
+            }
+            Err(e) => {
+                eprintln!("drafter: edits not written: {}: {e}", path.display());
+                self.set_status(Status::error(format!("edits not written: {e}")));
+            }
         }
     }
 
@@ -782,6 +899,10 @@ impl App<'_> {
             }
             if !self.editor.unsaved().is_empty() {
                 title.push_str(" | unsaved");
+            }
+            if let Some(status) = &self.status {
+                title.push_str(" | ");
+                title.push_str(&status.text);
             }
             state.window.set_title(&title);
             state.window.request_redraw();
@@ -821,7 +942,7 @@ impl App<'_> {
             }
         }
         match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::CloseRequested => self.request_quit(event_loop),
             WindowEvent::Resized(size) => {
                 if let Some(state) = self.state.as_mut() {
                     state.config.width = size.width.max(1);
@@ -868,6 +989,7 @@ impl App<'_> {
             }
             WindowEvent::MouseInput { state: button_state, button, .. } => match button_state {
                 ElementState::Pressed => {
+                    self.not_quitting();
                     self.pressed = Some(Press { button, at: self.cursor, dragged: false });
                     let at = DVec2::new(self.cursor.x, self.cursor.y);
                     if button == MouseButton::Left {
@@ -951,6 +1073,15 @@ impl App<'_> {
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
                 let (ctrl, shift) = (self.modifiers.control_key(), self.modifiers.shift_key());
+                let modifier = matches!(
+                    event.logical_key,
+                    Key::Named(NamedKey::Shift | NamedKey::Control | NamedKey::Alt | NamedKey::Super)
+                );
+                if modifier || event.repeat {
+                    // A modifier alone or a held key's repeat is no answer to the quit question.
+                } else if ctrl || action_for_key(&event.logical_key) != Some(Action::Quit) {
+                    self.not_quitting();
+                }
                 if let Some(command) = edit_command_for_key(&event.logical_key, ctrl, shift) {
                     return self.edit(command);
                 }
@@ -965,7 +1096,7 @@ impl App<'_> {
                     return Ok(());
                 }
                 match action_for_key(&event.logical_key) {
-                    Some(Action::Quit) => event_loop.exit(),
+                    Some(Action::Quit) => self.request_quit(event_loop),
                     Some(Action::Screenshot) => self.screenshot()?,
                     Some(action) => {
                         action.apply(&mut self.options, &mut self.orbit);
@@ -1122,6 +1253,26 @@ mod tests {
             assert_eq!(action_for_key(&key(c)), None, "{c} is an edit key only");
         }
         assert_eq!(edits_path(Path::new("out/gear.baked.glb")), Path::new("out/gear.baked.edits.toml"));
+    }
+
+    #[test]
+    fn a_quit_with_unsaved_edits_asks_once() {
+        assert_eq!(quit_request(0, false), Quit::Now, "nothing unsaved: Esc quits");
+        assert_eq!(quit_request(2, false), Quit::Ask, "unsaved edits: the first Esc asks");
+        assert_eq!(quit_request(2, true), Quit::Now, "the second quits");
+    }
+
+    #[test]
+    fn a_part_is_described_at_the_precision_the_bake_holds() {
+        let mut record = crate::edit::tests::record(3, [0.0; 3]);
+        record.gradient.f = f64::from(0.45f32);
+        record.gradient.p = f64::from(1.25f32);
+        record.flat = Some(f64::from(0.3f32));
+        let line = describe_record(3, "bolt", Some(&record));
+        assert!(line.contains("gradient q 10 f 0.45 p 1.25 identity"), "{line}");
+        assert!(line.ends_with(", flat 0.3"), "{line}");
+        assert!(!line.contains("0.4500000"), "{line}");
+        assert_eq!(describe_record(4, "", None), "part 4 \"(unnamed)\": not baked (bounding-box projector)");
     }
 
     #[test]

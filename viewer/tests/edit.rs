@@ -99,7 +99,7 @@ fn a_save_changes_only_the_edited_records_and_reloads_to_the_same_parameters() {
 fn exported_overrides_rebake_to_the_saved_records() {
     let original = bake(&drafter_bake::BakeConfig::default());
     let editor = edit(&original);
-    let toml = editor.overrides_toml("sample.baked.glb");
+    let toml = editor.overrides_toml("sample.baked.glb").expect("edits to export");
     assert_eq!(toml.matches("[[part]]").count(), 2, "{toml}");
     let mut config = drafter_bake::BakeConfig::default();
     config.apply_toml(&toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
