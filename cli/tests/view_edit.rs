@@ -362,7 +362,8 @@ fn the_window_refuses_a_read_only_file_keeps_a_0600_one_and_asks_before_quitting
     let mut stderr = String::new();
     std::io::Read::read_to_string(view.stderr.as_mut().expect("stderr"), &mut stderr).expect("stderr");
     assert!(status.success(), "{status}\nstdout:\n{}\nstderr:\n{stderr}", stdout());
-    assert!(stderr.contains("read-only (mode 0444)"), "{stderr}");
+    let refused = format!("drafter: not saved: {}: read-only (mode 0444); not replaced\n", file.display());
+    assert_eq!(stderr.matches(&refused).count(), 1, "{refused:?} once in:\n{stderr}");
     assert_eq!(stdout().matches("Unsaved edits (1 part): press Esc again").count(), 2, "{}", stdout());
     assert_eq!(records(&file)[part as usize].gradient.q, q + 1.0, "the edit after the save was not saved");
     assert_eq!(mode(&file), 0o600);

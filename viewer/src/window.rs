@@ -272,7 +272,7 @@ pub fn edits_path(file: &Path) -> PathBuf {
 }
 
 /// Writes a file for the window (a save, an export): the CLI passes its atomic writer, so an
-/// interrupted save never leaves a partial file.
+/// interrupted save never leaves a partial file. Its error names the file.
 pub type Writer = dyn Fn(&Path, &[u8]) -> Result<(), String>;
 
 /// One line about a part: its name and baked parameters (what a pick shows).
@@ -837,9 +837,10 @@ impl App<'_> {
         }
         let unsaved = self.editor.unsaved();
         let records: Vec<drafter_format::PartRecord> = self.editor.records().cloned().collect();
+        let named = |e: &dyn std::fmt::Display| format!("{}: {e}", self.file.display());
         let result = std::fs::read(&self.file)
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| drafter_format::replace_part_records(&bytes, &records).map_err(|e| e.to_string()))
+            .map_err(|e| named(&e))
+            .and_then(|bytes| drafter_format::replace_part_records(&bytes, &records).map_err(|e| named(&e)))
             .and_then(|bytes| (self.writer)(&self.file, &bytes));
         match result {
             Ok(()) => {
@@ -849,7 +850,7 @@ impl App<'_> {
                 self.set_status(Status::info(format!("saved: {} ({changed} changed)", self.file_name())));
             }
             Err(e) => {
-                eprintln!("drafter: not saved: {}: {e}", self.file.display());
+                eprintln!("drafter: not saved: {e}");
                 self.set_status(Status::error(format!("not saved: {e}")));
             }
         }
@@ -880,7 +881,7 @@ impl App<'_> {
                 self.set_status(Status::info(format!("edits of {parts} written to {name}")));
             }
             Err(e) => {
-                eprintln!("drafter: edits not written: {}: {e}", path.display());
+                eprintln!("drafter: edits not written: {e}");
                 self.set_status(Status::error(format!("edits not written: {e}")));
             }
         }
