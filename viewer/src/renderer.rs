@@ -79,6 +79,12 @@ pub struct FrameInfo {
     pub drawn_size: (u32, u32),
 }
 
+/// The passes in the order [`Renderer::encode_frame`] records them, by their module under
+/// `passes/` (a frame skips the passes it does not use and keeps the order of the rest).
+/// ARCHITECTURE.md states this order; `cli/tests/architecture.rs` checks the document and the
+/// encoding code against this list.
+pub const PASS_ORDER: &[&str] = &["gbuffer", "shadow", "enhance", "display", "lines", "upscale"];
+
 /// The passes and the device; holds at most one model.
 #[derive(Debug)]
 pub struct Renderer {
