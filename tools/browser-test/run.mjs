@@ -9,13 +9,17 @@
 //       triangles and meshes as drawn (a mesh used by N nodes or instances counts N times), ms the load time
 //       in the page. Without --screenshot nothing is rendered.
 //   cesium FILE [--screenshot OUT.png] [--edges-only | --no-edges] [--edge-color R,G,B] [--view AZ,EL]
-//              [--ortho] [--background R,G,B] [--frames N] [--timeout S]
+//              [--ortho] [--background R,G,B] [--frames N] [--timeout S] [--no-edge-cull]
 //       CesiumJS Model with EXT_mesh_primitive_edge_visibility edges on (surfaces and edges by default),
 //       rendered until ready plus N frames (default 3). --edge-color gives the edges a material of that
 //       colour (otherwise they take the primitive's own, lit like the faces). Prints {file, ok, ms,
 //       consoleErrors, edgePrimitives}: ms from load start to "ready", edgePrimitives the primitives that
 //       carry the extension. Note: with --ortho, CesiumJS 1.145 hides most edges behind their own faces
 //       (its edge depth test assumes a perspective projection); --edges-only is not affected.
+//       --no-edge-cull serves CesiumJS with the one-line change docs/clients.md proposes: its edge draw command
+//       without the primitive's back-face culling (1.145 culls the quad of every edge whose stored direction runs
+//       rightwards on screen, so a cylinder keeps one of its two outlines). Fits CesiumJS 1.145's build only;
+//       fails if the bundle does not hold the expected code.
 //   For both: ok is false if the page failed, timed out, or logged a console error.
 //   pixels IMG.png [--background R,G,B] [--color R,G,B] [--tol N] [--region X0,Y0,X1,Y1]
 //       Prints {differ: {count, bbox}} for pixels farther than N (per channel, default 40) from the
@@ -38,7 +42,7 @@ import { fileURLToPath } from 'node:url';
 
 import { startServer } from './lib/server.mjs';
 import { runPage, killBrowser } from './lib/browser.mjs';
-import { readGltfJson, withEdgeColor } from './lib/glb.mjs';
+import { readGltfJson, sceneBox, withEdgeColor } from './lib/glb.mjs';
 import { readPng, matchPixels, pixelAt } from './lib/png.mjs';
 
 const TOOL_ROOT = path.dirname(fileURLToPath(import.meta.url));
@@ -113,16 +117,44 @@ function edgePrimitives(bytes) {
 }
 
 /** Serves the model (bytes possibly rewritten), runs one client page, returns { result, consoleErrors }. */
-async function runClient(client, file, query, { timeoutS, screenshot, bytes }) {
+async function runClient(client, file, query, { timeoutS, screenshot, bytes, toolOverrides }) {
   const name = path.basename(file);
   const overrides = bytes ? new Map([[name, bytes]]) : new Map();
-  const server = await startServer({ toolRoot: TOOL_ROOT, modelDir: path.dirname(path.resolve(file)), overrides });
+  const modelDir = path.dirname(path.resolve(file));
+  const server = await startServer({ toolRoot: TOOL_ROOT, modelDir, overrides, toolOverrides });
   try {
     const search = new URLSearchParams({ client, model: `/model/${encodeURIComponent(name)}`, ...query });
     return await runPage({ url: `${server.url}/page/index.html?${search}`, timeoutMs: timeoutS * 1000, screenshot });
   } finally {
     await server.close();
   }
+}
+
+const CESIUM_JS = 'node_modules/cesium/Build/Cesium/Cesium.js';
+
+/**
+ * CesiumJS 1.145's bundle with its edge draw command (`deriveEdgeCommand` in ModelDrawCommand.js) given a copy
+ * of the primitive's render state with face culling off. The command is a shallow clone of the primitive's, so
+ * it keeps `cull: BACK` of a single-sided material, and the quad it builds per edge winds one way or the other
+ * with the edge's direction on screen (EdgeVisibilityStageVS.glsl makes the direction point right before
+ * taking its perpendicular): edges running rightwards are culled. The source change this makes:
+ *   const rs = clone(command.renderState, true); rs.cull.enabled = false;
+ *   edgeCommand.renderState = RenderState.fromCache(rs);
+ */
+function cesiumWithoutEdgeCull() {
+  const text = readFileSync(path.join(TOOL_ROOT, CESIUM_JS), 'utf8');
+  // The end of deriveEdgeCommand and the start of derivePlanarFillIdCommand, whose clone (qe) and
+  // RenderState (ze) names the change borrows.
+  const end = ',o.castShadows=!1,o.receiveShadows=!1,o}function dst(e){let t=lt.shallowClone(e);';
+  const planarFill = 'let n=qe(e.renderState,!0);n.blending.enabled=!1,t.renderState=ze.fromCache(n);';
+  if (text.split(end).length !== 2 || !text.includes(planarFill)) {
+    throw new Error(`--no-edge-cull: ${CESIUM_JS} is not the CesiumJS 1.145 build it was written for`);
+  }
+  const patched = end.replace(
+    ',o}',
+    ',o.renderState=(function(s){s.cull.enabled=!1;return ze.fromCache(s)})(qe(e.renderState,!0)),o}',
+  );
+  return Buffer.from(text.replace(end, patched));
 }
 
 /** Options shared by the two browser clients, as page query parameters. */
@@ -163,7 +195,7 @@ async function commandThree(argv) {
 
 async function commandCesium(argv) {
   const { positional, options } = parseArgs(argv, {
-    flags: ['ortho', 'edges-only', 'no-edges'],
+    flags: ['ortho', 'edges-only', 'no-edges', 'no-edge-cull'],
     values: ['screenshot', 'view', 'background', 'edge-color', 'frames', 'timeout'],
   });
   const [file] = positional;
@@ -179,12 +211,21 @@ async function commandCesium(argv) {
 
   let bytes = readFileSync(file);
   const edges = edgePrimitives(bytes);
+  // The camera frames the scene's box computed here (see sceneBox), not CesiumJS's bounding sphere.
+  let box = null;
+  try {
+    box = sceneBox(readGltfJson(bytes));
+  } catch {
+    // an unreadable file: CesiumJS reports it
+  }
+  if (box) query.box = box.join(',');
   if (options['edge-color'] !== undefined) bytes = withEdgeColor(bytes, rgb(options['edge-color'], '--edge-color')).bytes;
 
   const { result, consoleErrors } = await runClient('cesium', file, query, {
     timeoutS,
     screenshot: options.screenshot,
     bytes: options['edge-color'] !== undefined ? bytes : undefined,
+    toolOverrides: options['no-edge-cull'] ? new Map([[CESIUM_JS, cesiumWithoutEdgeCull()]]) : undefined,
   });
   const out = { file, ok: result.ok && consoleErrors.length === 0, ms: result.ms, consoleErrors, edgePrimitives: edges };
   if (options.screenshot && result.ok) out.screenshot = options.screenshot;

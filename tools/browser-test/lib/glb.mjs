@@ -66,3 +66,57 @@ export function withEdgeColor(bytes, rgb) {
   const out = glb ? joinGlb(json, glb.rest) : Buffer.from(JSON.stringify(json), 'utf8');
   return { bytes: out, primitives };
 }
+
+/** The 4x4 column-major matrix of a glTF node (its `matrix`, or translation * rotation * scale). */
+function nodeMatrix(node) {
+  if (Array.isArray(node.matrix) && node.matrix.length === 16) return node.matrix;
+  const [tx, ty, tz] = node.translation ?? [0, 0, 0];
+  const [x, y, z, w] = node.rotation ?? [0, 0, 0, 1];
+  const [sx, sy, sz] = node.scale ?? [1, 1, 1];
+  return [
+    (1 - 2 * (y * y + z * z)) * sx, 2 * (x * y + z * w) * sx, 2 * (x * z - y * w) * sx, 0,
+    2 * (x * y - z * w) * sy, (1 - 2 * (x * x + z * z)) * sy, 2 * (y * z + x * w) * sy, 0,
+    2 * (x * z + y * w) * sz, 2 * (y * z - x * w) * sz, (1 - 2 * (x * x + y * y)) * sz, 0,
+    tx, ty, tz, 1,
+  ];
+}
+
+function multiply(a, b) {
+  const out = new Array(16).fill(0);
+  for (let c = 0; c < 4; c++) for (let r = 0; r < 4; r++) for (let k = 0; k < 4; k++) out[c * 4 + r] += a[k * 4 + r] * b[c * 4 + k];
+  return out;
+}
+
+/**
+ * The box, in the glTF's scene axes, around every corner of the POSITION accessors' min/max boxes of the
+ * default scene's meshes, each carried through its node's world matrix; null if there is none. CesiumJS 1.145's
+ * Model.boundingSphere carries only the two points (min) and (max) through a node's matrix, which shrinks the
+ * box of a scene whose nodes are rotated differently (two instances of one mesh, one turned 90 degrees and one
+ * upside down, framed a sphere a third of the size), so the harness frames the camera on this box instead.
+ */
+export function sceneBox(json) {
+  const min = [Infinity, Infinity, Infinity];
+  const max = [-Infinity, -Infinity, -Infinity];
+  const scene = json.scenes?.[json.scene ?? 0];
+  const visit = (index, parent, depth) => {
+    const node = json.nodes?.[index];
+    if (!node || depth > 64) return;
+    const m = multiply(parent, nodeMatrix(node));
+    for (const primitive of json.meshes?.[node.mesh]?.primitives ?? []) {
+      const accessor = json.accessors?.[primitive.attributes?.POSITION];
+      if (!accessor?.min || !accessor?.max) continue;
+      for (let corner = 0; corner < 8; corner++) {
+        const p = [0, 1, 2].map((i) => ((corner >> i) & 1 ? accessor.max[i] : accessor.min[i]));
+        for (let i = 0; i < 3; i++) {
+          const v = m[i] * p[0] + m[4 + i] * p[1] + m[8 + i] * p[2] + m[12 + i];
+          min[i] = Math.min(min[i], v);
+          max[i] = Math.max(max[i], v);
+        }
+      }
+    }
+    for (const child of node.children ?? []) visit(child, m, depth + 1);
+  };
+  const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  for (const index of scene?.nodes ?? []) visit(index, identity, 0);
+  return min.every(Number.isFinite) && max.every(Number.isFinite) ? [...min, ...max] : null;
+}

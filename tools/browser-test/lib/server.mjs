@@ -2,7 +2,7 @@
 //
 // Serves two trees: "/" is this tool's folder (the pages and node_modules), "/model/" is the folder of the
 // model under test (so a .gltf finds its .bin and images). A model whose bytes were rewritten in memory is
-// served from `overrides` instead of the disk.
+// served from `overrides` instead of the disk, and a file of the tool's tree from `toolOverrides`.
 
 import { createServer } from 'node:http';
 import { readFile } from 'node:fs/promises';
@@ -36,10 +36,11 @@ function inside(root, rel) {
 
 /**
  * Starts the server. `toolRoot`: folder served at "/"; `modelDir`: folder served at "/model/";
- * `overrides`: Map from a name under /model/ to the bytes to serve for it.
+ * `overrides`: Map from a name under /model/ to the bytes to serve for it; `toolOverrides`: the same for a
+ * path under "/" (relative to `toolRoot`, e.g. "node_modules/cesium/Build/Cesium/Cesium.js").
  * Resolves to { url, close() }.
  */
-export async function startServer({ toolRoot, modelDir, overrides = new Map() }) {
+export async function startServer({ toolRoot, modelDir, overrides = new Map(), toolOverrides = new Map() }) {
   const server = createServer(async (req, res) => {
     try {
       const urlPath = decodeURIComponent(new URL(req.url, 'http://x').pathname);
@@ -50,7 +51,9 @@ export async function startServer({ toolRoot, modelDir, overrides = new Map() })
         body = overrides.get(rel);
         file = inside(modelDir, rel);
       } else {
-        file = inside(toolRoot, urlPath === '/' ? 'page/index.html' : urlPath.slice(1));
+        const rel = urlPath === '/' ? 'page/index.html' : urlPath.slice(1);
+        body = toolOverrides.get(rel);
+        file = inside(toolRoot, rel);
       }
       if (!file) throw Object.assign(new Error('outside the served folders'), { code: 'ENOENT' });
       body ??= await readFile(file);

@@ -72,7 +72,15 @@ function aimCamera(Cesium, scene, model, p) {
     new Cartesian3(),
   );
 
-  const sphere = model.boundingSphere;
+  // The sphere around the scene's box that run.mjs computed from the file (CesiumJS's own sphere ignores how
+  // each node turns its box); CesiumJS's when the file gave none.
+  let sphere = model.boundingSphere;
+  if (p.box && p.box.length === 6 && p.box.every(Number.isFinite)) {
+    const [x0, y0, z0, x1, y1, z1] = p.box;
+    const centre = Matrix4.multiplyByPoint(toWorld, new Cartesian3((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2), new Cartesian3());
+    const scale = Matrix4.getMaximumScale(toWorld);
+    sphere = { center: centre, radius: (scale * Math.hypot(x1 - x0, y1 - y0, z1 - z0)) / 2 };
+  }
   const radius = Math.max(sphere.radius, 1e-6);
   const canvas = scene.canvas;
   const aspect = canvas.clientWidth / canvas.clientHeight;

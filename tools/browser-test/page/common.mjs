@@ -14,6 +14,7 @@ export function params() {
     ortho: q.get('ortho') === '1',
     edges: q.get('edges') ?? 'both', // Cesium: off | both | only
     frames: Number(q.get('frames') ?? 3), // Cesium: frames to render once the model is ready
+    box: q.get('box') ? q.get('box').split(',').map(Number) : null, // Cesium: the scene's box in glTF axes
   };
 }
 
