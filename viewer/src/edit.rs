@@ -29,8 +29,8 @@ pub const ANCHOR_GRAB_PX: f64 = 8.0;
 /// barely moves it, so the direction tool tilts it instead ([`manipulate`]).
 pub const FACING_DEG: f64 = 20.0;
 
-/// Degrees a facing direction tilts per pixel of a direction drag (100 px: 50°).
-pub const TILT_DEGREES_PER_PIXEL: f64 = 0.5;
+/// Degrees the direction tool turns (or tilts) a direction per pixel of drag (100 px: 50°).
+pub const TURN_DEGREES_PER_PIXEL: f64 = 0.5;
 
 /// Step of `f` per key press.
 pub const F_STEP: f32 = 0.05;
@@ -307,8 +307,10 @@ pub enum Tool {
     /// Drag away from or towards the anchor: the scale grows or shrinks by the ratio of the
     /// cursor's distances from the anchor on screen.
     Scale,
-    /// Drag around the anchor: the direction turns about the reference plane's normal by the angle
-    /// the cursor turned about the anchor on screen.
+    /// Drag left or right: the direction turns about the reference plane's normal,
+    /// [`TURN_DEGREES_PER_PIXEL`] of horizontal drag, clockwise on screen to the right, wherever the
+    /// drag starts. A direction facing the viewer ([`PartBox::faces`]) tilts towards the drag
+    /// instead, at the same rate.
     Direction,
     /// Draw a line: the anchor at its start, the direction along it, the scale its length (all in
     /// the reference plane through the anchor).
@@ -395,25 +397,25 @@ pub fn manipulate(
             // towards the drag instead, by an angle in proportion to the drag's length; every
             // selected part turns by the same rotation.
             let drag = now - start;
+            if drag.length() < 1e-9 {
+                return Some(out);
+            }
             let towards = view.on_plane(anchor_px + drag, anchor, normal)? - anchor;
             let axis = normal.cross(towards);
-            if drag.length() < MIN_HANDLE_PX || axis.length() <= 1e-12 * towards.length() {
+            if axis.length() <= 1e-12 * towards.length() {
                 return None;
             }
-            let turn = DQuat::from_axis_angle(axis.normalize(), (drag.length() * TILT_DEGREES_PER_PIXEL).to_radians());
+            let turn = DQuat::from_axis_angle(axis.normalize(), (drag.length() * TURN_DEGREES_PER_PIXEL).to_radians());
             for p in &mut out {
                 p.direction = (turn * p.direction).normalize();
             }
         }
         Tool::Direction => {
-            let (a, b) = (start - anchor_px, now - anchor_px);
-            if a.length() < MIN_HANDLE_PX || b.length() < MIN_HANDLE_PX {
-                return None;
-            }
-            // Counter-clockwise on screen (y down, so flip y) is positive about a normal that
-            // faces the viewer.
-            let (a, b) = (DVec2::new(a.x, -a.y), DVec2::new(b.x, -b.y));
-            let angle = a.perp_dot(b).atan2(a.dot(b));
+            // A dial: the rate does not depend on where the drag starts. (The angle the cursor
+            // turned about the anchor gave a drag that starts far from it, or moves away from it,
+            // a few degrees for 100 px.) Counter-clockwise on screen is positive about a normal
+            // that faces the viewer: a drag to the left.
+            let angle = (-(now.x - start.x) * TURN_DEGREES_PER_PIXEL).to_radians();
             for (p, t) in out.iter_mut().zip(targets) {
                 let n = t.obb.reference_normal(view.toward_viewer(t.params.anchor));
                 p.direction = (DQuat::from_axis_angle(n, angle) * t.params.direction).normalize();
@@ -915,9 +917,9 @@ pub(crate) mod tests {
             manipulate(Tool::Scale, &[t], 0, &view, a + DVec2::new(10.0, 0.0), a + DVec2::new(1.0, 0.0)).is_none(),
             "no ratio on the anchor"
         );
-        // A quarter turn counter-clockwise on screen (right, then up: y is down) turns +x into +y.
-        let out =
-            manipulate(Tool::Direction, &[t], 0, &view, a + DVec2::new(40.0, 0.0), a + DVec2::new(0.0, -40.0)).unwrap();
+        // 180 px to the left: a quarter turn counter-clockwise on screen turns +x into +y.
+        let out = manipulate(Tool::Direction, &[t], 0, &view, a + DVec2::new(40.0, 0.0), a + DVec2::new(-140.0, -40.0))
+            .unwrap();
         assert!((out[0].direction - DVec3::Y).length() < 1e-12, "{:?}", out[0].direction);
         let shown = view.project(out[0].direction).unwrap() - view.project(DVec3::ZERO).unwrap();
         assert!(shown.x.abs() < 1e-9 && shown.y < 0.0, "drawn pointing up: {shown:?}");
@@ -963,17 +965,23 @@ pub(crate) mod tests {
         let (start, now) = (a + DVec2::new(60.0, 10.0), a + DVec2::new(160.0, 10.0));
         let out = manipulate(Tool::Direction, &[t], 0, &view, start, now).unwrap();
         let turned = t.params.direction.angle_between(out[0].direction).to_degrees();
-        assert!((turned - 100.0 * TILT_DEGREES_PER_PIXEL).abs() < 1e-6, "a 100 px drag turned it {turned}°");
+        assert!((turned - 100.0 * TURN_DEGREES_PER_PIXEL).abs() < 1e-6, "a 100 px drag turned it {turned}°");
         // Tilted towards the drag (right on screen: +x).
         assert!(out[0].direction.x > t.params.direction.x + 0.5, "{:?}", out[0].direction);
         assert!((out[0].direction.length() - 1.0).abs() < 1e-12);
-        // A direction in the plane turns about the anchor: a 100 px drag across, 100 px from it, 45°.
+        // A direction in the plane turns 50° for a 100 px drag wherever it starts: the drag
+        // away from the anchor (the angle about it: 2.5°), far from it, across it.
         let t = target(0, [0.0, 0.0, 0.0]);
-        let out =
-            manipulate(Tool::Direction, &[t], 0, &view, a + DVec2::new(100.0, 0.0), a + DVec2::new(100.0, -100.0))
-                .unwrap();
-        let turned = t.params.direction.angle_between(out[0].direction).to_degrees();
-        assert!((turned - 45.0).abs() < 1e-9, "{turned}°");
+        for (from, to) in
+            [((60.0, 10.0), (160.0, 10.0)), ((-400.0, 200.0), (-300.0, 205.0)), ((-50.0, 0.0), (50.0, 0.0))]
+        {
+            let (from, to) = (a + DVec2::from(from), a + DVec2::from(to));
+            let out = manipulate(Tool::Direction, &[t], 0, &view, from, to).unwrap();
+            let turned = t.params.direction.angle_between(out[0].direction).to_degrees();
+            assert!((turned - 50.0).abs() < 1e-9, "{from} → {to}: {turned}°");
+            // To the right: clockwise on screen (+x towards -y, drawn pointing down).
+            assert!(out[0].direction.y < -0.7, "{:?}", out[0].direction);
+        }
     }
 
     #[test]
@@ -1008,7 +1016,7 @@ pub(crate) mod tests {
                 .unwrap();
             assert!(out.iter().all(|p| (p.scale - 3.0).abs() < 1e-12), "{name}: same scale");
             let out =
-                manipulate(Tool::Direction, &parts, 0, &view, a + DVec2::new(20.0, 0.0), a + DVec2::new(0.0, 20.0))
+                manipulate(Tool::Direction, &parts, 0, &view, a + DVec2::new(20.0, 0.0), a + DVec2::new(200.0, 20.0))
                     .unwrap();
             for (p, t) in out.iter().zip(&parts) {
                 let n = t.obb.reference_normal(view.toward_viewer(t.params.anchor));

@@ -26,7 +26,9 @@
 //!   `Ctrl`+`Shift` adds). The selection is listed on stdout.
 //! * tools, for a left drag over a selection (the same key again: back to turning the object):
 //!   `A` anchor (drag the gradient across the part; a click centres it under the cursor), `X`
-//!   scale (drag away from or towards the anchor), `D` direction (turn about the anchor), `V`
+//!   scale (drag away from or towards the anchor; from the anchor's dot, the projector's end
+//!   follows the cursor), `D` direction (drag right or left: turn clockwise or counter-clockwise
+//!   about the anchor, 0.5° a pixel; a direction facing the viewer tilts towards the drag), `V`
 //!   projector line (draw anchor, direction and scale at once). Several parts follow the
 //!   reference: the same anchor offset, the same scale, the same turn about each part's axis.
 //! * gradient of the selection: `[`/`]` q, `,`/`.` f, `-`/`=` p, `T` next transfer curve γ,

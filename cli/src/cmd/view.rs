@@ -30,8 +30,8 @@ Editing the parts' gradients (Lux et al. 2013 \u{a7}4; baked files only):
   A, then drag         anchor: move the gradient across the part (a click centres it)
   X, then drag         scale: away from the anchor stretches the gradient, towards it shortens it
                        (a drag from the anchor's dot pulls the projector's end)
-  D, then drag         direction: turn it about the anchor (one running towards you tilts
-                       towards the drag)
+  D, then drag         direction: right turns it clockwise about the anchor, left counter-
+                       clockwise, 0.5 degrees a pixel (one running towards you tilts towards the drag)
   V, then drag         draw the projector: anchor at the start, direction and scale along the line
   the same key again   back to turning the object
   [ ]  , .  - =        q down/up, f down/up, p down/up;  T transfer curve, Y style hint, G flat grey
