@@ -39,6 +39,19 @@ pub fn icosa_directions() -> Vec<Vec3> {
     out.into_iter().map(Vec3::normalize).collect()
 }
 
+/// Numbers in [-1, 1) from a plain xorshift64 seeded with `seed`: the generator of the unit tests
+/// that place normals, boxes and eyes by hand.
+#[cfg(test)]
+pub(crate) fn xorshift(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    }
+}
+
 /// A seeded xorshift64* generator of views: deterministic, no dependency.
 #[derive(Clone, Debug)]
 pub struct ViewRng(u64);
