@@ -88,7 +88,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::brute::{Stream, keeps_pretest};
-use crate::gauss::{ArcCells, BaseSolid, QueryCounts, arc_paths, base_cells};
+use crate::gauss::{ArcCells, BaseSolid, arc_paths, base_cells};
+use crate::tree::QueryCounts;
 use crate::tree::{Purpose, breadth_first, check_breadth_first, push_children, widest_level, with_levels, with_ranges};
 use crate::{ArraysError, CostModel, EdgeSet};
 

@@ -96,6 +96,7 @@ mod gauss;
 mod index;
 pub mod measure;
 mod set;
+mod sphere;
 mod tree;
 mod visibility;
 
@@ -116,13 +117,14 @@ pub use cost::CostModel;
 pub use error::{ArraysError, LinesError};
 pub use gauss::{
     BaseSolid, Bins, CULL_MARGIN, DEFAULT_OVERLAP, GaussMapArrays, GaussMapHierarchy, GaussMapOptions, LevelCount,
-    LevelHistogram, QueryCounts, depth_for_count,
+    LevelHistogram, depth_for_count,
 };
 pub use index::{
     BruteForceReason, DEFAULT_MIN_HIERARCHY_CANDIDATES, DEFAULT_MIN_SPEEDUP, HierarchyChoice, SilhouetteArrays,
     SilhouetteIndex, SilhouetteOptions, StoredHierarchies,
 };
 pub use set::EdgeSet;
+pub use tree::QueryCounts;
 pub use visibility::{
     DecodedEdgeVisibility, EdgeVisibility, HARD, HARD_REPEATED, HIDDEN, SILHOUETTE, SilhouettesEncoded,
     VisibilityError, decode_edge_visibility, encode_edge_visibility, encode_edge_visibility_continuing,

@@ -1,4 +1,5 @@
-//! The breadth-first layout shared by both hierarchies, and its validation.
+//! The breadth-first layout shared by both hierarchies, its validation, and the level-by-level
+//! walk of a query over it ([`QueryTree`]) with its counts ([`QueryCounts`]).
 //!
 //! Node `i` is `[first_child, child_count, arc_start, arc_end]`: its children are the nodes
 //! `first_child..first_child + child_count` (all after `i`, so children of consecutive nodes are
@@ -13,7 +14,9 @@
 
 use std::cell::RefCell;
 
-use crate::ArraysError;
+use serde::{Deserialize, Serialize};
+
+use crate::{ArraysError, CostModel};
 
 /// What a hierarchy build makes: everything a query reads, or only what a file stores and the
 /// cost estimate counts. The query layouts (the Gauss map's arc blocks and their 16-bit copy,
@@ -24,6 +27,123 @@ pub(crate) enum Purpose {
     Query,
     Storage,
 }
+
+/// Work done by one query (for benchmarks and the cost model).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct QueryCounts {
+    /// Nodes entered (their children's bounds tested, their own candidates tested).
+    pub nodes_entered: usize,
+    /// Bounds (caps, or boxes and cones) tested.
+    pub bounds_tested: usize,
+    /// Entered nodes with own candidates.
+    pub ranges: usize,
+    /// Blocks of 4 lanes tested.
+    pub blocks_tested: usize,
+    /// Candidates tested with the exact predicate (blocks minus padding).
+    pub arcs_tested: usize,
+}
+
+impl std::ops::AddAssign for QueryCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.nodes_entered += o.nodes_entered;
+        self.bounds_tested += o.bounds_tested;
+        self.ranges += o.ranges;
+        self.blocks_tested += o.blocks_tested;
+        self.arcs_tested += o.arcs_tested;
+    }
+}
+
+impl QueryCounts {
+    /// Priced with a cost model's Gauss-map (`gauss = true`) or cone-BVH costs, in ns.
+    pub fn cost_ns(&self, cost: &CostModel, gauss: bool) -> f64 {
+        let [enter, test, range, block] = if gauss {
+            [cost.gauss_enter_ns, cost.gauss_test_ns, cost.gauss_range_ns, cost.gauss_block_ns]
+        } else {
+            [cost.bvh_enter_ns, cost.bvh_test_ns, cost.bvh_range_ns, cost.bvh_block_ns]
+        };
+        self.nodes_entered as f64 * f64::from(enter)
+            + self.bounds_tested as f64 * f64::from(test)
+            + self.ranges as f64 * f64::from(range)
+            + self.blocks_tested as f64 * f64::from(block)
+    }
+
+    /// Counts a node entered and the bounds of its `children` tested.
+    #[inline(always)]
+    pub(crate) fn enter(&mut self, children: usize) {
+        self.nodes_entered += 1;
+        self.bounds_tested += children;
+    }
+
+    /// Counts the own candidates of node `[_, _, start, end]` tested in `blocks` blocks.
+    #[inline(always)]
+    pub(crate) fn range(&mut self, [_, _, start, end]: [u32; 4], blocks: usize) {
+        self.ranges += 1;
+        self.blocks_tested += blocks;
+        self.arcs_tested += (end - start) as usize;
+    }
+}
+
+/// What a query of either hierarchy walks: the nodes as it reads them and the layout they come
+/// from.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct QueryTree<N> {
+    /// The nodes as a query reads them, bounds next to the record, padded with 4 entries so that
+    /// the up to 4 children of a node are tested in one SIMD pass.
+    pub(crate) nodes: Vec<N>,
+    /// The most nodes at one depth (sizes the walk's level buffers).
+    pub(crate) widest: usize,
+    /// The query layout: `[first_child, child_count, arc_start, arc_end]` per node, own
+    /// candidates in `order`.
+    pub(crate) flat: Vec<[u32; 4]>,
+    /// The candidate index of each storage position.
+    pub(crate) order: Vec<u32>,
+}
+
+impl<N: Copy> QueryTree<N> {
+    /// The tree of the layout `flat` over `order`, whose nodes as a query reads them are `nodes`
+    /// (one per entry of `flat`), padded with 4 copies of `pad`.
+    pub(crate) fn new(flat: Vec<[u32; 4]>, order: Vec<u32>, mut nodes: Vec<N>, pad: N) -> Self {
+        nodes.extend(std::iter::repeat_n(pad, 4));
+        QueryTree { nodes, widest: widest_level(&flat), flat, order }
+    }
+
+    /// Walks the tree one level at a time from the root: `step` gets the nodes entered at a level
+    /// and appends those entered at the next to `next[*width..]` (with [`push_children`]).
+    #[inline(always)]
+    pub(crate) fn walk_levels(&self, mut step: impl FnMut(&[u32], &mut [u32], &mut usize)) {
+        with_levels(self.widest + 4, |level, next| {
+            level[0] = 0;
+            let mut width = 1;
+            while width > 0 {
+                let mut next_width = 0;
+                step(&level[..width], next, &mut next_width);
+                std::mem::swap(level, next);
+                width = next_width;
+            }
+        });
+    }
+}
+
+/// The accessors of a hierarchy whose `tree` field is a [`QueryTree`].
+macro_rules! tree_accessors {
+    () => {
+        /// Number of candidates.
+        pub fn len(&self) -> usize {
+            self.tree.order.len()
+        }
+
+        /// Whether there are no candidates.
+        pub fn is_empty(&self) -> bool {
+            self.tree.order.is_empty()
+        }
+
+        /// Number of nodes.
+        pub fn node_count(&self) -> usize {
+            self.tree.flat.len()
+        }
+    };
+}
+pub(crate) use tree_accessors;
 
 thread_local! {
     /// The current and next level of a breadth-first walk, reused across queries on a thread.
