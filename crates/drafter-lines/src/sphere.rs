@@ -1,6 +1,7 @@
 //! Bounds on the sphere of normals that both hierarchies compute the same way: the widest angle
 //! from a centre, the rounded sine threshold of a cap or cone, and the Fibonacci sphere of sampled
-//! directions. The Gauss map's caps (`gauss/cap.rs`) are built on these.
+//! directions. The Gauss map's caps (`gauss/cap.rs`) and the cone BVH's cones
+//! (`cone_bvh/bounds.rs`) are built on these, so that one rounding rule serves both.
 
 use glam::{DVec3, Vec3};
 
@@ -13,6 +14,12 @@ pub(crate) const NEVER_CULL: f32 = 2.0;
 pub(crate) fn round_up(x: f64) -> f32 {
     let y = x as f32;
     if f64::from(y) < x { y.next_up() } else { y }
+}
+
+/// `x` rounded down to the nearest `f32`.
+pub(crate) fn round_down(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) > x { y.next_down() } else { y }
 }
 
 /// The stored threshold of a cap or cone whose widest angle from its centre is `angle`: `sin` of
@@ -65,7 +72,9 @@ pub(crate) fn fibonacci_direction(k: u32, count: u32) -> Vec3 {
 /// The running widest angle from a unit centre: the smallest dot product so far and the largest
 /// exact angle (`atan2` of the cross and dot products, accurate at every size), measured only for
 /// points near the smallest dot product, so that a node costs a few `atan2` calls instead of one
-/// per point ([`Widest::add_group`]).
+/// per point. Two rules take points: [`Widest::add_group`], the Gauss map's exact maximum, and
+/// [`Widest::add`], the cone BVH's rule (a point measured where its dot product reaches the
+/// smallest so far), whose stored cones depend on it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Widest {
     pub(crate) cos_min: f64,
@@ -102,6 +111,17 @@ impl Widest {
             if d <= near {
                 self.angle = self.angle.max(c.cross(point(k)).length().atan2(d));
             }
+        }
+    }
+
+    /// Takes the unit normal `n` seen from the unit `axis`: measured where its dot product is at
+    /// most the smallest so far (the widest normal so far).
+    #[inline(always)]
+    pub(crate) fn add(&mut self, axis: DVec3, n: DVec3) {
+        let d = axis.dot(n);
+        if d <= self.cos_min {
+            self.cos_min = d;
+            self.angle = self.angle.max(axis.cross(n).length().atan2(d));
         }
     }
 }
