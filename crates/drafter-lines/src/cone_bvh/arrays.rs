@@ -14,7 +14,7 @@ use crate::tree::check_breadth_first;
 
 impl ConeBvh {
     /// The flat arrays (see [`ConeBvhArrays`]); `None` for a tree without a normal split
-    /// ([`NormalSplit::Off`]), whose obvhs build cannot be replayed from split bytes.
+    /// ([`NormalSplit::Off`](super::NormalSplit::Off)), whose obvhs build cannot be replayed from split bytes.
     pub fn to_arrays(&self) -> Option<ConeBvhArrays> {
         Some(ConeBvhArrays {
             node_boxes: self.stored.boxes.iter().flatten().copied().collect(),
