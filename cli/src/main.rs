@@ -39,6 +39,8 @@ enum Command {
     Inspect(cmd::inspect::Args),
     /// Render a model headless to PNG in an illustration style (gradient, cel, gooch, metal, ...).
     Render(cmd::render::Args),
+    /// Draw one view as vector lines (SVG): baked edges and silhouettes, hidden lines exact.
+    Draw(cmd::draw::Args),
     /// Measure: `bench FILE` charts every stage's speed against accuracy; `bench render FILE` prints
     /// frame time per style as a ratio to phong.
     Bench(cmd::bench::Args),
@@ -65,6 +67,7 @@ fn main() -> ExitCode {
         Command::Cache(args) => cmd::cache::run(args),
         Command::Inspect(args) => cmd::inspect::run(args),
         Command::Render(args) => cmd::render::run(args),
+        Command::Draw(args) => cmd::draw::run(args),
         Command::Bench(args) => cmd::bench::run(args),
         Command::View(args) => cmd::view::run(args),
     });

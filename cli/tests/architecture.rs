@@ -55,7 +55,9 @@ fn workspace_members() -> Vec<String> {
                 .unwrap_or_else(|e| panic!("member glob {entry}: {e}"))
                 .map(|e| e.expect("a directory entry").path())
                 .filter(|p| p.join("Cargo.toml").is_file())
-                .map(|p| format!("{folder}/{}", p.file_name().unwrap().to_str().unwrap()))
+                .map(|p| {
+                    format!("{folder}/{}", p.file_name().and_then(|n| n.to_str()).expect("a UTF-8 crate folder name"))
+                })
                 .collect();
             found.sort();
             assert!(!found.is_empty(), "member glob {entry} matches no crate");
@@ -117,7 +119,7 @@ fn the_renderer_encodes_its_passes_in_pass_order() {
     assert_eq!(encoded_passes(), PASS_ORDER, "Renderer::encode_frame and renderer::PASS_ORDER disagree");
     let mut modules: Vec<String> = std::fs::read_dir(root().join("viewer/src/passes"))
         .expect("viewer/src/passes")
-        .map(|e| e.expect("a directory entry").file_name().into_string().unwrap())
+        .map(|e| e.expect("a directory entry").file_name().into_string().expect("a UTF-8 file name"))
         .filter_map(|name| name.strip_suffix(".rs").map(str::to_string))
         .filter(|name| name != "mod")
         .collect();

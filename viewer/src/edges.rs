@@ -81,6 +81,8 @@ pub struct MeshLines {
     pub instances: Range<u32>,
     /// Hard edges: object-space endpoints and class.
     pub hard: Vec<([Vec3; 2], LineClass)>,
+    /// The mesh triangle each hard edge was read from (its part, for drawings).
+    pub hard_triangles: Vec<u32>,
     pub silhouettes: Option<MeshSilhouetteLines>,
 }
 
@@ -156,6 +158,7 @@ impl ModelLines {
                 mesh.positions.get(tri[k % 3] as usize).copied()
             };
             let mut hard = Vec::new();
+            let mut hard_triangles = Vec::new();
             for (_, p, edges) in baked.primitive_edges.iter().filter(|(mm, _, _)| *mm as usize == m) {
                 let Some(group) = mesh.groups.iter().find(|g| g.primitive == Some(*p)) else {
                     bad_slots += 1;
@@ -169,7 +172,10 @@ impl ModelLines {
                     }
                     let t = group.start as usize + t;
                     match (position(t, k), position(t, k + 1)) {
-                        (Some(a), Some(b)) => hard.push(([a, b], LineClass::from_hard_code(class))),
+                        (Some(a), Some(b)) => {
+                            hard.push(([a, b], LineClass::from_hard_code(class)));
+                            hard_triangles.push(t as u32);
+                        }
                         _ => bad_slots += 1,
                     }
                 }
@@ -182,7 +188,7 @@ impl ModelLines {
             if hard.is_empty() && silhouettes.is_none() {
                 continue;
             }
-            meshes.push(MeshLines { mesh: m as u32, instances, hard, silhouettes });
+            meshes.push(MeshLines { mesh: m as u32, instances, hard, hard_triangles, silhouettes });
         }
         if bad_slots > 0 {
             notices.push(format!("{bad_slots} baked edges do not match the file's triangles: not drawn"));

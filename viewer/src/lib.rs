@@ -46,6 +46,7 @@
 
 pub mod camera;
 pub mod context;
+pub mod drawing;
 pub mod edges;
 pub mod edit;
 pub mod gpu_types;

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod bench_silhouettes;
 pub mod bench_sweep;
 pub mod cache;
+pub mod draw;
 pub mod inspect;
 pub mod render;
 pub mod view;

@@ -1,0 +1,132 @@
+//! `drafter draw FILE -o view.svg [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
+//! [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
+//! (`drafter_viewer::drawing`): the baked hard edges and the view's silhouettes, split where they
+//! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use drafter_viewer::View;
+use drafter_viewer::drawing::{self, DrawOptions, Hidden};
+
+use crate::cmd::out;
+use crate::cmd::render::{parse_size, parse_view};
+use crate::exit::BadInput;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The model to draw: a baked .glb/.gltf (its edges and silhouette hierarchies), or any model
+    /// (then only its outline is known: bake it first for creases).
+    pub file: PathBuf,
+    /// The SVG to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Drawing size in pixels (the SVG's user units), WIDTHxHEIGHT: the same view as `render`.
+    #[arg(long, value_name = "WxH", default_value = "800x600", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// View direction: azimuth about +y from +z towards +x, and elevation, in degrees.
+    #[arg(long, value_name = "AZ,EL", default_value = "35,25", value_parser = parse_view, allow_hyphen_values = true)]
+    pub view: (f32, f32),
+    /// Orthographic projection instead of perspective.
+    #[arg(long)]
+    pub ortho: bool,
+    /// Lines hidden by surfaces: left out, dashed or thin solid, in a group of their own.
+    #[arg(long, value_enum, default_value_t = HiddenArg::None)]
+    pub hidden: HiddenArg,
+    /// Pieces shorter than this many pixels are dropped and end points closer than it joined.
+    #[arg(long, value_name = "PX", default_value_t = 0.05)]
+    pub tolerance: f64,
+    /// Print the drawing's figures as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Refuse a model that lists more triangles than this.
+    #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
+    pub max_triangles: u64,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum HiddenArg {
+    None,
+    Dashed,
+    Solid,
+}
+
+impl From<HiddenArg> for Hidden {
+    fn from(h: HiddenArg) -> Hidden {
+        match h {
+            HiddenArg::None => Hidden::None,
+            HiddenArg::Dashed => Hidden::Dashed,
+            HiddenArg::Solid => Hidden::Solid,
+        }
+    }
+}
+
+pub fn run(args: Args) -> Result<()> {
+    if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("svg")) {
+        return Err(BadInput(format!("{}: output must end in .svg", args.output.display())).into());
+    }
+    let (w, h) = args.size;
+    if w == 0 || h == 0 || w > 65_536 || h > 65_536 {
+        return Err(BadInput(format!("--size {w}x{h}: each side must be 1 to 65536 pixels")).into());
+    }
+    if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
+        return Err(
+            BadInput(format!("--tolerance {}: must be a finite number of pixels, 0 or more", args.tolerance)).into()
+        );
+    }
+    let view = View { azimuth_deg: args.view.0, elevation_deg: args.view.1 };
+    if !(view.elevation_deg > -90.0 && view.elevation_deg < 90.0 && view.azimuth_deg.is_finite()) {
+        return Err(BadInput(format!("--view {},{}: elevation must be in (-90, 90)", args.view.0, args.view.1)).into());
+    }
+    let model = crate::cmd::render::load(&args.file, args.max_triangles)?;
+    let options = DrawOptions {
+        size: args.size,
+        view,
+        orthographic: args.ortho,
+        hidden: args.hidden.into(),
+        tolerance_px: args.tolerance,
+        ..DrawOptions::default()
+    };
+    let drawing = drawing::draw(&model, &options);
+    let svg = drawing::to_svg(&drawing, options.hidden);
+    drafter_catalog::output::write_atomically(&args.output, svg.as_bytes())?;
+    let s = &drawing.stats;
+    if args.json {
+        let value = serde_json::json!({
+            "output": args.output.display().to_string(),
+            "bytes": svg.len(),
+            "strokes": drawing.strokes.len(),
+            "edges": s.edges,
+            "silhouettes": s.silhouettes,
+            "duplicates": s.duplicates,
+            "triangles": s.triangles,
+            "pairs_tested": s.pairs_tested,
+            "visible_px": s.visible_px,
+            "hidden_px": s.hidden_px,
+            "ms": s.elapsed.as_secs_f64() * 1e3,
+        });
+        out!("{value}");
+    }
+    if !args.quiet {
+        eprintln!(
+            "drew {} → {}: {} strokes, {:.0} px visible, {:.0} px hidden, from {} edges ({} silhouettes) over {} triangles in {:.0} ms; {} bytes",
+            args.file.display(),
+            args.output.display(),
+            drawing.strokes.len(),
+            s.visible_px,
+            s.hidden_px,
+            s.edges,
+            s.silhouettes,
+            s.triangles,
+            s.elapsed.as_secs_f64() * 1e3,
+            svg.len()
+        );
+        for notice in &model.notices {
+            eprintln!("  note: {notice}");
+        }
+    }
+    Ok(())
+}

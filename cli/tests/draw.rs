@@ -1,0 +1,80 @@
+//! `drafter draw`: a valid SVG (xmllint) of the baked sample with its hidden lines in a group of
+//! their own; a model without baked edges gives its outline only, never an error; bad input and bad
+//! options end with exit 2, one line, and no output file. The exactness of the hidden lines is
+//! `viewer/tests/drawing.rs` (brute force).
+
+mod common;
+
+use std::process::Command;
+
+#[test]
+fn the_sample_draws_as_a_valid_svg_with_hidden_lines() {
+    let dir = common::scratch("draw");
+    let baked = dir.join("sample.glb");
+    assert!(
+        common::bake(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb").as_path(),
+            &baked,
+            &[]
+        )
+        .status
+        .success()
+    );
+    let svg = dir.join("sample.svg");
+    let run =
+        common::run(&["draw", baked.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--hidden", "dashed", "--json"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let figures: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(figures["strokes"].as_u64().unwrap() > 100 && figures["hidden_px"].as_f64().unwrap() > 0.0, "{figures}");
+    let lint = Command::new("xmllint")
+        .arg("--noout")
+        .arg(&svg)
+        .output()
+        .expect("xmllint (apt libxml2-utils; scripts/test installs it) checks the SVG");
+    assert!(lint.status.success(), "xmllint: {}", String::from_utf8_lossy(&lint.stderr));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains(r#"<g id="hidden""#) && text.contains(r#"<g id="visible""#));
+    assert_eq!(text.matches("<path").count() as u64, figures["strokes"].as_u64().unwrap());
+}
+
+#[test]
+fn a_model_without_baked_edges_draws_its_outline_or_nothing() {
+    let dir = common::scratch("draw-plain");
+    let stl = dir.join("tetra.stl");
+    std::fs::write(
+        &stl,
+        "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+    )
+    .unwrap();
+    let svg = dir.join("t.svg");
+    let run = common::run(&["draw", stl.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let lint = Command::new("xmllint").arg("--noout").arg(&svg).output().expect("xmllint");
+    assert!(lint.status.success());
+}
+
+#[test]
+fn bad_input_and_bad_options_end_with_exit_2_and_no_file() {
+    let dir = common::scratch("draw-bad");
+    let garbage = dir.join("garbage.glb");
+    std::fs::write(&garbage, b"glTF\x02\x00\x00\x00garbage").unwrap();
+    let svg = dir.join("out.svg");
+    let s = svg.to_str().unwrap();
+    let g = garbage.to_str().unwrap();
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb");
+    let sample = sample.to_str().unwrap();
+    for args in [
+        vec!["draw", g, "-o", s],
+        vec!["draw", sample, "-o", s, "--size", "0x600"],
+        vec!["draw", sample, "-o", s, "--tolerance=-1"],
+        vec!["draw", sample, "-o", s, "--tolerance", "NaN"],
+        vec!["draw", sample, "-o", s, "--view", "0,90"],
+        vec!["draw", sample, "-o", dir.join("out.png").to_str().unwrap()],
+    ] {
+        let run = common::run(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: one line: {stderr}");
+        assert!(!svg.exists(), "{args:?}: no output");
+    }
+}

@@ -1,0 +1,669 @@
+//! Vector line drawings with exact hidden lines (`drafter draw`, issue 45).
+//!
+//! # What is drawn
+//! The lines the raster lines pass draws ([`crate::edges`]): every hard edge of the file (crease,
+//! boundary, part border, non-manifold) and this view's silhouettes, queried from the baked
+//! hierarchies exactly as `drafter render --lines` does, under the same camera ([`Camera::fit`] on
+//! [`Model::frame_points`], the same `--view`, `--ortho`, `--size` and field of view).
+//!
+//! # Visibility, in object space
+//! Each edge is split where it passes behind a surface. Under a perspective or parallel projection
+//! an edge stays a straight segment on the screen and a triangle a triangle; along the projected
+//! edge (parameter `u`), and across a projected triangle, the *closeness* `c` — `1/w` in
+//! perspective (w the view depth), minus the normalised depth in parallel projection — is an
+//! affine function of the screen position. So the part of an edge that one triangle hides is
+//! exact and closed-form: the interval of `u` where the projected point lies inside the projected
+//! triangle (three half-planes, each linear in `u`) and the triangle is closer than the edge (one
+//! more linear inequality). The hidden part of an edge is the union of these intervals over the
+//! triangles a BVH of projected boxes (obvhs, `x`, `y` and `c`; a triangle wholly behind the edge
+//! is never visited) returns; its visible part is the rest. Change points are therefore found to
+//! rounding, not by sampling; a triangle hides a point only when it is closer by more than a
+//! relative `1e-7` of the closeness, so the faces meeting at an edge never hide it. Pieces shorter
+//! than [`DrawOptions::tolerance_px`] are dropped and edges drawn twice (both parts of a border)
+//! once; pieces sharing end points are chained into polylines.
+//!
+//! Limits: edges are the file's edges, so a curved CAD surface's outline is its tessellation's;
+//! lines are not clipped against each other's widths (a line passing just behind another's
+//! surface edge is split at the edge itself).
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::builder::build_bvh2;
+
+use crate::camera::Camera;
+use crate::edges::LineClass;
+use crate::model::Model;
+use crate::style::{DEFAULT_FOV_Y_DEG, View};
+
+/// What a drawing shows of the lines hidden by surfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hidden {
+    /// Not drawn (and not computed).
+    None,
+    /// Drawn dashed, in a group of their own.
+    Dashed,
+    /// Drawn as thin solid lines, in a group of their own.
+    Solid,
+}
+
+/// One view's drawing options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrawOptions {
+    /// Width and height in pixels (the SVG's user units).
+    pub size: (u32, u32),
+    pub view: View,
+    pub orthographic: bool,
+    pub fov_y_deg: f32,
+    pub hidden: Hidden,
+    /// Pieces shorter than this (pixels) are dropped, and end points closer than it are joined.
+    pub tolerance_px: f64,
+}
+
+impl Default for DrawOptions {
+    fn default() -> Self {
+        DrawOptions {
+            size: (800, 600),
+            view: View::default(),
+            orthographic: false,
+            fov_y_deg: DEFAULT_FOV_Y_DEG,
+            hidden: Hidden::None,
+            tolerance_px: 0.05,
+        }
+    }
+}
+
+/// A chained polyline of one class, visible or hidden, in pixels (y down).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stroke {
+    pub class: LineClass,
+    pub visible: bool,
+    /// The part the line's first piece belongs to (`None` where the model has no such part).
+    pub part: Option<u32>,
+    pub points: Vec<DVec2>,
+}
+
+/// What [`draw`] did, for reports and benchmarks.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DrawStats {
+    /// Triangles in the occlusion BVH (every instance's).
+    pub triangles: usize,
+    /// Edges considered: hard edges of every instance plus this view's silhouettes.
+    pub edges: usize,
+    /// Of which silhouettes.
+    pub silhouettes: usize,
+    /// Edges dropped as drawn twice.
+    pub duplicates: usize,
+    /// Triangle-edge pairs tested exactly (after the BVH).
+    pub pairs_tested: u64,
+    /// Visible and hidden length in pixels.
+    pub visible_px: f64,
+    pub hidden_px: f64,
+    pub elapsed: Duration,
+}
+
+/// A view's line drawing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Drawing {
+    pub width: u32,
+    pub height: u32,
+    pub strokes: Vec<Stroke>,
+    pub stats: DrawStats,
+}
+
+/// A projected point: pixels and closeness (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Projected {
+    x: f64,
+    y: f64,
+    c: f64,
+}
+
+/// The camera's projection in f64 (its f32 matrix, evaluated without further rounding).
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
+    clip_from_render: DMat4,
+    /// Where the camera looks from, as the raster lines pass queries silhouettes.
+    view: crate::edges::WorldView,
+    origin: DVec3,
+    orthographic: bool,
+    width: f64,
+    height: f64,
+}
+
+impl Projection {
+    /// The projection `drafter render` uses for `options` on `model`.
+    pub fn new(model: &Model, options: &DrawOptions) -> Projection {
+        let (w, h) = options.size;
+        let aspect = w as f32 / h.max(1) as f32;
+        let camera = Camera::fit(&model.frame_points, options.view, aspect, options.orthographic, options.fov_y_deg);
+        Projection {
+            clip_from_render: camera.clip_from_render().as_dmat4(),
+            view: crate::renderer::world_view(&camera, model.origin),
+            origin: model.origin,
+            orthographic: options.orthographic,
+            width: f64::from(w),
+            height: f64::from(h),
+        }
+    }
+
+    /// Where the camera looks from, as the silhouette query takes it.
+    pub fn view(&self) -> crate::edges::WorldView {
+        self.view
+    }
+
+    /// Pixels (x right, y down) of a world point; `None` behind the eye.
+    pub fn to_screen(&self, world: DVec3) -> Option<DVec2> {
+        self.project(world).map(|p| DVec2::new(p.x, p.y))
+    }
+
+    /// Pixels (x right, y down) and closeness of a world point; `None` behind the eye.
+    fn project(&self, world: DVec3) -> Option<Projected> {
+        let clip: DVec4 = self.clip_from_render * (world - self.origin).extend(1.0);
+        if clip.w.is_nan() || clip.w <= 0.0 {
+            return None;
+        }
+        let ndc = clip.truncate() / clip.w;
+        let c = if self.orthographic { -ndc.z } else { 1.0 / clip.w };
+        Some(Projected { x: (ndc.x + 1.0) * 0.5 * self.width, y: (1.0 - ndc.y) * 0.5 * self.height, c })
+    }
+}
+
+/// A world-space edge to draw.
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    a: DVec3,
+    b: DVec3,
+    class: LineClass,
+    part: Option<u32>,
+}
+
+/// Every triangle of every instance in world space, with its part.
+struct Triangles {
+    corners: Vec<[DVec3; 3]>,
+}
+
+fn world_triangles(model: &Model) -> Triangles {
+    let mut corners = Vec::new();
+    for batch in &model.batches {
+        for instance in batch.instances.clone() {
+            let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            let points: Vec<DVec3> = batch
+                .vertices
+                .iter()
+                .map(|v| world.transform_point3(Vec3::from_array(v.position_in_object).as_dvec3()))
+                .collect();
+            for t in batch.indices.chunks_exact(3) {
+                let p = |k: usize| points.get(t[k] as usize).copied();
+                if let (Some(a), Some(b), Some(c)) = (p(0), p(1), p(2)) {
+                    corners.push([a, b, c]);
+                }
+            }
+        }
+    }
+    Triangles { corners }
+}
+
+/// The part of mesh triangle `t` drawn by `instance`.
+fn part_of(model: &Model, instance: u32, t: usize) -> Option<u32> {
+    let batch = model.batches.iter().find(|b| b.instances.contains(&instance))?;
+    let v = *batch.indices.get(3 * t)? as usize;
+    let label = batch.vertices.get(v)?.label;
+    let gpu = model.instances.get(instance as usize)?;
+    if label >= gpu.label_count {
+        return None;
+    }
+    model.label_to_part.get((gpu.label_base + label) as usize).copied()
+}
+
+/// The edges of `model` for a view from `projection`: hard edges of every instance and the
+/// view's silhouettes, in world space.
+fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
+    let mut edges = Vec::new();
+    for mesh in &model.lines.meshes {
+        for instance in mesh.instances.clone() {
+            let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            for (k, &([a, b], class)) in mesh.hard.iter().enumerate() {
+                let part = mesh.hard_triangles.get(k).and_then(|&t| part_of(model, instance, t as usize));
+                edges.push(Edge {
+                    a: world.transform_point3(a.as_dvec3()),
+                    b: world.transform_point3(b.as_dvec3()),
+                    class,
+                    part,
+                });
+            }
+        }
+    }
+    let frame = model.lines.silhouettes(projection.view);
+    let silhouettes = frame.segments.len();
+    for (segment, drawn) in frame.segments.iter().zip(&frame.drawn) {
+        let Some(world) = model.instance_world_from_object.get(segment.instance as usize) else { continue };
+        edges.push(Edge {
+            a: world.transform_point3(Vec3::from_array(segment.a_in_object).as_dvec3()),
+            b: world.transform_point3(Vec3::from_array(segment.b_in_object).as_dvec3()),
+            class: LineClass::Silhouette,
+            part: part_of(model, drawn.instance, (drawn.corner / 3) as usize),
+        });
+    }
+    (edges, silhouettes)
+}
+
+/// Closeness tolerance: a triangle hides a point when closer by more than this share of the
+/// point's closeness.
+const CLOSER_BY: f64 = 1e-7;
+
+/// The interval of `u` in [0, 1] over which the projected triangle `t` hides the projected
+/// segment `a → b`, if any (see the module docs).
+fn hidden_interval(a: Projected, b: Projected, t: &[Projected; 3]) -> Option<(f64, f64)> {
+    let area = (t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[1].y - t[0].y) * (t[2].x - t[0].x);
+    if area == 0.0 || !area.is_finite() {
+        return None;
+    }
+    let sign = area.signum();
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    // Inside: each edge's half-plane, linear in u.
+    for k in 0..3 {
+        let (p, q) = (t[k], t[(k + 1) % 3]);
+        let side = |x: f64, y: f64| sign * ((q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x));
+        let (s0, s1) = (side(a.x, a.y), side(b.x, b.y));
+        if !clip_positive(s0, s1, &mut lo, &mut hi) {
+            return None;
+        }
+    }
+    // Closer: the triangle's closeness at the segment's points, by barycentric coordinates
+    // (affine in the screen position, so in u), against the segment's own.
+    let closeness_at = |x: f64, y: f64| {
+        let w1 = ((x - t[0].x) * (t[2].y - t[0].y) - (y - t[0].y) * (t[2].x - t[0].x)) / area;
+        let w2 = ((t[1].x - t[0].x) * (y - t[0].y) - (t[1].y - t[0].y) * (x - t[0].x)) / area;
+        t[0].c + w1 * (t[1].c - t[0].c) + w2 * (t[2].c - t[0].c)
+    };
+    let margin = |c: f64| CLOSER_BY * c.abs().max(f64::MIN_POSITIVE);
+    let d0 = closeness_at(a.x, a.y) - a.c - margin(a.c);
+    let d1 = closeness_at(b.x, b.y) - b.c - margin(b.c);
+    if !clip_positive(d0, d1, &mut lo, &mut hi) || hi <= lo {
+        return None;
+    }
+    Some((lo, hi))
+}
+
+/// Narrows `[lo, hi]` to where `f(u) = f0 + u (f1 − f0) > 0`; false when nothing is left.
+fn clip_positive(f0: f64, f1: f64, lo: &mut f64, hi: &mut f64) -> bool {
+    if !(f0.is_finite() && f1.is_finite()) {
+        return false;
+    }
+    if f0 <= 0.0 && f1 <= 0.0 {
+        return false;
+    }
+    if f0 > 0.0 && f1 > 0.0 {
+        return true;
+    }
+    let root = f0 / (f0 - f1);
+    if f0 > 0.0 {
+        *hi = hi.min(root);
+    } else {
+        *lo = lo.max(root);
+    }
+    *hi > *lo
+}
+
+/// The union of `intervals` (sorted in place), merged.
+fn union(intervals: &mut [(f64, f64)]) -> Vec<(f64, f64)> {
+    intervals.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for &(lo, hi) in intervals.iter() {
+        match out.last_mut() {
+            Some(last) if lo <= last.1 => last.1 = last.1.max(hi),
+            _ => out.push((lo, hi)),
+        }
+    }
+    out
+}
+
+/// The occlusion structure: projected triangles and a BVH over their boxes.
+struct Occluders {
+    projected: Vec<[Projected; 3]>,
+    bvh: obvhs::bvh2::Bvh2,
+}
+
+impl Occluders {
+    fn new(triangles: &Triangles, projection: &Projection) -> Occluders {
+        let projected: Vec<[Projected; 3]> = triangles
+            .corners
+            .iter()
+            .filter_map(|t| Some([projection.project(t[0])?, projection.project(t[1])?, projection.project(t[2])?]))
+            .collect();
+        let boxes: Vec<Aabb> = projected.iter().map(padded_box).collect();
+        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::fast_build() };
+        let bvh = build_bvh2(&boxes, params, &mut Duration::default());
+        Occluders { projected, bvh }
+    }
+
+    /// The hidden intervals of the projected segment `a → b`.
+    fn hidden(&self, a: Projected, b: Projected, tested: &mut u64) -> Vec<(f64, f64)> {
+        let lo = glam::Vec3A::new(a.x.min(b.x) as f32, a.y.min(b.y) as f32, a.c.min(b.c) as f32);
+        let hi = glam::Vec3A::new(a.x.max(b.x) as f32, a.y.max(b.y) as f32, f32::MAX);
+        let query = Aabb { min: lo - pad(lo), max: hi + pad(hi) };
+        let mut intervals = Vec::new();
+        self.bvh.aabb_traverse(query, |bvh, node| {
+            let node = &bvh.nodes[node as usize];
+            let first = node.first_index as usize;
+            for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+                *tested += 1;
+                if let Some(interval) = hidden_interval(a, b, &self.projected[p as usize]) {
+                    intervals.push(interval);
+                }
+            }
+            true
+        });
+        union(&mut intervals)
+    }
+}
+
+/// Twice an `f32` rounding of `v` and a little: boxes in `f32` that still contain the `f64`
+/// values they bound.
+fn pad(v: glam::Vec3A) -> glam::Vec3A {
+    v.abs() * 4.0 * f32::EPSILON + glam::Vec3A::splat(1e-6)
+}
+
+fn padded_box(t: &[Projected; 3]) -> Aabb {
+    let lo = glam::Vec3A::new(
+        t[0].x.min(t[1].x).min(t[2].x) as f32,
+        t[0].y.min(t[1].y).min(t[2].y) as f32,
+        t[0].c.min(t[1].c).min(t[2].c) as f32,
+    );
+    let hi = glam::Vec3A::new(
+        t[0].x.max(t[1].x).max(t[2].x) as f32,
+        t[0].y.max(t[1].y).max(t[2].y) as f32,
+        t[0].c.max(t[1].c).max(t[2].c) as f32,
+    );
+    Aabb { min: lo - pad(lo), max: hi + pad(hi) }
+}
+
+/// A piece of an edge on the screen.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    a: DVec2,
+    b: DVec2,
+    class: LineClass,
+    visible: bool,
+    part: Option<u32>,
+}
+
+/// One edge of the view with the parts of it that surfaces hide.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgeVisibility {
+    /// World-space end points.
+    pub a: DVec3,
+    pub b: DVec3,
+    pub class: LineClass,
+    pub part: Option<u32>,
+    /// The end points on the screen (pixels, y down).
+    pub screen: [DVec2; 2],
+    /// Hidden intervals of the screen parameter `u` (0 at `screen[0]`, 1 at `screen[1]`),
+    /// sorted and disjoint.
+    pub hidden: Vec<(f64, f64)>,
+}
+
+/// Every edge of a view (drawn twice: once) and what hides it.
+#[derive(Clone, Debug)]
+pub struct Visibility {
+    pub projection: Projection,
+    pub edges: Vec<EdgeVisibility>,
+    pub stats: DrawStats,
+}
+
+/// The edges of `model` in the view `options` describe, each with its hidden intervals.
+pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
+    let start = Instant::now();
+    let projection = Projection::new(model, options);
+    let triangles = world_triangles(model);
+    let (edges, silhouettes) = view_edges(model, &projection);
+    let occluders = Occluders::new(&triangles, &projection);
+    let mut stats =
+        DrawStats { triangles: triangles.corners.len(), edges: edges.len(), silhouettes, ..Default::default() };
+    // Edges drawn twice (a border of two parts, an instance's edge on another's) once: the same
+    // class between the same pixels, to a hundredth of the tolerance.
+    let quantum = (options.tolerance_px.max(0.0) * 0.01).max(1e-9);
+    let key = |p: &Projected| ((p.x / quantum).round() as i64, (p.y / quantum).round() as i64);
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for edge in &edges {
+        let (Some(a), Some(b)) = (projection.project(edge.a), projection.project(edge.b)) else { continue };
+        let (ka, kb) = (key(&a), key(&b));
+        let ordered = if ka <= kb { (ka, kb) } else { (kb, ka) };
+        if !seen.insert((ordered, edge.class as u32)) {
+            stats.duplicates += 1;
+            continue;
+        }
+        let hidden = occluders.hidden(a, b, &mut stats.pairs_tested);
+        out.push(EdgeVisibility {
+            a: edge.a,
+            b: edge.b,
+            class: edge.class,
+            part: edge.part,
+            screen: [DVec2::new(a.x, a.y), DVec2::new(b.x, b.y)],
+            hidden,
+        });
+    }
+    stats.elapsed = start.elapsed();
+    Visibility { projection, edges: out, stats }
+}
+
+/// Draws `model` as `options` say.
+pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
+    let start = Instant::now();
+    let Visibility { edges, mut stats, .. } = visibility(model, options);
+    let tolerance = options.tolerance_px.max(0.0);
+    let mut pieces = Vec::new();
+    for edge in &edges {
+        let [pa, pb] = edge.screen;
+        let length = pa.distance(pb);
+        if length < tolerance {
+            continue;
+        }
+        let at = |u: f64| pa + (pb - pa) * u;
+        let mut push = |lo: f64, hi: f64, visible: bool| {
+            if (hi - lo) * length >= tolerance {
+                pieces.push(Piece { a: at(lo), b: at(hi), class: edge.class, visible, part: edge.part });
+            }
+        };
+        let mut from = 0.0;
+        for &(lo, hi) in &edge.hidden {
+            push(from, lo, true);
+            if options.hidden != Hidden::None {
+                push(lo, hi, false);
+            }
+            from = hi;
+        }
+        push(from, 1.0, true);
+    }
+    for p in &pieces {
+        let length = p.a.distance(p.b);
+        if p.visible {
+            stats.visible_px += length;
+        } else {
+            stats.hidden_px += length;
+        }
+    }
+    let strokes = chain(&pieces, tolerance);
+    stats.elapsed = start.elapsed();
+    Drawing { width: options.size.0, height: options.size.1, strokes, stats }
+}
+
+/// Joins pieces of one class and visibility that meet end to end (within `tolerance`) into
+/// polylines, deterministically (pieces in order, each chain walked forward then backward).
+fn chain(pieces: &[Piece], tolerance: f64) -> Vec<Stroke> {
+    let quantum = tolerance.max(1e-9);
+    let cell = |p: DVec2| ((p.x / quantum).round() as i64, (p.y / quantum).round() as i64);
+    // End point cell → pieces touching it, per class and visibility.
+    let mut ends: HashMap<(u32, bool, (i64, i64)), Vec<usize>> = HashMap::new();
+    for (i, p) in pieces.iter().enumerate() {
+        for end in [p.a, p.b] {
+            ends.entry((p.class as u32, p.visible, cell(end))).or_default().push(i);
+        }
+    }
+    let mut used = vec![false; pieces.len()];
+    let mut strokes = Vec::new();
+    for start in 0..pieces.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let first = pieces[start];
+        let mut points = std::collections::VecDeque::from([first.a, first.b]);
+        // Forward from b, then backward from a.
+        for forward in [true, false] {
+            loop {
+                let tip =
+                    if forward { *points.back().unwrap_or(&first.b) } else { *points.front().unwrap_or(&first.a) };
+                let next = ends
+                    .get(&(first.class as u32, first.visible, cell(tip)))
+                    .and_then(|list| list.iter().copied().find(|&j| !used[j]));
+                let Some(j) = next else { break };
+                used[j] = true;
+                let p = pieces[j];
+                let other = if cell(p.a) == cell(tip) { p.b } else { p.a };
+                if forward {
+                    points.push_back(other);
+                } else {
+                    points.push_front(other);
+                }
+            }
+        }
+        strokes.push(Stroke { class: first.class, visible: first.visible, part: first.part, points: points.into() });
+    }
+    strokes
+}
+
+/// The class names of the SVG groups and paths.
+pub fn class_name(class: LineClass) -> &'static str {
+    match class {
+        LineClass::Silhouette => "silhouette",
+        LineClass::Crease => "crease",
+        LineClass::Boundary => "boundary",
+        LineClass::PartBorder => "part-border",
+        LineClass::NonManifold => "non-manifold",
+    }
+}
+
+/// Stroke widths in pixels, after Gooch et al. 1999 (§3): silhouettes heaviest, black; creases
+/// lighter; hidden lines thin.
+fn width_of(class: LineClass, visible: bool) -> f64 {
+    if !visible {
+        return 0.6;
+    }
+    match class {
+        LineClass::Silhouette => 1.6,
+        LineClass::Boundary | LineClass::PartBorder | LineClass::NonManifold => 1.2,
+        LineClass::Crease => 0.9,
+    }
+}
+
+/// The drawing as SVG: a group per visibility, a group per class inside, one path per stroke
+/// carrying its part (`class="part-N"`); coordinates at a hundredth of a pixel (or the tolerance,
+/// if finer). Restyle with CSS on the ids and classes.
+pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let (w, h) = (drawing.width, drawing.height);
+    let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
+    );
+    let _ = writeln!(s, "<desc>drafter draw: {} strokes</desc>", drawing.strokes.len());
+    let classes =
+        [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
+    for visible in [false, true] {
+        if !visible && hidden == Hidden::None {
+            continue;
+        }
+        let (id, extra) = match (visible, hidden) {
+            (true, _) => ("visible", String::new()),
+            (false, Hidden::Dashed) => ("hidden", r#" stroke-dasharray="4 3""#.to_string()),
+            (false, _) => ("hidden", String::new()),
+        };
+        let colour = if visible { "#000" } else { "#666" };
+        let _ = writeln!(s, r#"<g id="{id}" stroke="{colour}"{extra}>"#);
+        for class in classes {
+            let strokes: Vec<&Stroke> =
+                drawing.strokes.iter().filter(|st| st.visible == visible && st.class == class).collect();
+            if strokes.is_empty() {
+                continue;
+            }
+            let _ = writeln!(s, r#"<g class="{}" stroke-width="{}">"#, class_name(class), width_of(class, visible));
+            for stroke in strokes {
+                let part = stroke.part.map(|p| format!(r#" class="part-{p}""#)).unwrap_or_default();
+                let _ = write!(s, r#"<path{part} d=""#);
+                for (i, p) in stroke.points.iter().enumerate() {
+                    let _ = write!(s, "{}{} {}", if i == 0 { "M" } else { " L" }, coordinate(p.x), coordinate(p.y));
+                }
+                let _ = writeln!(s, r#""/>"#);
+            }
+            let _ = writeln!(s, "</g>");
+        }
+        let _ = writeln!(s, "</g>");
+    }
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// A coordinate at a hundredth of a pixel, without trailing zeros.
+fn coordinate(v: f64) -> String {
+    let text = format!("{:.2}", v);
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" { "0".to_string() } else { text.to_string() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(x: f64, y: f64, c: f64) -> Projected {
+        Projected { x, y, c }
+    }
+
+    #[test]
+    fn a_triangle_in_front_hides_the_middle_of_a_segment_exactly() {
+        // Segment along y = 5 from x = 0 to 10 at closeness 1; triangle covering x in [2, 6] at
+        // y = 5, closeness 2 (closer).
+        let t = [p(2.0, 0.0, 2.0), p(6.0, 5.0 * 2.0, 2.0), p(2.0, 10.0, 2.0)];
+        let (lo, hi) = hidden_interval(p(0.0, 5.0, 1.0), p(10.0, 5.0, 1.0), &t).expect("hidden");
+        assert!((lo - 0.2).abs() < 1e-12 && (hi - 0.4).abs() < 1e-12, "{lo} {hi}");
+        // The same triangle behind hides nothing.
+        let behind = t.map(|q| p(q.x, q.y, 0.5));
+        assert_eq!(hidden_interval(p(0.0, 5.0, 1.0), p(10.0, 5.0, 1.0), &behind), None);
+        // A triangle piercing the segment's depth hides from where it comes in front: closeness
+        // rising along x from 0 (at x = 2) to 2 (at x = 6) crosses 1 at x = 4.
+        let tri = [p(2.0, -10.0, 0.0), p(6.0, 5.0, 2.0), p(2.0, 20.0, 0.0)];
+        let (lo, hi) = hidden_interval(p(0.0, 5.0, 1.0), p(10.0, 5.0, 1.0), &tri).expect("hidden");
+        assert!((lo - 0.4).abs() < 1e-6 && (hi - 0.6).abs() < 1e-12, "{lo} {hi}");
+    }
+
+    #[test]
+    fn a_face_meeting_the_edge_never_hides_it() {
+        // The edge is a side of the triangle, at the same closeness.
+        let t = [p(0.0, 0.0, 1.0), p(10.0, 0.0, 1.0), p(5.0, 8.0, 1.0)];
+        assert_eq!(hidden_interval(p(0.0, 0.0, 1.0), p(10.0, 0.0, 1.0), &t), None);
+    }
+
+    #[test]
+    fn intervals_merge_and_pieces_chain() {
+        let mut v = vec![(0.5, 0.7), (0.1, 0.2), (0.15, 0.3), (0.7, 0.8)];
+        assert_eq!(union(&mut v), vec![(0.1, 0.3), (0.5, 0.8)]);
+        let piece = |a: (f64, f64), b: (f64, f64)| Piece {
+            a: DVec2::new(a.0, a.1),
+            b: DVec2::new(b.0, b.1),
+            class: LineClass::Crease,
+            visible: true,
+            part: None,
+        };
+        let strokes =
+            chain(&[piece((1.0, 0.0), (2.0, 0.0)), piece((0.0, 0.0), (1.0, 0.0)), piece((2.0, 0.0), (2.0, 1.0))], 0.05);
+        assert_eq!(strokes.len(), 1);
+        assert_eq!(strokes[0].points.len(), 4);
+    }
+}
