@@ -33,6 +33,7 @@ use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
+use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::edges::LineClass;
@@ -332,7 +333,7 @@ impl Occluders {
     fn new(triangles: &Triangles, projection: &Projection) -> Occluders {
         let projected: Vec<[Projected; 3]> = triangles
             .corners
-            .iter()
+            .par_iter()
             .filter_map(|t| Some([projection.project(t[0])?, projection.project(t[1])?, projection.project(t[2])?]))
             .collect();
         let boxes: Vec<Aabb> = projected.iter().map(padded_box).collect();
@@ -343,24 +344,42 @@ impl Occluders {
 
     /// The hidden intervals of the projected segment `a → b`.
     fn hidden(&self, a: Projected, b: Projected, tested: &mut u64) -> Vec<(f64, f64)> {
-        let lo = glam::Vec3A::new(a.x.min(b.x) as f32, a.y.min(b.y) as f32, a.c.min(b.c) as f32);
-        let hi = glam::Vec3A::new(a.x.max(b.x) as f32, a.y.max(b.y) as f32, f32::MAX);
-        let query = Aabb { min: lo - pad(lo), max: hi + pad(hi) };
+        // A long edge is queried in screen pieces of at most QUERY_PIECE_PX, each with its own
+        // box: a diagonal across the frame would otherwise visit every triangle of the frame.
+        // Closeness is affine along the edge, so a piece's ends interpolate exactly and its
+        // intervals map back to the edge's parameter.
+        let length = (b.x - a.x).hypot(b.y - a.y);
+        let pieces = ((length / QUERY_PIECE_PX).ceil() as usize).clamp(1, 4096);
+        let at = |u: f64| Projected { x: a.x + (b.x - a.x) * u, y: a.y + (b.y - a.y) * u, c: a.c + (b.c - a.c) * u };
         let mut intervals = Vec::new();
-        self.bvh.aabb_traverse(query, |bvh, node| {
-            let node = &bvh.nodes[node as usize];
-            let first = node.first_index as usize;
-            for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
-                *tested += 1;
-                if let Some(interval) = hidden_interval(a, b, &self.projected[p as usize]) {
-                    intervals.push(interval);
+        for k in 0..pieces {
+            let (u0, u1) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
+            let (pa, pb) = (if k == 0 { a } else { at(u0) }, if k + 1 == pieces { b } else { at(u1) });
+            let lo = glam::Vec3A::new(pa.x.min(pb.x) as f32, pa.y.min(pb.y) as f32, pa.c.min(pb.c) as f32);
+            let hi = glam::Vec3A::new(pa.x.max(pb.x) as f32, pa.y.max(pb.y) as f32, f32::MAX);
+            let query = Aabb { min: lo - pad(lo), max: hi + pad(hi) };
+            self.bvh.aabb_traverse(query, |bvh, node| {
+                let node = &bvh.nodes[node as usize];
+                let first = node.first_index as usize;
+                for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+                    *tested += 1;
+                    if let Some((lo, hi)) = hidden_interval(pa, pb, &self.projected[p as usize]) {
+                        intervals.push((u0 + lo * (u1 - u0), u0 + hi * (u1 - u0)));
+                        // One triangle hides the whole piece: nothing else can change it.
+                        if lo <= 0.0 && hi >= 1.0 {
+                            return false;
+                        }
+                    }
                 }
-            }
-            true
-        });
+                true
+            });
+        }
         union(&mut intervals)
     }
 }
+
+/// The longest stretch of an edge one BVH query covers, in pixels.
+const QUERY_PIECE_PX: f64 = 24.0;
 
 /// Twice an `f32` rounding of `v` and a little: boxes in `f32` that still contain the `f64`
 /// values they bound.
@@ -429,7 +448,7 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
     let quantum = (options.tolerance_px.max(0.0) * 0.01).max(1e-9);
     let key = |p: &Projected| ((p.x / quantum).round() as i64, (p.y / quantum).round() as i64);
     let mut seen = std::collections::HashSet::new();
-    let mut out = Vec::new();
+    let mut unique = Vec::new();
     for edge in &edges {
         let (Some(a), Some(b)) = (projection.project(edge.a), projection.project(edge.b)) else { continue };
         let (ka, kb) = (key(&a), key(&b));
@@ -438,7 +457,20 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
             stats.duplicates += 1;
             continue;
         }
-        let hidden = occluders.hidden(a, b, &mut stats.pairs_tested);
+        unique.push((edge, a, b));
+    }
+    // Edges are independent: on the thread pool, in order (the result does not depend on the
+    // thread count).
+    let answers: Vec<(Vec<(f64, f64)>, u64)> = unique
+        .par_iter()
+        .map(|(_, a, b)| {
+            let mut tested = 0;
+            (occluders.hidden(*a, *b, &mut tested), tested)
+        })
+        .collect();
+    let mut out = Vec::with_capacity(unique.len());
+    for ((edge, a, b), (hidden, tested)) in unique.into_iter().zip(answers) {
+        stats.pairs_tested += tested;
         out.push(EdgeVisibility {
             a: edge.a,
             b: edge.b,
