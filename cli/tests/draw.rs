@@ -1,4 +1,4 @@
-//! `drafter draw`: a valid SVG (xmllint) of the baked sample with its hidden lines in a group of
+//! `drafter draw`: a valid SVG (xmllint) and PDF (pdfinfo) of the baked sample with its hidden lines in a group of
 //! their own; a model without baked edges gives its outline only, never an error; bad input and bad
 //! options end with exit 2, one line, and no output file. The exactness of the hidden lines is
 //! `viewer/tests/drawing.rs` (brute force).
@@ -35,6 +35,23 @@ fn the_sample_draws_as_a_valid_svg_with_hidden_lines() {
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains(r#"<g id="hidden""#) && text.contains(r#"<g id="visible""#));
     assert_eq!(text.matches("<path").count() as u64, figures["strokes"].as_u64().unwrap());
+}
+
+/// The same drawing as a PDF: one page of 600 × 450 pt for 800 × 600 px, which poppler reads.
+#[test]
+fn the_sample_draws_as_a_pdf() {
+    let dir = common::scratch("draw-pdf");
+    let pdf = dir.join("sample.pdf");
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb");
+    let run = common::run(&["draw", sample.to_str().unwrap(), "-o", pdf.to_str().unwrap(), "--hidden", "dashed"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let info = Command::new("pdfinfo")
+        .arg(&pdf)
+        .output()
+        .expect("pdfinfo (apt poppler-utils; scripts/test installs it) checks the PDF");
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(info.status.success(), "pdfinfo: {}", String::from_utf8_lossy(&info.stderr));
+    assert!(text.contains("Pages:           1") && text.contains("600 x 450 pts"), "{text}");
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! `drafter draw FILE -o view.svg [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
+//! `drafter draw FILE -o view.svg|view.pdf [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
 //! [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
 //! (`drafter_viewer::drawing`): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
@@ -18,7 +18,7 @@ pub struct Args {
     /// The model to draw: a baked .glb/.gltf (its edges and silhouette hierarchies), or any model
     /// (then only its outline is known: bake it first for creases).
     pub file: PathBuf,
-    /// The SVG to write.
+    /// The drawing to write: .svg, or .pdf (the same strokes on one page, a pixel as 0.75 pt).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Drawing size in pixels (the SVG's user units), WIDTHxHEIGHT: the same view as `render`.
@@ -65,9 +65,12 @@ impl From<HiddenArg> for Hidden {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("svg")) {
-        return Err(BadInput(format!("{}: output must end in .svg", args.output.display())).into());
-    }
+    let extension = args.output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let pdf = match extension.as_deref() {
+        Some("svg") => false,
+        Some("pdf") => true,
+        _ => return Err(BadInput(format!("{}: output must end in .svg or .pdf", args.output.display())).into()),
+    };
     let (w, h) = args.size;
     if w == 0 || h == 0 || w > 65_536 || h > 65_536 {
         return Err(BadInput(format!("--size {w}x{h}: each side must be 1 to 65536 pixels")).into());
@@ -91,13 +94,17 @@ pub fn run(args: Args) -> Result<()> {
         ..DrawOptions::default()
     };
     let drawing = drawing::draw(&model, &options);
-    let svg = drawing::to_svg(&drawing, options.hidden);
-    drafter_catalog::output::write_atomically(&args.output, svg.as_bytes())?;
+    let bytes = if pdf {
+        drawing::to_pdf(&drawing, options.hidden)
+    } else {
+        drawing::to_svg(&drawing, options.hidden).into_bytes()
+    };
+    drafter_catalog::output::write_atomically(&args.output, &bytes)?;
     let s = &drawing.stats;
     if args.json {
         let value = serde_json::json!({
             "output": args.output.display().to_string(),
-            "bytes": svg.len(),
+            "bytes": bytes.len(),
             "strokes": drawing.strokes.len(),
             "edges": s.edges,
             "silhouettes": s.silhouettes,
@@ -122,7 +129,7 @@ pub fn run(args: Args) -> Result<()> {
             s.silhouettes,
             s.triangles,
             s.elapsed.as_secs_f64() * 1e3,
-            svg.len()
+            bytes.len()
         );
         for notice in &model.notices {
             eprintln!("  note: {notice}");
