@@ -208,6 +208,35 @@ fn world_triangles(model: &Model) -> Triangles {
     Triangles { corners }
 }
 
+/// An edge by the bits of its two end points, in either order.
+type EdgeKey = ([u32; 3], [u32; 3]);
+
+fn edge_key(a: Vec3, b: Vec3) -> EdgeKey {
+    let (ka, kb) = (a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits));
+    if ka <= kb { (ka, kb) } else { (kb, ka) }
+}
+
+/// The object-space normals of the faces at each edge of the mesh drawn by `instance` (the batch's
+/// triangles, whose positions are the file's: the hard edges' end points are the same `f32`s).
+fn mesh_edge_faces(model: &Model, instance: u32) -> HashMap<EdgeKey, Vec<DVec3>> {
+    let mut faces: HashMap<EdgeKey, Vec<DVec3>> = HashMap::new();
+    let Some(batch) = model.batches.iter().find(|b| b.instances.contains(&instance)) else { return faces };
+    for t in batch.indices.chunks_exact(3) {
+        let p: Vec<Vec3> = t
+            .iter()
+            .filter_map(|&i| batch.vertices.get(i as usize).map(|v| Vec3::from_array(v.position_in_object)))
+            .collect();
+        if p.len() != 3 {
+            continue;
+        }
+        let normal = (p[1].as_dvec3() - p[0].as_dvec3()).cross(p[2].as_dvec3() - p[0].as_dvec3());
+        for k in 0..3 {
+            faces.entry(edge_key(p[k], p[(k + 1) % 3])).or_default().push(normal);
+        }
+    }
+    faces
+}
+
 /// The part of mesh triangle `t` drawn by `instance`.
 fn part_of(model: &Model, instance: u32, t: usize) -> Option<u32> {
     let batch = model.batches.iter().find(|b| b.instances.contains(&instance))?;
@@ -225,10 +254,35 @@ fn part_of(model: &Model, instance: u32, t: usize) -> Option<u32> {
 fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
     let mut edges = Vec::new();
     for mesh in &model.lines.meshes {
+        let faces = mesh_edge_faces(model, mesh.instances.start);
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            let object_from_world =
+                model.lines.object_from_world.get(instance as usize).copied().unwrap_or(DMat4::IDENTITY);
             for (k, &([a, b], class)) in mesh.hard.iter().enumerate() {
                 let part = mesh.hard_triangles.get(k).and_then(|&t| part_of(model, instance, t as usize));
+                // A crease whose faces turn opposite ways to the viewer lies on the contour: drawn
+                // as a silhouette, as the raster lines pass draws a crease across which the depth
+                // jumps (Gooch et al. 1999 draw every silhouette black and heavy).
+                let class = match (class, faces.get(&edge_key(a, b))) {
+                    (LineClass::Crease, Some(normals)) if normals.len() == 2 => {
+                        let middle = (a.as_dvec3() + b.as_dvec3()) * 0.5;
+                        let towards = match projection.view {
+                            crate::edges::WorldView::Perspective { eye } => {
+                                object_from_world.transform_point3(eye) - middle
+                            }
+                            crate::edges::WorldView::Orthographic { direction } => {
+                                object_from_world.transform_vector3(direction)
+                            }
+                        };
+                        if normals[0].dot(towards) * normals[1].dot(towards) < 0.0 {
+                            LineClass::Silhouette
+                        } else {
+                            class
+                        }
+                    }
+                    (class, _) => class,
+                };
                 edges.push(Edge {
                     a: world.transform_point3(a.as_dvec3()),
                     b: world.transform_point3(b.as_dvec3()),

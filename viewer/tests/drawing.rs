@@ -10,7 +10,7 @@ mod common;
 use drafter_viewer::Model;
 use drafter_viewer::View;
 use drafter_viewer::drawing::{self, DrawOptions, Hidden};
-use drafter_viewer::edges::WorldView;
+use drafter_viewer::edges::{LineClass, WorldView};
 use glam::{DVec2, DVec3, Vec3};
 
 /// Every triangle of `model` in world space.
@@ -158,4 +158,95 @@ fn the_svg_groups_classes_and_chains_pieces() {
     assert_eq!(svg, drawing::to_svg(&drawing::draw(&model, &options), options.hidden), "deterministic");
     let none = drawing::to_svg(&drawing::draw(&model, &DrawOptions { hidden: Hidden::None, ..options }), Hidden::None);
     assert!(!none.contains(r#"<g id="hidden""#));
+}
+
+/// The drawing's visible black lines (silhouettes, boundaries, part borders) against the raster
+/// lines pass of `drafter render --lines` in the Gooch style (black lines over cool-to-warm shading,
+/// creases white): at the same view and size, every black pixel of the raster lies within 2 px of
+/// the drawing's black lines, and nearly every pixel of those lines within 2 px of the raster's black.
+#[test]
+fn the_drawing_matches_the_raster_lines_pass() {
+    let model = common::sample();
+    let size = (800u32, 600u32);
+    let options = DrawOptions { size, hidden: Hidden::None, ..DrawOptions::default() };
+    let drawing = drawing::draw(&model, &options);
+    let mut renderer = common::renderer();
+    renderer.set_model(&model).expect("upload");
+    let render = drafter_viewer::RenderOptions {
+        size,
+        style: drafter_viewer::Style::Gooch,
+        use_part_styles: false,
+        lines: true,
+        view: options.view,
+        ..drafter_viewer::RenderOptions::default()
+    };
+    let image = renderer.render(&render).expect("frame");
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let raster_black: Vec<bool> = image.rgba.chunks_exact(4).map(|p| p[0].max(p[1]).max(p[2]) < 48).collect();
+    // The drawing's black classes, rasterised by sampling each segment every quarter pixel.
+    let mut drawn = vec![false; w * h];
+    for stroke in drawing.strokes.iter().filter(|s| s.visible && s.class != LineClass::Crease) {
+        for pair in stroke.points.windows(2) {
+            let steps = (pair[0].distance(pair[1]) * 4.0).ceil().max(1.0) as usize;
+            for k in 0..=steps {
+                let p = pair[0] + (pair[1] - pair[0]) * (k as f64 / steps as f64);
+                let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
+                if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+                    drawn[y as usize * w + x as usize] = true;
+                }
+            }
+        }
+    }
+    let near = |mask: &[bool], x: usize, y: usize| {
+        let r = 2isize;
+        (-r..=r).any(|dy| {
+            (-r..=r).any(|dx| {
+                let (xx, yy) = (x as isize + dx, y as isize + dy);
+                xx >= 0 && yy >= 0 && (xx as usize) < w && (yy as usize) < h && mask[yy as usize * w + xx as usize]
+            })
+        })
+    };
+    let share = |from: &[bool], to: &[bool]| {
+        let (mut n, mut hit) = (0usize, 0usize);
+        for y in 0..h {
+            for x in 0..w {
+                if from[y * w + x] {
+                    n += 1;
+                    hit += usize::from(near(to, x, y));
+                }
+            }
+        }
+        (hit as f64 / n.max(1) as f64, n)
+    };
+    for class in [LineClass::Silhouette, LineClass::Boundary, LineClass::PartBorder] {
+        let mut mask = vec![false; w * h];
+        for stroke in drawing.strokes.iter().filter(|s| s.visible && s.class == class) {
+            for pair in stroke.points.windows(2) {
+                let steps = (pair[0].distance(pair[1]) * 4.0).ceil().max(1.0) as usize;
+                for k in 0..=steps {
+                    let p = pair[0] + (pair[1] - pair[0]) * (k as f64 / steps as f64);
+                    let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
+                    if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+                        mask[y as usize * w + x as usize] = true;
+                    }
+                }
+            }
+        }
+        let (s, n) = share(&mask, &raster_black);
+        eprintln!("{class:?}: {n} pixels, {:.2}% near the raster's black", 100.0 * s);
+    }
+    let (drawing_in_raster, drawn_pixels) = share(&drawn, &raster_black);
+    let (raster_in_drawing, raster_pixels) = share(&raster_black, &drawn);
+    eprintln!(
+        "drawing pixels {drawn_pixels}: {:.2}% near the raster's black; raster black pixels {raster_pixels}: {:.2}% near the drawing",
+        100.0 * drawing_in_raster,
+        100.0 * raster_in_drawing
+    );
+    assert!(drawn_pixels > 2000 && raster_pixels > 2000);
+    // The raster pass turns a crease into an outline where the depth jumps across it by more than
+    // a relative threshold (`passes::lines::CONTOUR_DEPTH_JUMP`), an image-space test; the drawing
+    // where its faces turn opposite ways, exactly. Folds whose far side lies close behind (gear
+    // flanks) are outlines only in the drawing: 90.4% of its black pixels meet the raster's black.
+    assert!(drawing_in_raster >= 0.88, "{drawing_in_raster}");
+    assert!(raster_in_drawing >= 0.97, "{raster_in_drawing}");
 }
