@@ -1,32 +1,8 @@
 // G-buffer pass: rasterises every mesh once (instanced) and shades it in the style of its part.
 // Outputs colour, view-space normal, linear view depth and part id + 1 (0 = background).
-// Keep the structs in sync with gpu_types.rs; style numbers with Style::index in style.rs; the
+// Frame and Instance are in shared.wgsl. Keep the structs in sync with gpu_types.rs; style numbers with Style::index in style.rs; the
 // lookup bindings with LOOKUP_BINDINGS in gbuffer.rs. Lookups: baked textures where the file has
 // them (flags in `lookups`), the procedural formulas otherwise (gbuffer.rs, "Lookup textures").
-
-struct Frame {
-    clip_from_render: mat4x4<f32>,
-    view_from_render: mat4x4<f32>,
-    camera_position: vec4<f32>, // w = 1: orthographic
-    light_in_view: vec4<f32>,
-    viewport: vec4<f32>,
-    scene_style: u32,
-    use_part_styles: u32,
-    cel_steps: u32,
-    flags: u32,
-    style_params: vec4<f32>, // splash-back alpha, beta; hatch period (px); hatch sharpness c
-}
-
-struct Instance {
-    render_from_object: mat4x4<f32>,
-    normal_col0: vec4<f32>,
-    normal_col1: vec4<f32>,
-    normal_col2: vec4<f32>,
-    label_base: u32,
-    mirrored: u32,
-    label_count: u32,
-    pad: u32,
-}
 
 struct Part {
     projector_row: vec4<f32>,

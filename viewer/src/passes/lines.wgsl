@@ -4,32 +4,8 @@
 // fragment shader, so consecutive segments join without gaps. Hidden parts are discarded by
 // comparing the line's view depth with the G-buffer's linear depth at the nearest point of the
 // segment (and one texel to either side), within a tolerance.
-// Keep the structs in sync with gpu_types.rs (FrameUniforms, InstanceGpu, LineSegmentGpu,
+// Frame and Instance are in shared.wgsl. Keep the structs in sync with gpu_types.rs (FrameUniforms, InstanceGpu, LineSegmentGpu,
 // LinesUniforms) and the class codes (`kind`) with edges::LineClass.
-
-struct Frame {
-    clip_from_render: mat4x4<f32>,
-    view_from_render: mat4x4<f32>,
-    camera_position: vec4<f32>, // w = 1: orthographic
-    light_in_view: vec4<f32>,
-    viewport: vec4<f32>,
-    scene_style: u32,
-    use_part_styles: u32,
-    cel_steps: u32,
-    flags: u32,
-    style_params: vec4<f32>,
-}
-
-struct Instance {
-    render_from_object: mat4x4<f32>,
-    normal_col0: vec4<f32>,
-    normal_col1: vec4<f32>,
-    normal_col2: vec4<f32>,
-    label_base: u32,
-    mirrored: u32,
-    label_count: u32,
-    pad: u32,
-}
 
 struct Segment {
     a: vec3<f32>,

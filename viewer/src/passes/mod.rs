@@ -10,6 +10,22 @@ pub mod lines;
 pub mod shadow;
 pub mod upscale;
 
+/// The WGSL of a pass that draws the scene: `shared.wgsl` (the `Frame` and `Instance` structs,
+/// declared once) followed by the pass's own source.
+macro_rules! shader_source {
+    ($file:literal) => {
+        wgpu::ShaderModuleDescriptor {
+            label: Some($file),
+            source: wgpu::ShaderSource::Wgsl(std::borrow::Cow::Borrowed(concat!(
+                include_str!("shared.wgsl"),
+                "\n",
+                include_str!($file)
+            ))),
+        }
+    };
+}
+pub(crate) use shader_source;
+
 /// A bind group layout entry for a uniform buffer.
 pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages, dynamic: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -119,4 +135,54 @@ pub(crate) fn fullscreen_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    /// Bytes of a WGSL struct of the shared file, from its members' types (the types it uses:
+    /// `mat4x4<f32>`, `vec4<f32>`, `u32`; their uniform/storage layout needs no padding here).
+    fn wgsl_struct_size(name: &str) -> usize {
+        let source = include_str!("shared.wgsl");
+        let start = source.find(&format!("struct {name} {{")).unwrap_or_else(|| panic!("struct {name} in shared.wgsl"));
+        let body = &source[start..];
+        let body = &body[body.find('{').unwrap_or(0) + 1..body.find('}').unwrap_or(0)];
+        body.lines()
+            .filter_map(|line| {
+                line.split("//").next()?.split_once(':').map(|(_, t)| t.trim().trim_end_matches(',').to_string())
+            })
+            .map(|t| match t.as_str() {
+                "mat4x4<f32>" => 64,
+                "vec4<f32>" => 16,
+                "u32" | "f32" => 4,
+                other => panic!("{name}: member type {other} not known to this test"),
+            })
+            .sum()
+    }
+
+    #[test]
+    fn the_shared_structs_match_the_rust_side() {
+        assert_eq!(wgsl_struct_size("Frame"), std::mem::size_of::<crate::gpu_types::FrameUniforms>());
+        assert_eq!(wgsl_struct_size("Instance"), std::mem::size_of::<crate::gpu_types::InstanceGpu>());
+    }
+
+    /// Each shared declaration exists once: no pass declares them again.
+    #[test]
+    fn no_pass_declares_the_shared_structs_again() {
+        let passes = [
+            ("gbuffer.wgsl", include_str!("gbuffer.wgsl")),
+            ("lines.wgsl", include_str!("lines.wgsl")),
+            ("shadow.wgsl", include_str!("shadow.wgsl")),
+            ("display.wgsl", include_str!("display.wgsl")),
+            ("enhance.wgsl", include_str!("enhance.wgsl")),
+            ("upscale.wgsl", include_str!("upscale.wgsl")),
+        ];
+        for (file, source) in passes {
+            for name in ["Frame", "Instance"] {
+                assert!(
+                    !source.contains(&format!("struct {name} {{")),
+                    "{file} declares {name} again: use shared.wgsl"
+                );
+            }
+        }
+    }
 }

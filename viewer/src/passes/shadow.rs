@@ -211,7 +211,7 @@ pub struct ShadowPass {
 impl ShadowPass {
     pub fn new(device: &wgpu::Device) -> ShadowPass {
         use wgpu::ShaderStages as S;
-        let module = device.create_shader_module(wgpu::include_wgsl!("shadow.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("shadow.wgsl"));
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow scene bind group layout"),
             entries: &[storage_entry(0, S::VERTEX)],

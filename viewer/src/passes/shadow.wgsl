@@ -1,18 +1,7 @@
 // Shadow pass: the model flattened onto the ground from a point light. Screen-space layers (hard:
 // 1, umbra + penumbra: 2) accumulate into the mask directly; the soft shadow renders one layer
 // into a top-down ground map and resolves the stack of planes from it (fs_resolve).
-// Keep the structs in sync with gpu_types.rs (Instance, ShadowLayer, Resolve).
-
-struct Instance {
-    render_from_object: mat4x4<f32>,
-    normal_col0: vec4<f32>,
-    normal_col1: vec4<f32>,
-    normal_col2: vec4<f32>,
-    label_base: u32,
-    mirrored: u32,
-    label_count: u32,
-    pad: u32,
-}
+// Frame and Instance are in shared.wgsl. Keep the structs in sync with gpu_types.rs (Instance, ShadowLayer, Resolve).
 
 struct ShadowLayer {
     clip_from_render: mat4x4<f32>,
