@@ -9,7 +9,7 @@
 //! | cel steps (`cel`, `goochel`) | `cel_atlas`: the row whose `steps` and `specular` equal the frame's options | the step function in the shader |
 //! | cool-to-warm (`gooch`, `goochel`) | `cool_to_warm_0` | the Gooch et al. 1998 formula in the shader |
 //! | halftone (`hatch`) | `hatching` + `hatching_mipN`, uploaded as the mip chain | screen-space strokes in the shader |
-//! | metal (`metal`) | `metal_bands`, `metal_highlights` | the viewer's 32-entry table ([`crate::style::metal_table`]) and six lights in the shader |
+//! | metal (`metal`) | `metal_bands`, `metal_highlights` | the bake's band table ([`crate::style::metal_table`]) and six lights in the shader |
 //!
 //! The γ atlas is always a texture (procedural or baked, same slot, same lookup); for the others the
 //! G-buffer binds a 1 × 1 placeholder and a flag tells the shader to compute instead. Every lookup is
@@ -421,12 +421,6 @@ pub fn decode_png(name: &str, bytes: &[u8], format: LookupFormat) -> Result<Look
     };
     LookupImage::new(name, width, height, format, data).ok_or_else(|| LookupError::Layout("short image".into()))
 }
-
-/// `x ∈ [0, 1]` → the nearest 8-bit UNORM value, as drafter-textures quantises.
-fn unorm8(x: f32) -> u8 {
-    if x.is_nan() { 0 } else { (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8 }
-}
-
 /// The procedural γ atlas: row `k` is `TransferCurve::ALL[k]`, texel `j` = γ(j/127) in `f32`
 /// ([`crate::style::transfer_tables`]).
 pub fn procedural_gamma() -> GammaLookup {
@@ -452,7 +446,7 @@ pub fn procedural_metal_bands() -> LookupImage {
         width: table.len() as u32,
         height: 1,
         format: LookupFormat::R8,
-        levels: vec![table.into_iter().map(unorm8).collect()],
+        levels: vec![table.into_iter().map(drafter_textures::unorm8).collect()],
     }
 }
 

@@ -386,30 +386,15 @@ pub fn transfer_index(curve: TransferCurve) -> usize {
     TransferCurve::ALL.iter().position(|&c| c == curve).unwrap_or(0)
 }
 
-/// Entries of the metal band table.
-pub const METAL_TABLE_LEN: usize = 32;
+/// Entries of the metal band table: the bake's ([`drafter_textures::MetalOptions`]' default).
+pub const METAL_TABLE_LEN: usize = drafter_textures::metal::DEFAULT_METAL_TABLE_LEN as usize;
 
-/// Gooch et al. 1999, §5.2.1: a periodic table of random intensities `b + r^e` (b = −0.1,
-/// r uniform in [0, 1], e = 1.4), each entry filtered with its neighbours 1-5-1 and clamped to
-/// [0, 1]. The G-buffer pass wraps it around each part's principal axis when the file has no
-/// baked `metal_bands` (procedural fallback). Deterministic (a fixed xorshift seed) so that images
-/// are reproducible.
+/// Gooch et al. 1999, §5.2.1: the periodic table of filtered random intensities the G-buffer pass
+/// wraps around each part's principal axis when the file has no baked `metal_bands` (procedural
+/// fallback). It is drafter-textures' table with the bake's default options, the rule and seed
+/// the baked texture comes from, so a plain file's metal matches a baked one's.
 pub fn metal_table() -> Vec<f32> {
-    let mut state: u32 = 0x9e37_79b9;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        f64::from(state) / f64::from(u32::MAX)
-    };
-    let raw: Vec<f64> = (0..METAL_TABLE_LEN).map(|_| -0.1 + next().powf(1.4)).collect();
-    let n = raw.len();
-    (0..n)
-        .map(|k| {
-            let v = (raw[(k + n - 1) % n] + 5.0 * raw[k] + raw[(k + 1) % n]) / 7.0;
-            v.clamp(0.0, 1.0) as f32
-        })
-        .collect()
+    drafter_textures::metal_table(&drafter_textures::MetalOptions::default())
 }
 
 #[cfg(test)]
