@@ -184,19 +184,7 @@ fn the_drawing_matches_the_raster_lines_pass() {
     let (w, h) = (size.0 as usize, size.1 as usize);
     let raster_black: Vec<bool> = image.rgba.chunks_exact(4).map(|p| p[0].max(p[1]).max(p[2]) < 48).collect();
     // The drawing's black classes, rasterised by sampling each segment every quarter pixel.
-    let mut drawn = vec![false; w * h];
-    for stroke in drawing.strokes.iter().filter(|s| s.visible && s.class != LineClass::Crease) {
-        for pair in stroke.points.windows(2) {
-            let steps = (pair[0].distance(pair[1]) * 4.0).ceil().max(1.0) as usize;
-            for k in 0..=steps {
-                let p = pair[0] + (pair[1] - pair[0]) * (k as f64 / steps as f64);
-                let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
-                if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-                    drawn[y as usize * w + x as usize] = true;
-                }
-            }
-        }
-    }
+    let drawn = rasterise(&drawing, (w, h), |class| class != LineClass::Crease);
     let near = |mask: &[bool], x: usize, y: usize| {
         let r = 2isize;
         (-r..=r).any(|dy| {
@@ -219,20 +207,7 @@ fn the_drawing_matches_the_raster_lines_pass() {
         (hit as f64 / n.max(1) as f64, n)
     };
     for class in [LineClass::Silhouette, LineClass::Boundary, LineClass::PartBorder] {
-        let mut mask = vec![false; w * h];
-        for stroke in drawing.strokes.iter().filter(|s| s.visible && s.class == class) {
-            for pair in stroke.points.windows(2) {
-                let steps = (pair[0].distance(pair[1]) * 4.0).ceil().max(1.0) as usize;
-                for k in 0..=steps {
-                    let p = pair[0] + (pair[1] - pair[0]) * (k as f64 / steps as f64);
-                    let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
-                    if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-                        mask[y as usize * w + x as usize] = true;
-                    }
-                }
-            }
-        }
-        let (s, n) = share(&mask, &raster_black);
+        let (s, n) = share(&rasterise(&drawing, (w, h), |c| c == class), &raster_black);
         eprintln!("{class:?}: {n} pixels, {:.2}% near the raster's black", 100.0 * s);
     }
     let (drawing_in_raster, drawn_pixels) = share(&drawn, &raster_black);
@@ -249,4 +224,23 @@ fn the_drawing_matches_the_raster_lines_pass() {
     // flanks) are outlines only in the drawing: 90.4% of its black pixels meet the raster's black.
     assert!(drawing_in_raster >= 0.88, "{drawing_in_raster}");
     assert!(raster_in_drawing >= 0.97, "{raster_in_drawing}");
+}
+
+/// The pixels the visible strokes of the classes `keep` accepts pass through (each segment sampled
+/// every quarter pixel).
+fn rasterise(drawing: &drawing::Drawing, (w, h): (usize, usize), keep: impl Fn(LineClass) -> bool) -> Vec<bool> {
+    let mut mask = vec![false; w * h];
+    for stroke in drawing.strokes.iter().filter(|s| s.visible && keep(s.class)) {
+        for pair in stroke.points.windows(2) {
+            let steps = (pair[0].distance(pair[1]) * 4.0).ceil().max(1.0) as usize;
+            for k in 0..=steps {
+                let p = pair[0] + (pair[1] - pair[0]) * (k as f64 / steps as f64);
+                let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
+                if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+                    mask[y as usize * w + x as usize] = true;
+                }
+            }
+        }
+    }
+    mask
 }
