@@ -104,25 +104,13 @@ impl LookupImage {
     }
 }
 
-/// How an environment map is indexed by the eye-space normal (drafter-textures' `envmap`; the spec's
-/// `mapping` / `highlightMapping`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum EnvMapping {
-    /// The whole sphere, octahedral (the bake's default).
-    #[default]
-    Octahedral,
-    /// The front hemisphere as the picture of a lit sphere (a matcap).
-    NormalSphere,
-}
+/// How an environment map is indexed by the eye-space normal: drafter-textures' rule, which the
+/// bake writes (the spec's `mapping` / `highlightMapping`).
+pub use drafter_textures::EnvMapping;
 
-impl EnvMapping {
-    fn parse(name: &str) -> Option<EnvMapping> {
-        match name {
-            "octahedral" => Some(EnvMapping::Octahedral),
-            "normal_sphere" => Some(EnvMapping::NormalSphere),
-            _ => None,
-        }
-    }
+/// The mapping a file names, in the spelling the bake writes (`octahedral`, `normal_sphere`).
+fn parse_mapping(name: &str) -> Option<EnvMapping> {
+    serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()
 }
 
 /// The γ atlas: row `r` holds `curves[r]`.
@@ -328,7 +316,7 @@ impl Decoder<'_> {
             "colour" => Some(false),
             _ => None,
         };
-        match (EnvMapping::parse(&c.mapping), factored, light.try_normalize()) {
+        match (parse_mapping(&c.mapping), factored, light.try_normalize()) {
             (Some(mapping), Some(factored), Some(light_in_eye)) => {
                 Some(CoolToWarmLookup { image, mapping, factored, light_in_eye, splash_back: c.splash_back })
             }
@@ -360,7 +348,7 @@ impl Decoder<'_> {
     fn metal(&mut self, m: &MetalTexture) -> Option<MetalLookup> {
         let bands = self.image(m.bands.index, LookupFormat::R8)?;
         let highlights = self.image(m.highlights.index, LookupFormat::R8)?;
-        match EnvMapping::parse(&m.highlight_mapping) {
+        match parse_mapping(&m.highlight_mapping) {
             Some(mapping) => Some(MetalLookup { bands, highlights, mapping }),
             None => self.reject("metal", format!("highlight mapping {:?} not understood", m.highlight_mapping)),
         }
@@ -476,6 +464,14 @@ mod tests {
             writer.finish().unwrap();
         }
         out
+    }
+
+    #[test]
+    fn mappings_are_read_in_the_bakes_spelling() {
+        assert_eq!(parse_mapping("octahedral"), Some(EnvMapping::Octahedral));
+        assert_eq!(parse_mapping("normal_sphere"), Some(EnvMapping::NormalSphere));
+        assert_eq!(parse_mapping("NormalSphere"), None);
+        assert_eq!(parse_mapping(""), None);
     }
 
     #[test]
