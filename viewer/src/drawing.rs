@@ -2,8 +2,9 @@
 //!
 //! # What is drawn
 //! The lines the raster lines pass draws ([`crate::edges`]): every hard edge of the file (crease,
-//! boundary, part border, non-manifold) and this view's silhouettes, queried from the baked
-//! hierarchies exactly as `drafter render --lines` does, under the same camera ([`Camera::fit`] on
+//! boundary, part border, non-manifold) and this view's silhouettes among the file's candidates,
+//! decided from face normals computed in f64 from the positions (the stored normals are rounded),
+//! under the camera `drafter render --lines` uses ([`Camera::fit`] on
 //! [`Model::frame_points`], the same `--view`, `--ortho`, `--size` and field of view).
 //!
 //! # Visibility, in object space
@@ -216,22 +217,63 @@ fn edge_key(a: Vec3, b: Vec3) -> EdgeKey {
     if ka <= kb { (ka, kb) } else { (kb, ka) }
 }
 
-/// The object-space normals of the faces at each edge of the mesh drawn by `instance` (the batch's
-/// triangles, whose positions are the file's: the hard edges' end points are the same `f32`s).
-fn mesh_edge_faces(model: &Model, instance: u32) -> HashMap<EdgeKey, Vec<DVec3>> {
-    let mut faces: HashMap<EdgeKey, Vec<DVec3>> = HashMap::new();
-    let Some(batch) = model.batches.iter().find(|b| b.instances.contains(&instance)) else { return faces };
-    for t in batch.indices.chunks_exact(3) {
-        let p: Vec<Vec3> = t
-            .iter()
-            .filter_map(|&i| batch.vertices.get(i as usize).map(|v| Vec3::from_array(v.position_in_object)))
-            .collect();
-        if p.len() != 3 {
-            continue;
+/// The normals (f64, unnormalised) of the first two faces met at an edge, and how many faces meet
+/// there.
+#[derive(Clone, Copy, Debug, Default)]
+struct EdgeFaces {
+    normals: [DVec3; 2],
+    count: u32,
+}
+
+impl EdgeFaces {
+    /// The two faces of a manifold edge.
+    fn pair(&self) -> Option<[DVec3; 2]> {
+        (self.count == 2).then_some(self.normals)
+    }
+}
+
+/// A multiplicative hash of the position bits (FxHash's step): the map below is built over every
+/// edge of a mesh, where SipHash cost several times the rest of a drawing of the dragon.
+#[derive(Default)]
+struct EdgeHasher(u64);
+
+impl std::hash::Hasher for EdgeHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u32(u32::from(b));
         }
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.0 = (self.0.rotate_left(5) ^ u64::from(x)).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+}
+
+type EdgeMap = HashMap<EdgeKey, EdgeFaces, std::hash::BuildHasherDefault<EdgeHasher>>;
+
+/// The object-space normals of the faces at each edge of the mesh drawn by `instance` (the batch's
+/// triangles, whose positions are the file's: the hard edges' and candidates' end points are the
+/// same `f32`s).
+fn mesh_edge_faces(model: &Model, instance: u32) -> EdgeMap {
+    let mut faces = EdgeMap::default();
+    let Some(batch) = model.batches.iter().find(|b| b.instances.contains(&instance)) else { return faces };
+    faces.reserve(batch.indices.len() / 2 + 16);
+    for t in batch.indices.chunks_exact(3) {
+        let (Some(p0), Some(p1), Some(p2)) =
+            (batch.vertices.get(t[0] as usize), batch.vertices.get(t[1] as usize), batch.vertices.get(t[2] as usize))
+        else {
+            continue;
+        };
+        let p = [p0, p1, p2].map(|v| Vec3::from_array(v.position_in_object));
         let normal = (p[1].as_dvec3() - p[0].as_dvec3()).cross(p[2].as_dvec3() - p[0].as_dvec3());
         for k in 0..3 {
-            faces.entry(edge_key(p[k], p[(k + 1) % 3])).or_default().push(normal);
+            let entry = faces.entry(edge_key(p[k], p[(k + 1) % 3])).or_default();
+            if entry.count < 2 {
+                entry.normals[entry.count as usize] = normal;
+            }
+            entry.count += 1;
         }
     }
     faces
@@ -253,8 +295,9 @@ fn part_of(model: &Model, instance: u32, t: usize) -> Option<u32> {
 /// view's silhouettes, in world space.
 fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
     let mut edges = Vec::new();
-    for mesh in &model.lines.meshes {
-        let faces = mesh_edge_faces(model, mesh.instances.start);
+    let faces_of: Vec<EdgeMap> =
+        model.lines.meshes.par_iter().map(|mesh| mesh_edge_faces(model, mesh.instances.start)).collect();
+    for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
             let object_from_world =
@@ -264,8 +307,8 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
                 // A crease whose faces turn opposite ways to the viewer lies on the contour: drawn
                 // as a silhouette, as the raster lines pass draws a crease across which the depth
                 // jumps (Gooch et al. 1999 draw every silhouette black and heavy).
-                let class = match (class, faces.get(&edge_key(a, b))) {
-                    (LineClass::Crease, Some(normals)) if normals.len() == 2 => {
+                let class = match (class, faces.get(&edge_key(a, b)).and_then(EdgeFaces::pair)) {
+                    (LineClass::Crease, Some(normals)) => {
                         let middle = (a.as_dvec3() + b.as_dvec3()) * 0.5;
                         let towards = match projection.view {
                             crate::edges::WorldView::Perspective { eye } => {
@@ -292,16 +335,44 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
             }
         }
     }
-    let frame = model.lines.silhouettes(projection.view);
-    let silhouettes = frame.segments.len();
-    for (segment, drawn) in frame.segments.iter().zip(&frame.drawn) {
-        let Some(world) = model.instance_world_from_object.get(segment.instance as usize) else { continue };
-        edges.push(Edge {
-            a: world.transform_point3(Vec3::from_array(segment.a_in_object).as_dvec3()),
-            b: world.transform_point3(Vec3::from_array(segment.b_in_object).as_dvec3()),
-            class: LineClass::Silhouette,
-            part: part_of(model, drawn.instance, (drawn.corner / 3) as usize),
-        });
+    // Silhouettes exactly, from the faces' normals computed in f64 from the positions: the file's
+    // stored normals (and the hierarchies built on them) are rounded, and a face within a few
+    // hundredths of a degree of edge-on can come out facing the other way, which moves a
+    // cylinder's outline one column back (found against OpenCascade, docs/drawing.md). A drawing
+    // is made once, so every candidate is tested. A face exactly edge-on counts as facing away, so
+    // one of its two edges is the outline.
+    let mut silhouettes = 0;
+    for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
+        let Some(candidates) = &mesh.silhouettes else { continue };
+        let normals: Vec<Option<[DVec3; 2]>> =
+            candidates.segments.iter().map(|&[a, b]| faces.get(&edge_key(a, b)).and_then(EdgeFaces::pair)).collect();
+        for instance in mesh.instances.clone() {
+            let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            let object_from_world =
+                model.lines.object_from_world.get(instance as usize).copied().unwrap_or(DMat4::IDENTITY);
+            for (k, (&[a, b], n)) in candidates.segments.iter().zip(&normals).enumerate() {
+                let Some([n1, n2]) = n else { continue };
+                let towards = match projection.view {
+                    crate::edges::WorldView::Perspective { eye } => {
+                        object_from_world.transform_point3(eye) - a.as_dvec3()
+                    }
+                    crate::edges::WorldView::Orthographic { direction } => {
+                        object_from_world.transform_vector3(direction)
+                    }
+                };
+                if (n1.dot(towards) > 0.0) == (n2.dot(towards) > 0.0) {
+                    continue;
+                }
+                silhouettes += 1;
+                let corner = candidates.corners.get(k).copied().unwrap_or(0);
+                edges.push(Edge {
+                    a: world.transform_point3(a.as_dvec3()),
+                    b: world.transform_point3(b.as_dvec3()),
+                    class: LineClass::Silhouette,
+                    part: part_of(model, instance, (corner / 3) as usize),
+                });
+            }
+        }
     }
     (edges, silhouettes)
 }

@@ -244,3 +244,47 @@ fn rasterise(drawing: &drawing::Drawing, (w, h): (usize, usize), keep: impl Fn(L
     }
     mask
 }
+
+/// A 126-sided cylinder seen so that two of its faces are exactly edge-on (found against
+/// OpenCascade's hidden-line removal, docs/drawing.md): the outline is still drawn, on both sides,
+/// and from a view a hair away the same.
+#[test]
+fn a_cylinder_with_faces_edge_on_keeps_its_outline() {
+    let dir = std::env::temp_dir().join(format!("drafter-drawing-cylinder-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    let n = 126;
+    let mut obj = String::new();
+    for k in 0..n {
+        // Columns half a step off the axes: the faces' normals fall on them, two exactly along x.
+        let angle = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
+        let (x, z) = (angle.cos(), angle.sin());
+        obj += &format!("v {x} 0 {z}\nv {x} 3 {z}\n");
+    }
+    obj += "v 0 0 0\nv 0 3 0\n";
+    for k in 0..n {
+        let (a, b) = (2 * k + 1, 2 * ((k + 1) % n) + 1);
+        obj += &format!("f {a} {b} {}\nf {a} {} {}\n", b + 1, b + 1, a + 1);
+        obj += &format!("f {} {b} {a}\nf {} {} {}\n", 2 * n + 1, 2 * n + 2, a + 1, b + 1);
+    }
+    let path = dir.join("cylinder.obj");
+    std::fs::write(&path, obj).expect("write");
+    let model = common::baked(&path);
+    for azimuth in [0.0, 0.001] {
+        let options = DrawOptions {
+            view: View { azimuth_deg: azimuth, elevation_deg: 30.0 },
+            orthographic: true,
+            ..DrawOptions::default()
+        };
+        let drawing = drawing::draw(&model, &options);
+        let outline: f64 = drawing
+            .strokes
+            .iter()
+            .filter(|s| s.visible && s.class == LineClass::Silhouette)
+            .flat_map(|s| s.points.windows(2).map(|p| p[0].distance(p[1])))
+            .sum();
+        assert!(drawing.stats.silhouettes >= 2, "azimuth {azimuth}: {} silhouettes", drawing.stats.silhouettes);
+        // Two sides of the cylinder's height, each several hundred pixels long on an 800 x 600 view.
+        assert!(outline > 600.0, "azimuth {azimuth}: {outline:.0} px of visible outline");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
