@@ -668,8 +668,7 @@ fn fallback_part(id: u32, name: &str, world: &Aabb, origin: DVec3) -> Part {
         v
     };
     let long = order[0];
-    let away = center - origin;
-    let direction = if away[long] < -1e-12 * (away.length() + size[long]) { -axis(long) } else { axis(long) };
+    let direction = drafter_bounds::facing_away(axis(long), center - origin, size[long]);
     let scale = size[long];
     // p = 1/2 + d·(x − a)/s, in render coordinates (x_render = x_world − origin).
     let row = if scale > 1e-12 * (1.0 + center.length()) {

@@ -53,4 +53,4 @@ pub use obb::{
     Coverage, DEFAULT_FACE_NORMALS, DEFAULT_OBB_METHOD, DEFAULT_OPTIMAL_BUDGET, Obb, ObbMethod, ObbOptions, ObbStats,
     aabb, box_with_axes, oriented_box, oriented_box_f32, oriented_box_with_stats, world_points,
 };
-pub use projector::{BIAS_MATRIX, Projector};
+pub use projector::{BIAS_MATRIX, Projector, facing_away};

@@ -50,6 +50,16 @@ pub struct Projector {
     pub scale: f64,
 }
 
+/// The initial projector's sign rule (Lux et al. 2013, §3): `axis` or its opposite, whichever points
+/// away from the scene centre, `offset` being the part's centre minus the scene's; within `1e-12`
+/// of `|offset| + size` of perpendicular (a part at the centre, an axis across the offset) `axis`
+/// keeps its own sign. The bake's projectors and the viewer's stand-in for an unbaked part both use
+/// it.
+pub fn facing_away(axis: DVec3, offset: DVec3, size: f64) -> DVec3 {
+    let tolerance = 1e-12 * (offset.length() + size);
+    if axis.dot(offset) < -tolerance { -axis } else { axis }
+}
+
 impl Projector {
     /// The paper's initial projector for a part with box `obb` in a scene centred at `scene_center`:
     /// anchor = box centre, direction = longest box axis (`obb.axes[0]`) with the sign that points away
@@ -57,12 +67,8 @@ impl Projector {
     /// the box size) at the scene centre or the axis is perpendicular to the offset, the box's canonical
     /// sign is kept (largest world component positive).
     pub fn from_obb(obb: &Obb, scene_center: DVec3) -> Self {
-        let direction = obb.axes[0];
         let scale = 2.0 * obb.half_extents.x;
-        let away = obb.center - scene_center;
-        let along = direction.dot(away);
-        let tol = 1e-12 * (away.length() + scale);
-        let direction = if along < -tol { -direction } else { direction };
+        let direction = facing_away(obb.axes[0], obb.center - scene_center, scale);
         Self { anchor: obb.center, direction, scale }
     }
 
