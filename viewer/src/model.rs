@@ -641,13 +641,13 @@ fn baked_part(record: &PartRecord, origin: DVec3) -> Part {
     // Column-major: row 0 is elements 0, 4, 8, 12.
     let row = DVec4::new(m[0], m[4], m[8], m[12]);
     let transfer = transfer_index(record.gradient.transfer);
-    let style = record.style.map(Style::from);
+    let style = record.style;
     let axes = record.obb.axes.map(|a| [a[0] as f32, a[1] as f32, a[2] as f32, 0.0]);
     let gpu = PartGpu {
         projector_row: render_row(row, origin),
         axes,
         gradient: [record.gradient.q as f32, record.gradient.f as f32, record.gradient.p as f32, transfer as f32],
-        style_hint: style.map_or(NO_STYLE, Style::index),
+        style_hint: style.map_or(NO_STYLE, crate::style::shader_index),
         flags: 0,
         flat: record.flat.map_or(NOT_FLAT, |g| g as f32),
         _pad: 0,

@@ -300,7 +300,7 @@ impl Renderer {
             camera_position: camera.position_in_render.extend(if options.orthographic { 1.0 } else { 0.0 }).to_array(),
             light_in_view: LIGHT_IN_VIEW.normalize().extend(0.0).to_array(),
             viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
-            scene_style: options.style.index(),
+            scene_style: crate::style::shader_index(options.style),
             use_part_styles: u32::from(options.use_part_styles),
             cel_steps: options.cel_steps,
             flags,

@@ -3,97 +3,23 @@
 //! The styles are the ones the `DRAFTER_illustration` spec names as part style hints; see
 //! `passes/gbuffer.wgsl` for the formulas and the papers they come from.
 
-use std::fmt;
-use std::str::FromStr;
-
 use drafter_core::gradient::{IntensityTransfer, TransferCurve};
-use drafter_format::PartStyle;
 
-/// A shading style of the G-buffer pass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Style {
-    /// Projective gradients (Lux et al. 2013): each part's projector gives `p`, the transfer `γ`
-    /// and the gradient function `ω(i, q, f, p)` give a grey value. Independent of light and
-    /// normals. The default.
-    #[default]
-    Gradient,
-    /// Cel shading: the clamped diffuse term in 2–4 steps, optional specular band.
-    Cel,
-    /// Cool-to-warm shading (Gooch et al. 1998/1999), optional splash-back multiplier.
-    Gooch,
-    /// Cel steps over Gooch's full-range `(1 + n·l)/2` (ten Bosch 2005).
-    Goochel,
-    /// Blinn–Phong: the photorealistic reference.
-    Phong,
-    /// Gooch metal: anisotropic bands around the part's principal axis plus highlights.
-    Metal,
-    /// Pen-and-ink hatching: Freudenberg's soft threshold of a halftone against the intensity.
-    Hatch,
-}
+/// A shading style of the G-buffer pass: the format's type, so that the file's style hints, the
+/// frame's style and the CLI's `--style` are one enum.
+pub use drafter_format::{PartStyle as Style, UnknownStyle};
 
-impl Style {
-    /// Every style, in the order of the spec's list.
-    pub const ALL: [Style; 7] =
-        [Style::Gradient, Style::Cel, Style::Gooch, Style::Goochel, Style::Phong, Style::Metal, Style::Hatch];
-
-    /// The name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Style::Gradient => "gradient",
-            Style::Cel => "cel",
-            Style::Gooch => "gooch",
-            Style::Goochel => "goochel",
-            Style::Phong => "phong",
-            Style::Metal => "metal",
-            Style::Hatch => "hatch",
-        }
-    }
-
-    /// The value the shaders switch on (keep in sync with `STYLE_*` in `passes/gbuffer.wgsl`).
-    pub fn index(self) -> u32 {
-        match self {
-            Style::Phong => 0,
-            Style::Gradient => 1,
-            Style::Cel => 2,
-            Style::Gooch => 3,
-            Style::Goochel => 4,
-            Style::Metal => 5,
-            Style::Hatch => 6,
-        }
-    }
-}
-
-impl fmt::Display for Style {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A style name that is not one of [`Style::ALL`].
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown style {0:?}: expected one of gradient, cel, gooch, goochel, phong, metal, hatch")]
-pub struct UnknownStyle(pub String);
-
-/// A part's style hint as the file carries it (the same seven styles).
-impl From<PartStyle> for Style {
-    fn from(style: PartStyle) -> Self {
-        match style {
-            PartStyle::Gradient => Style::Gradient,
-            PartStyle::Cel => Style::Cel,
-            PartStyle::Gooch => Style::Gooch,
-            PartStyle::Goochel => Style::Goochel,
-            PartStyle::Phong => Style::Phong,
-            PartStyle::Metal => Style::Metal,
-            PartStyle::Hatch => Style::Hatch,
-        }
-    }
-}
-
-impl FromStr for Style {
-    type Err = UnknownStyle;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Style::ALL.into_iter().find(|style| style.name() == s).ok_or_else(|| UnknownStyle(s.to_owned()))
+/// The value the shaders switch on for `style` (keep in sync with `STYLE_*` in
+/// `passes/gbuffer.wgsl`).
+pub fn shader_index(style: Style) -> u32 {
+    match style {
+        Style::Phong => 0,
+        Style::Gradient => 1,
+        Style::Cel => 2,
+        Style::Gooch => 3,
+        Style::Goochel => 4,
+        Style::Metal => 5,
+        Style::Hatch => 6,
     }
 }
 
@@ -408,7 +334,7 @@ mod tests {
             assert_eq!(s.name().parse::<Style>(), Ok(s));
         }
         assert!("toon".parse::<Style>().is_err());
-        let mut indices: Vec<u32> = Style::ALL.iter().map(|s| s.index()).collect();
+        let mut indices: Vec<u32> = Style::ALL.iter().map(|&s| shader_index(s)).collect();
         indices.sort_unstable();
         assert_eq!(indices, (0..7).collect::<Vec<_>>());
     }

@@ -1208,7 +1208,7 @@ mod tests {
             seen.push(options.style);
         }
         assert_eq!(options.style, Style::default());
-        seen.sort_by_key(|s| s.index());
+        seen.sort_by_key(|&s| crate::style::shader_index(s));
         assert_eq!(seen.len(), 7);
         seen.dedup();
         assert_eq!(seen.len(), 7, "every style once");

@@ -17,8 +17,8 @@ pub struct Args {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Shading style of the scene; parts with a baked style hint keep theirs (see --uniform-style).
-    #[arg(long, value_enum, default_value_t = StyleArg::Gradient)]
-    pub style: StyleArg,
+    #[arg(long, value_enum, default_value_t = Style::Gradient)]
+    pub style: Style,
     /// Ignore the parts' baked style hints: every part in --style.
     #[arg(long)]
     pub uniform_style: bool,
@@ -68,31 +68,6 @@ pub struct Args {
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum StyleArg {
-    Gradient,
-    Cel,
-    Gooch,
-    Goochel,
-    Phong,
-    Metal,
-    Hatch,
-}
-
-impl From<StyleArg> for Style {
-    fn from(s: StyleArg) -> Style {
-        match s {
-            StyleArg::Gradient => Style::Gradient,
-            StyleArg::Cel => Style::Cel,
-            StyleArg::Gooch => Style::Gooch,
-            StyleArg::Goochel => Style::Goochel,
-            StyleArg::Phong => Style::Phong,
-            StyleArg::Metal => Style::Metal,
-            StyleArg::Hatch => Style::Hatch,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum ShadowArg {
     None,
     Hard,
@@ -129,7 +104,7 @@ impl Args {
         RenderOptions {
             size: self.size,
             supersample: self.supersample,
-            style: self.style.into(),
+            style: self.style,
             use_part_styles: !self.uniform_style,
             view: View { azimuth_deg: self.view.0, elevation_deg: self.view.1 },
             orthographic: self.ortho,

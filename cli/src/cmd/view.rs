@@ -13,7 +13,7 @@ use anyhow::Result;
 use drafter_viewer::window::WindowError;
 use drafter_viewer::{Enhancements, RenderOptions, View};
 
-use crate::cmd::render::{ShadowArg, StyleArg, load};
+use crate::cmd::render::{ShadowArg, load};
 use crate::exit::BadInput;
 
 /// `drafter view --help`'s text after the options: the window's keys, the editing gestures, saving
@@ -49,8 +49,8 @@ pub struct Args {
     /// The model to show: a baked .glb/.gltf, or any glTF, OBJ, STL, OFF, PLY.
     pub file: PathBuf,
     /// Shading style to start with.
-    #[arg(long, value_enum, default_value_t = StyleArg::Gradient)]
-    pub style: StyleArg,
+    #[arg(long, value_enum, default_value_t = drafter_viewer::Style::Gradient)]
+    pub style: drafter_viewer::Style,
     /// Initial window size in pixels, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = crate::cmd::render::parse_size)]
     pub size: (u32, u32),
@@ -78,7 +78,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let options = RenderOptions {
         size: args.size,
-        style: args.style.into(),
+        style: args.style,
         view: View { azimuth_deg: args.view.0, elevation_deg: args.view.1 },
         orthographic: args.ortho,
         enhancements: if args.edges { Enhancements::ALL } else { Enhancements::default() },

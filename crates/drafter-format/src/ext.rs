@@ -247,16 +247,29 @@ pub struct PartRecord {
     pub flat: Option<f64>,
 }
 
-/// A part's shading style hint: the viewer's styles, spelled as in the schema's `style` enum.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// A shading style: a part's style hint in the file (spelled as in the schema's `style` enum), the
+/// style the viewer draws a frame in, and the CLI's `--style` (with the `clap` feature) — one type.
+/// See the viewer's `passes/gbuffer.wgsl` for the formulas and the papers they come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum PartStyle {
+    /// Projective gradients (Lux et al. 2013): each part's projector gives `p`, the transfer `γ`
+    /// and the gradient function `ω(i, q, f, p)` give a grey value. Independent of light and
+    /// normals. The default.
+    #[default]
     Gradient,
+    /// Cel shading: the clamped diffuse term in 2–4 steps, optional specular band.
     Cel,
+    /// Cool-to-warm shading (Gooch et al. 1998/1999), optional splash-back multiplier.
     Gooch,
+    /// Cel steps over Gooch's full-range `(1 + n·l)/2` (ten Bosch 2005).
     Goochel,
+    /// Blinn–Phong: the photorealistic reference.
     Phong,
+    /// Gooch metal: anisotropic bands around the part's principal axis plus highlights.
     Metal,
+    /// Pen-and-ink hatching: Freudenberg's soft threshold of a halftone against the intensity.
     Hatch,
 }
 
@@ -289,6 +302,19 @@ impl PartStyle {
 impl std::fmt::Display for PartStyle {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+/// A style name that is not one of [`PartStyle::ALL`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown style {0:?}: expected one of gradient, cel, gooch, goochel, phong, metal, hatch")]
+pub struct UnknownStyle(pub String);
+
+impl std::str::FromStr for PartStyle {
+    type Err = UnknownStyle;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        PartStyle::ALL.into_iter().find(|style| style.name() == s).ok_or_else(|| UnknownStyle(s.to_owned()))
     }
 }
 

@@ -27,7 +27,7 @@ pub use ext::{
     ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION, GaussMapRecord, GradientRecord, GradientTexture,
     HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture, NodeExtension, NormalsInfo, ObbMethod,
     PartRecord, PartStyle, PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef,
-    TexturesRecord, TransferCurve,
+    TexturesRecord, TransferCurve, UnknownStyle,
 };
 pub use external::external_buffers;
 pub use reader::{

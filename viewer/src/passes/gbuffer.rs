@@ -110,7 +110,7 @@ pub const ALL_STYLES: u32 = (1 << Style::ALL.len()) - 1;
 /// The styles a frame draws, bit [`Style::index`] each: the scene's style when part styles are off
 /// (or some part has no hint), and every part's hint (`part_hints`, the same bits) when they are on.
 pub fn frame_styles(options: &RenderOptions, part_hints: u32, unhinted_parts: bool) -> u32 {
-    let scene = 1 << options.style.index();
+    let scene = 1 << crate::style::shader_index(options.style);
     if !options.use_part_styles {
         return scene;
     }
@@ -517,10 +517,10 @@ mod tests {
 
     #[test]
     fn a_frame_compiles_in_the_styles_it_can_draw_and_no_other() {
-        let hatch = 1 << Style::Hatch.index();
-        let metal = 1 << Style::Metal.index();
+        let hatch = 1 << crate::style::shader_index(Style::Hatch);
+        let metal = 1 << crate::style::shader_index(Style::Metal);
         let gradient = RenderOptions { style: Style::Gradient, ..Default::default() };
-        let scene = 1 << Style::Gradient.index();
+        let scene = 1 << crate::style::shader_index(Style::Gradient);
         // Part styles off: the scene's style whatever the hints.
         let off = RenderOptions { use_part_styles: false, ..gradient.clone() };
         assert_eq!(frame_styles(&off, hatch | metal, true), scene);
@@ -530,6 +530,6 @@ mod tests {
         assert_eq!(frame_styles(&on, hatch, true), hatch | scene);
         assert_eq!(frame_styles(&on, 0, true), scene);
         assert!(ALL_STYLES.count_ones() as usize == Style::ALL.len());
-        assert!(Style::ALL.iter().all(|s| ALL_STYLES & (1 << s.index()) != 0));
+        assert!(Style::ALL.iter().all(|s| ALL_STYLES & (1 << crate::style::shader_index(*s)) != 0));
     }
 }
