@@ -258,7 +258,7 @@ type EdgeMap = HashMap<EdgeKey, EdgeFaces, std::hash::BuildHasherDefault<EdgeHas
 /// same `f32`s).
 fn mesh_edge_faces(model: &Model, instance: u32) -> EdgeMap {
     let mut faces = EdgeMap::default();
-    let Some(batch) = model.batches.iter().find(|b| b.instances.contains(&instance)) else { return faces };
+    let Some(batch) = batch_of(model, instance) else { return faces };
     faces.reserve(batch.indices.len() / 2 + 16);
     for t in batch.indices.chunks_exact(3) {
         let (Some(p0), Some(p1), Some(p2)) =
@@ -279,9 +279,14 @@ fn mesh_edge_faces(model: &Model, instance: u32) -> EdgeMap {
     faces
 }
 
-/// The part of mesh triangle `t` drawn by `instance`.
-fn part_of(model: &Model, instance: u32, t: usize) -> Option<u32> {
-    let batch = model.batches.iter().find(|b| b.instances.contains(&instance))?;
+/// The batch that draws `instance` (looked up once per instance, not per edge).
+fn batch_of(model: &Model, instance: u32) -> Option<&crate::model::Batch> {
+    model.batches.iter().find(|b| b.instances.contains(&instance))
+}
+
+/// The part of mesh triangle `t` drawn by `instance` through `batch`.
+fn part_of(model: &Model, batch: Option<&crate::model::Batch>, instance: u32, t: usize) -> Option<u32> {
+    let batch = batch?;
     let v = *batch.indices.get(3 * t)? as usize;
     let label = batch.vertices.get(v)?.label;
     let gpu = model.instances.get(instance as usize)?;
@@ -300,10 +305,11 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
     for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            let batch = batch_of(model, instance);
             let object_from_world =
                 model.lines.object_from_world.get(instance as usize).copied().unwrap_or(DMat4::IDENTITY);
             for (k, &([a, b], class)) in mesh.hard.iter().enumerate() {
-                let part = mesh.hard_triangles.get(k).and_then(|&t| part_of(model, instance, t as usize));
+                let part = mesh.hard_triangles.get(k).and_then(|&t| part_of(model, batch, instance, t as usize));
                 // A crease whose faces turn opposite ways to the viewer lies on the contour: drawn
                 // as a silhouette, as the raster lines pass draws a crease across which the depth
                 // jumps (Gooch et al. 1999 draw every silhouette black and heavy).
@@ -348,6 +354,7 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
             candidates.segments.iter().map(|&[a, b]| faces.get(&edge_key(a, b)).and_then(EdgeFaces::pair)).collect();
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
+            let batch = batch_of(model, instance);
             let object_from_world =
                 model.lines.object_from_world.get(instance as usize).copied().unwrap_or(DMat4::IDENTITY);
             for (k, (&[a, b], n)) in candidates.segments.iter().zip(&normals).enumerate() {
@@ -369,7 +376,7 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
                     a: world.transform_point3(a.as_dvec3()),
                     b: world.transform_point3(b.as_dvec3()),
                     class: LineClass::Silhouette,
-                    part: part_of(model, instance, (corner / 3) as usize),
+                    part: part_of(model, batch, instance, (corner / 3) as usize),
                 });
             }
         }
