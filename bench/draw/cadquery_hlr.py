@@ -289,33 +289,31 @@ def drafter_paths(path):
 # Comparison
 
 
+def _cut(pl, step, offset):
+    """Points at `offset` (0: start, 0.5: middle) of each piece of a polyline cut into pieces of at
+    most `step`, and the pieces' lengths."""
+    a, b = pl[:-1], pl[1:]
+    seg = np.linalg.norm(b - a, axis=1)
+    n = np.maximum(1, np.ceil(seg / step)).astype(int)
+    idx = np.repeat(np.arange(len(seg)), n)
+    k = np.concatenate([np.arange(m) for m in n]) if len(n) else np.zeros(0)
+    t = (k + offset) / n[idx]
+    return a[idx] + (b[idx] - a[idx]) * t[:, None], seg[idx] / n[idx]
+
+
 def pieces(lines, step):
     """Midpoints and lengths of every polyline cut into pieces of at most `step`."""
-    mids, lens = [], []
-    for pl in lines:
-        a, b = pl[:-1], pl[1:]
-        seg = np.linalg.norm(b - a, axis=1)
-        n = np.maximum(1, np.ceil(seg / step)).astype(int)
-        idx = np.repeat(np.arange(len(seg)), n)
-        k = np.concatenate([np.arange(m) for m in n]) if len(n) else np.zeros(0)
-        t = (k + 0.5) / n[idx]
-        mids.append(a[idx] + (b[idx] - a[idx]) * t[:, None])
-        lens.append(seg[idx] / n[idx])
-    if not mids:
+    cut = [_cut(pl, step, 0.5) for pl in lines]
+    if not cut:
         return np.zeros((0, 2)), np.zeros(0)
-    return np.concatenate(mids), np.concatenate(lens)
+    return np.concatenate([m for m, _ in cut]), np.concatenate([l for _, l in cut])
 
 
 def samples(lines, step):
+    """Every polyline's points at most `step` apart, its last point included."""
     pts = []
     for pl in lines:
-        a, b = pl[:-1], pl[1:]
-        seg = np.linalg.norm(b - a, axis=1)
-        n = np.maximum(1, np.ceil(seg / step)).astype(int)
-        idx = np.repeat(np.arange(len(seg)), n)
-        k = np.concatenate([np.arange(m) for m in n]) if len(n) else np.zeros(0)
-        t = k / n[idx]
-        pts.append(a[idx] + (b[idx] - a[idx]) * t[:, None])
+        pts.append(_cut(pl, step, 0.0)[0])
         pts.append(pl[-1:])
     return np.concatenate(pts) if pts else np.zeros((0, 2))
 
