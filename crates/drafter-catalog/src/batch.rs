@@ -432,7 +432,7 @@ pub fn run(
     } else {
         std::thread::scope(|scope| {
             for _ in 0..workers {
-                scope.spawn(&work);
+                scope.spawn(work);
             }
         });
     }
