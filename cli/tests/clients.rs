@@ -199,7 +199,7 @@ fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
 /// `q`: the file a writer would make that stored them in the world space of an instance rotated by
 /// `q` instead of the mesh's own space.
 fn with_normals_rotated(baked: &[u8], q: [f64; 4]) -> Vec<u8> {
-    let chunks = drafter_core::glb::split(baked).expect("a GLB");
+    let chunks = drafter_format::glb::split(baked).expect("a GLB");
     let json: Value = serde_json::from_slice(chunks.json).expect("json");
     let mut bin = chunks.bin.expect("a BIN chunk").to_vec();
     let mut turned = 0;
@@ -230,7 +230,7 @@ fn with_normals_rotated(baked: &[u8], q: [f64; 4]) -> Vec<u8> {
         }
     }
     assert!(turned > 0, "no silhouette normals in the file");
-    drafter_core::glb::write(&serde_json::to_vec(&json).expect("json"), &bin).expect("GLB")
+    drafter_format::glb::write(&serde_json::to_vec(&json).expect("json"), &bin).expect("GLB")
 }
 
 /// Red pixels of one upright cylinder in a CesiumJS shot, in the columns `x0..=x1`: on its left and

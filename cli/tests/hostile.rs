@@ -135,7 +135,7 @@ fn truncated_files() {
     assert_rejected(&write(&dir, "cut.gltf", &gltf[..gltf.len() / 2]), "line");
     // A GLB whose header claims more bytes than the file has: a valid container (drafter-core's
     // writer) with its total length field overwritten.
-    let mut glb = drafter_core::glb::write(b"{}", &[0u8; 8]).expect("glb");
+    let mut glb = drafter_format::glb::write(b"{}", &[0u8; 8]).expect("glb");
     glb[8..12].copy_from_slice(&1_000_000u32.to_le_bytes());
     assert_rejected(&write(&dir, "cut.glb", &glb), "GLB");
     assert_rejected(&write(&dir, "cut.off", b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n"), "line");

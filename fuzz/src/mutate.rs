@@ -471,15 +471,15 @@ fn stl_binary_header(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
 /// Mutates the JSON chunk of a .glb (or its BIN chunk's bytes) and frames it again; a file that
 /// does not split gets a byte mutation.
 fn mutate_glb_json(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
-    let Ok(chunks) = drafter_core::glb::split(bytes) else { return mutate_bytes(bytes, &[], rng) };
+    let Ok(chunks) = drafter_format::glb::split(bytes) else { return mutate_bytes(bytes, &[], rng) };
     let json = mutate_json_text(chunks.json, rng);
-    drafter_core::glb::write(&json, chunks.bin.unwrap_or_default()).unwrap_or_else(|_| bytes.to_vec())
+    drafter_format::glb::write(&json, chunks.bin.unwrap_or_default()).unwrap_or_else(|_| bytes.to_vec())
 }
 
 fn mutate_glb_bin(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
-    let Ok(chunks) = drafter_core::glb::split(bytes) else { return mutate_bytes(bytes, &[], rng) };
+    let Ok(chunks) = drafter_format::glb::split(bytes) else { return mutate_bytes(bytes, &[], rng) };
     let bin = mutate_bytes(chunks.bin.unwrap_or_default(), &[], rng);
-    drafter_core::glb::write(chunks.json, &bin).unwrap_or_else(|_| bytes.to_vec())
+    drafter_format::glb::write(chunks.json, &bin).unwrap_or_else(|_| bytes.to_vec())
 }
 
 /// Keys whose integer values index another array of the document.

@@ -125,7 +125,7 @@ fn data_uri(bin: &[u8]) -> String {
 
 /// A .glb as a .gltf whose buffer 0 is a data URI.
 fn glb_to_gltf(bytes: &[u8]) -> Option<Vec<u8>> {
-    let chunks = drafter_core::glb::split(bytes).ok()?;
+    let chunks = drafter_format::glb::split(bytes).ok()?;
     let mut doc: serde_json::Value = serde_json::from_slice(chunks.json).ok()?;
     let buffer = doc.get_mut("buffers")?.get_mut(0)?.as_object_mut()?;
     buffer.insert("uri".into(), data_uri(chunks.bin.unwrap_or_default()).into());
@@ -394,7 +394,7 @@ fn features(corpus: &mut Corpus) {
         }]
     });
     let json = serde_json::to_vec(&doc).unwrap_or_default();
-    if let Ok(glb) = drafter_core::glb::write(&json, &bin) {
+    if let Ok(glb) = drafter_format::glb::write(&json, &bin) {
         if let Some(gltf) = glb_to_gltf(&glb) {
             corpus.add(Target::Gltf, "generated:features (as .gltf)", gltf);
         }

@@ -30,7 +30,7 @@ fn split(target: Target, bytes: &[u8]) -> Option<(Value, Option<Vec<u8>>)> {
     match target {
         Target::Gltf => Some((serde_json::from_slice(bytes).ok()?, None)),
         _ => {
-            let chunks = drafter_core::glb::split(bytes).ok()?;
+            let chunks = drafter_format::glb::split(bytes).ok()?;
             Some((serde_json::from_slice(chunks.json).ok()?, Some(chunks.bin.unwrap_or_default().to_vec())))
         }
     }
@@ -40,7 +40,7 @@ fn join(doc: &Value, bin: Option<&[u8]>) -> Vec<u8> {
     let json = serde_json::to_vec(doc).expect("json");
     match bin {
         None => json,
-        Some(bin) => drafter_core::glb::write(&json, bin).expect("glb"),
+        Some(bin) => drafter_format::glb::write(&json, bin).expect("glb"),
     }
 }
 

@@ -5,7 +5,7 @@
 //! Layout of the BIN chunk: per mesh, positions, normals, then indices, each in its own buffer view (targets
 //! ARRAY_BUFFER / ELEMENT_ARRAY_BUFFER) starting on a 4-byte boundary; accessors start at offset 0 of their view.
 //! Indices are u16 when every index fits below 65535 (the restart value a primitive must not use), else u32.
-//! The container is framed by `drafter_core::glb::write` (the workspace's one GLB writer): the JSON chunk padded
+//! The container is framed by `drafter_format::glb::write` (the workspace's one GLB writer): the JSON chunk padded
 //! with spaces, the BIN chunk with zeros, both to 4 bytes.
 //!
 //! Determinism: JSON objects are built with keys inserted in sorted order (see [`object`]), so the bytes are the
@@ -181,7 +181,7 @@ impl Document {
         top.retain(|(_, value)| value.as_array().is_none_or(|a| !a.is_empty()));
         let json = object(top).to_string().into_bytes();
         // The samples are a few kilobytes, far below the container's 4 GiB limit.
-        drafter_core::glb::write(&json, &bin.data).expect("a sample fits in a GLB")
+        drafter_format::glb::write(&json, &bin.data).expect("a sample fits in a GLB")
     }
 }
 

@@ -30,7 +30,7 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
 /// Reads a sample back through drafter-core's GLB framer, checking what the samples promise beyond a valid
 /// container: the declared length is the file's, both chunks are padded to 4 bytes and nothing follows BIN.
 fn read_glb(bytes: &[u8]) -> Glb {
-    let chunks = drafter_core::glb::split(bytes).expect("valid GLB container");
+    let chunks = drafter_format::glb::split(bytes).expect("valid GLB container");
     assert_eq!(u32_at(bytes, 8) as usize, bytes.len(), "declared length");
     assert_eq!(chunks.json.len() % 4, 0, "JSON chunk padded to 4 bytes");
     let json: Value = serde_json::from_slice(chunks.json).expect("JSON chunk parses");

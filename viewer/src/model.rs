@@ -151,7 +151,7 @@ impl Model {
     pub fn load_bytes_within(path: &Path, bytes: &[u8], limits: &drafter_io::Limits) -> Result<Model, LoadError> {
         // A compressed GLB (EXT_meshopt_compression) is decoded once, and everything below reads
         // the plain bytes; a stream that does not decode is reported by the import.
-        let plain = drafter_core::meshopt::decompress_glb(bytes).ok().flatten();
+        let plain = drafter_format::meshopt::decompress_glb(bytes).ok().flatten();
         let bytes = plain.as_deref().unwrap_or(bytes);
         let imported = drafter_io::import_bytes_within(path, bytes, limits)?;
         let baked = read_baked(path, bytes)?;

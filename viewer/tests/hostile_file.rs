@@ -13,10 +13,10 @@ fn a_huge_part_count_is_not_allocated() {
     let baked = drafter_bake::bake(&imported.scene, &drafter_bake::BakeConfig::default()).expect("bakes");
     let honest = Model::load_bytes(Path::new("honest.glb"), &baked.written.main).expect("loads");
 
-    let chunks = drafter_core::glb::split(&baked.written.main).expect("glb");
+    let chunks = drafter_format::glb::split(&baked.written.main).expect("glb");
     let mut json: serde_json::Value = serde_json::from_slice(chunks.json).expect("json");
     json["extensions"][drafter_format::EXTENSION]["partCount"] = 4_000_000_000u32.into();
-    let lying = drafter_core::glb::write(&serde_json::to_vec(&json).expect("json"), chunks.bin.unwrap_or_default())
+    let lying = drafter_format::glb::write(&serde_json::to_vec(&json).expect("json"), chunks.bin.unwrap_or_default())
         .expect("glb");
     let model = Model::load_bytes(Path::new("lying.glb"), &lying).expect("loads");
     assert_eq!(model.parts.len(), honest.parts.len());

@@ -104,7 +104,7 @@ pub enum Compression {
     #[default]
     None,
     /// `EXT_meshopt_compression` on the buffer views where it pays (lossless codecs, see
-    /// `drafter_core::meshopt`), on a scene reordered for them (`reorder.rs` in this crate), with
+    /// `drafter_format::meshopt`), on a scene reordered for them (`reorder.rs` in this crate), with
     /// shading normals as bytes (`KHR_mesh_quantization`); readers need the extension (three.js with its MeshoptDecoder,
     /// CesiumJS, gltfpack, our own). GLB output only.
     Meshopt,

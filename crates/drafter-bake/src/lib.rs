@@ -86,7 +86,7 @@ pub struct BakeReport {
     pub sections: drafter_format::ByteSections,
     /// What `--compress` did (absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub compression: Option<drafter_core::meshopt::CompressionStats>,
+    pub compression: Option<drafter_format::meshopt::CompressionStats>,
     /// What the normal stage did, summed over unique meshes (absent when it was off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normals: Option<NormalsSummary>,
@@ -314,7 +314,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     let compression = match (config.compress, &config.container) {
         (Compression::None, _) => None,
         (Compression::Meshopt, Container::Glb) => {
-            let (main, stats) = drafter_core::meshopt::compress_glb(&written.main)
+            let (main, stats) = drafter_format::meshopt::compress_glb(&written.main)
                 .map_err(|e| BakeError::Internal { stage: "write", message: format!("compression: {e}") })?;
             written.main = main;
             Some(stats)

@@ -84,7 +84,7 @@ fn no_written_primitive_has_an_all_zero_bitfield() {
     for compress in [drafter_bake::Compression::None, drafter_bake::Compression::Meshopt] {
         let config = drafter_bake::BakeConfig { compress, ..Default::default() };
         let baked = drafter_bake::bake(&imported.scene, &config).expect("bake");
-        let plain = drafter_core::meshopt::decompress_glb(&baked.written.main).expect("decode");
+        let plain = drafter_format::meshopt::decompress_glb(&baked.written.main).expect("decode");
         let bytes = plain.as_deref().unwrap_or(&baked.written.main);
         let written: Vec<_> = visibility_bytes(bytes).into_iter().filter_map(|(p, v)| v.map(|v| (p, v))).collect();
         assert!(!written.is_empty());

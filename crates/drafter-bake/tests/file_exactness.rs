@@ -197,9 +197,10 @@ fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
     assert!(input == triangles(&sa) && input == triangles(&sb), "the baked triangles are the input's");
     // NORMAL is normalized bytes in the compressed file (KHR_mesh_quantization, required), each
     // a unit vector within the validator's tolerance, near the plain file's.
-    let plain_glb = drafter_core::meshopt::decompress_glb(&packed.written.main).expect("decodes").expect("compressed");
+    let plain_glb =
+        drafter_format::meshopt::decompress_glb(&packed.written.main).expect("decodes").expect("compressed");
     let json: serde_json::Value =
-        serde_json::from_slice(drafter_core::glb::split(&plain_glb).expect("a GLB").json).expect("JSON");
+        serde_json::from_slice(drafter_format::glb::split(&plain_glb).expect("a GLB").json).expect("JSON");
     let required: Vec<&str> =
         json["extensionsRequired"].as_array().expect("required list").iter().filter_map(|v| v.as_str()).collect();
     assert!(required.contains(&"KHR_mesh_quantization"), "{required:?}");

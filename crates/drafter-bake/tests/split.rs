@@ -104,7 +104,7 @@ fn model_glb() -> Vec<u8> {
         "bufferViews": views,
         "accessors": accessors,
     });
-    drafter_core::glb::write(doc.to_string().as_bytes(), &bin).expect("glb")
+    drafter_format::glb::write(doc.to_string().as_bytes(), &bin).expect("glb")
 }
 
 /// The same mesh as a scene without a glTF document (as OBJ input is).

@@ -472,7 +472,7 @@ fn input_size(path: &Path) -> u64 {
     own + crate::cache::gltf_file_uris(&text)
         .0
         .into_iter()
-        .filter_map(|uri| drafter_core::uri::relative_path(&uri).ok())
+        .filter_map(|uri| drafter_format::uri::relative_path(&uri).ok())
         .map(|relative: PathBuf| std::fs::metadata(folder.join(relative)).map_or(0, |m| m.len()))
         .sum::<u64>()
 }

@@ -157,9 +157,9 @@ fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &draf
     h.update(input_digest);
     for uri in uris {
         let folder = path.parent().unwrap_or(Path::new(""));
-        let content_digest = match drafter_io::resolve_buffer_uri(folder, uri).ok()? {
-            drafter_io::UriSource::Data(bytes) => digest(&bytes),
-            drafter_io::UriSource::File { path, .. } => {
+        let content_digest = match drafter_format::uri::resolve_buffer_uri(folder, uri).ok()? {
+            drafter_format::uri::UriSource::Data(bytes) => digest(&bytes),
+            drafter_format::uri::UriSource::File { path, .. } => {
                 let mut file = blake3::Hasher::new();
                 hash_file(&mut file, &path).ok()?;
                 *file.finalize().as_bytes()
@@ -185,8 +185,8 @@ fn hash_file(hasher: &mut blake3::Hasher, path: &Path) -> std::io::Result<()> {
 /// The JSON of a glTF's bytes: a GLB's first chunk, or the bytes themselves (empty for a GLB whose
 /// container is malformed: the import refuses it anyway).
 fn json_of(bytes: &[u8]) -> &[u8] {
-    if drafter_core::glb::is_glb(bytes) {
-        drafter_core::glb::split(bytes).map_or(&[], |chunks| chunks.json)
+    if drafter_format::glb::is_glb(bytes) {
+        drafter_format::glb::split(bytes).map_or(&[], |chunks| chunks.json)
     } else {
         bytes
     }
@@ -200,7 +200,7 @@ fn json_of_file(path: &Path) -> std::io::Result<Vec<u8>> {
     let size = file.metadata()?.len();
     let mut head = Vec::with_capacity(20);
     (&mut file).take(20).read_to_end(&mut head)?;
-    if drafter_core::glb::is_glb(&head) && head.len() == 20 {
+    if drafter_format::glb::is_glb(&head) && head.len() == 20 {
         // The header's length and the JSON chunk's as `glb::split` checks them; a container sound
         // here but refused there (or the reverse) only costs a key that a single bake of the same
         // file would not share, and such a file fails its bake anyway.

@@ -31,7 +31,7 @@ pub fn listed_triangles(path: &Path, bytes: &[u8]) -> u64 {
     };
     use drafter_core::SourceFormat as F;
     match format {
-        F::Glb => drafter_core::glb::split(bytes).map_or(0, |c| gltf_triangles(c.json)),
+        F::Glb => drafter_format::glb::split(bytes).map_or(0, |c| gltf_triangles(c.json)),
         F::Gltf => gltf_triangles(bytes),
         F::Stl => binary_stl_triangles(bytes).unwrap_or(bytes.len() as u64 / 250),
         F::Ply => header_count(bytes, b"element face").min(bytes.len() as u64 / 3),

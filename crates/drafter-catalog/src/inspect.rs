@@ -37,7 +37,7 @@ pub struct Report {
     /// `EXT_meshopt_compression`: views encoded and their bytes (`file_bytes_before`: the file
     /// decoded); absent for a plain file.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub compression: Option<drafter_core::meshopt::CompressionStats>,
+    pub compression: Option<drafter_format::meshopt::CompressionStats>,
 }
 
 /// What a baked file carries: the root extension and every part, by id.
@@ -129,13 +129,13 @@ pub fn inspect_bytes(path: &Path, bytes: &[u8], limits: &drafter_io::Limits, wel
     let imported = drafter_io::import_bytes_within(path, bytes, limits)?;
     let mut report = build_report(&path.display().to_string(), &imported.scene, imported.diagnostics, weld);
     // A compressed GLB: what is encoded, then the baked data from the decoded bytes.
-    let json = drafter_core::glb::split(bytes).ok().map(|c| c.json);
-    report.compression = json.and_then(drafter_core::meshopt::describe).map(|mut stats| {
+    let json = drafter_format::glb::split(bytes).ok().map(|c| c.json);
+    report.compression = json.and_then(drafter_format::meshopt::describe).map(|mut stats| {
         stats.file_bytes_after = bytes.len() as u64;
         stats
     });
     let plain = match report.compression {
-        Some(_) => drafter_core::meshopt::decompress_glb(bytes)
+        Some(_) => drafter_format::meshopt::decompress_glb(bytes)
             .map_err(|e| Error::Input(format!("{}: {e}", path.display())))?,
         None => None,
     };

@@ -7,24 +7,19 @@
 //!   deterministic.
 //! * [`gradient`]: the gradient function ω(i, q, f, p) and intensity transfer γ of Lux et al. 2013,
 //!   shared by the stages that bake them (bounds, textures) and the viewer that evaluates them.
-//! * [`glb`]: the binary glTF container, split and written in one place; [`uri`]: which glTF buffer
-//!   URIs may be followed. Pure byte- and string-level code shared by the importer and the format.
 //! * [`Diagnostic`]: recoverable problems of the input, aggregated by kind with a count and a first
 //!   example. Flawed input is data, not a failure.
 //!
 //! Invariant: nothing in this crate reads or writes files.
 
 mod diagnostic;
-pub mod glb;
 pub mod gradient;
 mod ids;
-pub mod meshopt;
 mod obb_method;
 mod param;
 mod scene;
 pub mod snorm;
 mod topology;
-pub mod uri;
 
 pub use diagnostic::{Diagnostic, DiagnosticKind, DiagnosticSummary, Diagnostics, summarize, thousands};
 pub use ids::{EdgeId, InstanceId, MaterialId, MeshId, NodeId, PartId};

@@ -547,7 +547,7 @@ impl Doc {
         self.set_buffer(None);
         let tree = std::mem::take(&mut self.json);
         let json = serde_json::to_vec(&NodeExtensions::over(&tree, name, node_extension))?;
-        let glb = drafter_core::glb::write(&json, &self.bin).map_err(FormatError::from)?;
+        let glb = crate::glb::write(&json, &self.bin).map_err(FormatError::from)?;
         let sections = sections_of(&tree, json.len().next_multiple_of(4) as u64, glb.len() as u64);
         Ok((glb, sections))
     }

@@ -95,8 +95,8 @@ pub fn replace_part_records(bytes: &[u8], records: &[PartRecord]) -> Result<Vec<
     }
     out.push_str(&text[at..]);
     match bin {
-        _ if !drafter_core::glb::is_glb(bytes) => Ok(out.into_bytes()),
-        bin => Ok(drafter_core::glb::write(out.as_bytes(), bin.unwrap_or(&[]))?),
+        _ if !crate::glb::is_glb(bytes) => Ok(out.into_bytes()),
+        bin => Ok(crate::glb::write(out.as_bytes(), bin.unwrap_or(&[]))?),
     }
 }
 

@@ -2,10 +2,9 @@
 //! `Fn(uri) -> Option<bytes>`, and [`external_buffers`] is the loader every reader of baked files
 //! (`drafter inspect`, the viewer) passes, so none of them joins URIs onto folders itself.
 //!
-//! The rule is the importer's, and so is the code: drafter-io's `read_buffer_uri` (the crate that
-//! reads input files) decodes `data:` base64 URIs and follows relative references only inside the
-//! file's folder (`drafter_core::uri` checks the string; the joined path is canonicalized, symbolic
-//! links followed, and must still lie inside the canonical folder).
+//! The rule is the importer's, and so is the code: [`crate::uri::read_buffer_uri`] decodes `data:`
+//! base64 URIs and follows relative references only inside the file's folder (the string checked,
+//! the joined path canonicalized, symbolic links followed, and still inside the canonical folder).
 
 use std::path::{Path, PathBuf};
 
@@ -14,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// buffer it cannot load.
 pub fn external_buffers(path: &Path) -> impl Fn(&str) -> Option<Vec<u8>> + use<> {
     let folder = folder_of(path);
-    move |uri: &str| drafter_io::read_buffer_uri(&folder, uri).ok()
+    move |uri: &str| crate::uri::read_buffer_uri(&folder, uri).ok()
 }
 
 /// The folder a file's relative URIs resolve against (`.` for a bare file name).
@@ -54,7 +53,7 @@ mod tests {
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(dir.join("secret.bin"), inner.join("link.bin")).expect("symlink");
-            let refused = drafter_io::read_buffer_uri(&inner, "link.bin").expect_err("a link out of the folder");
+            let refused = crate::uri::read_buffer_uri(&inner, "link.bin").expect_err("a link out of the folder");
             assert!(refused.contains("symbolic link"), "{refused}");
             std::os::unix::fs::symlink(inner.join("sub/c.bin"), inner.join("inner-link.bin")).expect("symlink");
             assert_eq!(load("inner-link.bin"), Some(vec![3]));

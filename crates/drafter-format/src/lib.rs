@@ -8,17 +8,25 @@
 //! * [`replace_part_records`] writes an illustrator's edited part records back into a baked file,
 //!   every other byte unchanged (`drafter view`'s save);
 //! * [`external_buffers`] is the loader of a baked .gltf's buffer those readers take, confined to the
-//!   file's folder; [`split_container`] frames a .glb through `drafter_core::glb`.
+//!   file's folder; [`split_container`] frames a .glb through [`glb`].
+//! * [`glb`] is the workspace's one GLB framer (split and write), [`meshopt`] its one
+//!   `EXT_meshopt_compression` codec (`compress_glb` for `bake --compress`, `decompress_glb` in front
+//!   of every reader), [`uri`] its one rule for which buffer URIs may be followed and how they are
+//!   read; the importer (drafter-io), inspect, the viewer and the bake all go through them.
 //!
 //! Invariant: this is the only crate that knows the file format. The extension is listed in
 //! `extensionsUsed` and never in `extensionsRequired`, so any glTF viewer opens the result as a plain
 //! model; everything of a glTF input that the scene model does not represent passes through.
 
+pub mod accessor;
 mod doc;
 mod edit;
 pub mod ext;
 mod external;
+pub mod glb;
+pub mod meshopt;
 mod reader;
+pub mod uri;
 mod writer;
 
 pub use edit::{replace_part_records, validate as validate_part_record};
@@ -63,11 +71,11 @@ pub enum FormatError {
     Version(String),
 }
 
-impl From<drafter_core::glb::GlbError> for FormatError {
-    fn from(e: drafter_core::glb::GlbError) -> Self {
+impl From<glb::GlbError> for FormatError {
+    fn from(e: crate::glb::GlbError) -> Self {
         match e {
-            drafter_core::glb::GlbError::TooLarge(total) => Self::TooLarge(total),
-            malformed @ drafter_core::glb::GlbError::Malformed { .. } => Self::Invalid(malformed.to_string()),
+            glb::GlbError::TooLarge(total) => Self::TooLarge(total),
+            malformed @ glb::GlbError::Malformed { .. } => Self::Invalid(malformed.to_string()),
         }
     }
 }

@@ -5,13 +5,13 @@
 use serde_json::Value;
 
 use crate::FormatError;
+use crate::accessor::{self, ComponentType, Layout, LayoutError};
 
 /// `bytes`, or the plain GLB they decode to when they use `EXT_meshopt_compression` (see
-/// `drafter_core::meshopt`): every reader here takes compressed and plain files alike.
+/// `crate::meshopt`): every reader here takes compressed and plain files alike.
 fn plain(bytes: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, FormatError> {
-    if drafter_core::glb::is_glb(bytes)
-        && let Some(decoded) =
-            drafter_core::meshopt::decompress_glb(bytes).map_err(|e| FormatError::Invalid(e.to_string()))?
+    if crate::glb::is_glb(bytes)
+        && let Some(decoded) = crate::meshopt::decompress_glb(bytes).map_err(|e| FormatError::Invalid(e.to_string()))?
     {
         return Ok(std::borrow::Cow::Owned(decoded));
     }
@@ -49,12 +49,12 @@ impl BakedFile {
 }
 
 /// Splits a .glb into its JSON and BIN chunks, or returns a .gltf's JSON as is. The container is
-/// framed by [`drafter_core::glb`], the workspace's one GLB reader.
+/// framed by [`crate::glb`], the workspace's one GLB reader.
 pub fn split_container(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), FormatError> {
-    if !drafter_core::glb::is_glb(bytes) {
+    if !crate::glb::is_glb(bytes) {
         return Ok((bytes, None));
     }
-    let chunks = drafter_core::glb::split(bytes)?;
+    let chunks = crate::glb::split(bytes)?;
     Ok((chunks.json, chunks.bin))
 }
 
@@ -262,46 +262,20 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
     Ok(BakedFile { root, nodes, primitive_labels, primitive_edges, mesh_silhouettes })
 }
 
-/// The bytes of a tightly packed SCALAR accessor with components of `size` bytes.
-/// The bytes of a tightly packed accessor of `size`-byte elements (no `byteStride`, or one equal
-/// to `size`), checked against its buffer view and the buffer.
-fn accessor_bytes<'a>(doc: &Value, accessor: usize, buffer: &'a [u8], size: usize) -> Result<&'a [u8], FormatError> {
-    let (start, stride, count) = accessor_layout(doc, accessor, buffer, size)?;
-    if stride != size {
-        return Err(FormatError::Invalid(format!("/accessors/{accessor}: interleaved (byteStride {stride})")));
-    }
-    Ok(&buffer[start..start + count * size])
-}
-
-/// Reads a FLOAT SCALAR accessor (tightly packed) from the single buffer.
+/// Reads a FLOAT SCALAR accessor from the single buffer.
 pub fn read_floats(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<f32>, FormatError> {
-    let component = doc.get("accessors").and_then(|a| a.get(accessor)).and_then(|a| a.get("componentType"));
-    if component.and_then(Value::as_u64) != Some(5126) {
+    let (a, view, layout) = accessor_in(doc, accessor, buffer, "SCALAR")?;
+    if a.component != ComponentType::F32 {
         return Err(FormatError::Invalid(format!("/accessors/{accessor}: not a FLOAT accessor")));
     }
-    let bytes = accessor_bytes(doc, accessor, buffer, 4)?;
-    Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
+    Ok(accessor::read_vectors::<1>(view, &layout, a.component, false).into_iter().map(|[v]| v).collect())
 }
 
-/// Reads an unsigned SCALAR accessor (tightly packed) from the single buffer.
+/// Reads an unsigned SCALAR accessor from the single buffer.
 pub fn read_scalars(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<u32>, FormatError> {
-    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
-    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    let size = match a.get("componentType").and_then(Value::as_u64) {
-        Some(5121) => 1,
-        Some(5123) => 2,
-        Some(5125) => 4,
-        _ => return Err(bad("not an unsigned integer type")),
-    };
-    let bytes = accessor_bytes(doc, accessor, buffer, size)?;
-    Ok(bytes
-        .chunks_exact(size)
-        .map(|c| match size {
-            1 => c[0] as u32,
-            2 => u16::from_le_bytes([c[0], c[1]]) as u32,
-            _ => u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
-        })
-        .collect())
+    let (a, view, layout) = accessor_in(doc, accessor, buffer, "SCALAR")?;
+    accessor::read_indices(view, &layout, a.component)
+        .ok_or_else(|| FormatError::Invalid(format!("/accessors/{accessor}: not an unsigned integer type")))
 }
 
 /// The two sets of vertex normals of one primitive of a baked file (the paper's toggle, Cignoni et
@@ -427,101 +401,97 @@ fn derived_candidates(
     Ok((corners, normals))
 }
 
-/// Where an accessor's elements lie: (first byte in the buffer, byte stride, count), for elements
-/// of `size` bytes, honouring its buffer view's `byteStride`. Every offset is checked against the
-/// buffer view and the buffer with checked arithmetic (the numbers come from the file).
-fn accessor_layout(
+/// What the readers need of an accessor's JSON.
+struct AccessorInfo {
+    component: ComponentType,
+    normalized: bool,
+}
+
+/// An accessor of `kind` (`"SCALAR"`, `"VEC3"`) in the single buffer: its type, its buffer view's
+/// bytes and its elements' layout there, every offset checked with checked arithmetic (the numbers
+/// come from the file).
+fn accessor_in<'a>(
     doc: &Value,
     accessor: usize,
-    buffer: &[u8],
-    size: usize,
-) -> Result<(usize, usize, usize), FormatError> {
+    buffer: &'a [u8],
+    kind: &str,
+) -> Result<(AccessorInfo, &'a [u8], Layout), FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
     let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
+    if a.get("type").and_then(Value::as_str) != Some(kind) {
+        return Err(bad(&format!("not a {kind} accessor")));
+    }
+    let component = a
+        .get("componentType")
+        .and_then(Value::as_u64)
+        .and_then(ComponentType::from_code)
+        .ok_or_else(|| bad("no valid componentType"))?;
+    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
     let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
     let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
     let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))?;
     let number = |v: &Value, key: &str| v.get(key).and_then(Value::as_u64).unwrap_or(0);
-    let stride = match number(view, "byteStride") {
-        0 => size as u64,
-        s if s >= size as u64 => s,
-        _ => return Err(bad("byteStride smaller than an element")),
-    };
-    let view_start = number(view, "byteOffset");
     let view_length =
         view.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad("bufferView has no byteLength"))?;
-    let offset = number(a, "byteOffset");
-    // The last element ends at offset + (count − 1)·stride + size: inside the view and the buffer.
-    let end = match count {
-        0 => Some(offset),
-        _ => (count - 1).checked_mul(stride).and_then(|x| x.checked_add(offset)?.checked_add(size as u64)),
-    };
-    let end = end.filter(|&e| e <= view_length).ok_or_else(|| bad("data outside its buffer view"))?;
-    if view_start.checked_add(end).is_none_or(|e| e > buffer.len() as u64) {
-        return Err(bad("data outside the buffer"));
-    }
-    Ok(((view_start + offset) as usize, stride as usize, count as usize))
-}
-
-/// The elements of an accessor, `size` bytes each (see [`accessor_layout`]).
-fn accessor_elements<'a>(
-    doc: &Value,
-    accessor: usize,
-    buffer: &'a [u8],
-    size: usize,
-) -> Result<impl Iterator<Item = &'a [u8]>, FormatError> {
-    let (start, stride, count) = accessor_layout(doc, accessor, buffer, size)?;
-    Ok((0..count).map(move |i| &buffer[start + i * stride..start + i * stride + size]))
+    let view_bytes = usize::try_from(number(view, "byteOffset"))
+        .ok()
+        .zip(usize::try_from(view_length).ok())
+        .and_then(|(start, length)| buffer.get(start..start.checked_add(length)?))
+        .ok_or_else(|| bad("data outside the buffer"))?;
+    let components = if kind == "VEC3" { 3 } else { 1 };
+    let as_usize = |v: u64| usize::try_from(v).map_err(|_| bad("data outside its buffer view"));
+    let layout = Layout::new(
+        view_bytes.len(),
+        Some(as_usize(number(view, "byteStride"))?),
+        as_usize(number(a, "byteOffset"))?,
+        as_usize(count)?,
+        components * component.size(),
+    )
+    .map_err(|e| match e {
+        LayoutError::StrideTooSmall => bad("byteStride smaller than an element"),
+        LayoutError::OutsideView => bad("data outside its buffer view"),
+    })?;
+    Ok((AccessorInfo { component, normalized }, view_bytes, layout))
 }
 
 /// Reads a VEC3 accessor of unit vectors as stored: BYTE or SHORT normalized, or FLOAT, the three
 /// component types the merged `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
 fn read_unit_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<StoredNormals, FormatError> {
-    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
-    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    if a.get("type").and_then(Value::as_str) != Some("VEC3") {
-        return Err(bad("silhouetteNormals must be VEC3"));
-    }
-    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
-    match (a.get("componentType").and_then(Value::as_u64), normalized) {
-        (Some(5120), true) => Ok(StoredNormals::Byte(
-            accessor_elements(doc, accessor, buffer, 3)?.map(|c| [c[0] as i8, c[1] as i8, c[2] as i8]).collect(),
-        )),
-        (Some(5122), true) => Ok(StoredNormals::Short(
-            accessor_elements(doc, accessor, buffer, 6)?
+    let (a, view, layout) = accessor_in(doc, accessor, buffer, "VEC3")?;
+    match (a.component, a.normalized) {
+        (ComponentType::I8, true) => {
+            Ok(StoredNormals::Byte(layout.elements(view).map(|c| [c[0] as i8, c[1] as i8, c[2] as i8]).collect()))
+        }
+        (ComponentType::I16, true) => Ok(StoredNormals::Short(
+            layout
+                .elements(view)
                 .map(|c| std::array::from_fn(|k| i16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
                 .collect(),
         )),
-        (Some(5126), false) => Ok(StoredNormals::Float(read_vec3s(doc, accessor, buffer)?)),
-        _ => Err(bad("silhouetteNormals must be FLOAT, or BYTE or SHORT normalized")),
+        (ComponentType::F32, false) => {
+            Ok(StoredNormals::Float(accessor::read_vectors(view, &layout, a.component, false)))
+        }
+        _ => Err(FormatError::Invalid(format!(
+            "/accessors/{accessor}: silhouetteNormals must be FLOAT, or BYTE or SHORT normalized"
+        ))),
     }
 }
 
 /// Reads a VEC3 accessor of FLOAT, or of BYTE / SHORT normalized (decoded as glTF defines, then
 /// renormalised: these are shading normals), from the single buffer, tightly packed or strided.
 fn read_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[f32; 3]>, FormatError> {
-    let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
-    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    if a.get("type").and_then(Value::as_str) != Some("VEC3") {
-        return Err(bad("not a VEC3 accessor"));
-    }
-    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
-    match (a.get("componentType").and_then(Value::as_u64), normalized) {
-        (Some(5126), _) => Ok(accessor_elements(doc, accessor, buffer, 12)?
-            .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
-            .collect()),
-        (Some(5120), true) => Ok(accessor_elements(doc, accessor, buffer, 3)?
-            .map(|c| unit(drafter_core::snorm8_decode([c[0] as i8, c[1] as i8, c[2] as i8])))
-            .collect()),
-        (Some(5122), true) => Ok(accessor_elements(doc, accessor, buffer, 6)?
-            .map(|c| {
-                let v: [f32; 3] = std::array::from_fn(|k| {
-                    (f32::from(i16::from_le_bytes([c[2 * k], c[2 * k + 1]])) / 32767.0).max(-1.0)
-                });
-                unit(glam::Vec3::from(v))
-            })
-            .collect()),
-        _ => Err(bad("not a FLOAT, or BYTE or SHORT normalized, VEC3 accessor")),
+    let (a, view, layout) = accessor_in(doc, accessor, buffer, "VEC3")?;
+    match (a.component, a.normalized) {
+        (ComponentType::F32, _) => Ok(accessor::read_vectors(view, &layout, a.component, false)),
+        (ComponentType::I8 | ComponentType::I16, true) => {
+            Ok(accessor::read_vectors::<3>(view, &layout, a.component, true)
+                .into_iter()
+                .map(|v| unit(glam::Vec3::from(v)))
+                .collect())
+        }
+        _ => Err(FormatError::Invalid(format!(
+            "/accessors/{accessor}: not a FLOAT, or BYTE or SHORT normalized, VEC3 accessor"
+        ))),
     }
 }
 

@@ -15,12 +15,13 @@
 
 use std::path::Path;
 
-use drafter_core::glb;
-use drafter_core::uri::{self, UriTarget};
 use drafter_core::{
     DiagnosticKind, Diagnostics, Instance, Material, MaterialId, Mesh, MeshId, Node, NodeId, Scene, SourceDocument,
     SourceFormat, TriangleGroup,
 };
+use drafter_format::accessor::{self, ComponentType, Layout};
+use drafter_format::glb;
+use drafter_format::uri::read_buffer_uri;
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::json::validation::Validate as _;
@@ -343,53 +344,6 @@ fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Res
     Ok(out)
 }
 
-/// What a glTF buffer or image URI refers to: the bytes of a data URI, or a file.
-#[derive(Debug)]
-pub enum UriSource {
-    Data(Vec<u8>),
-    /// A file inside the glTF's folder: its canonical path, and the path the URI gives (for
-    /// messages).
-    File {
-        path: std::path::PathBuf,
-        relative: std::path::PathBuf,
-    },
-}
-
-/// What a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused: the rule of
-/// what may be followed is drafter-core's (`drafter_core::uri`); the joined path is then
-/// canonicalized and must stay inside the canonical folder, so a symbolic link cannot lead out of
-/// it either. [`read_buffer_uri`] reads what this resolves; the cache's key hashes the file
-/// without reading it into memory.
-pub fn resolve_buffer_uri(folder: &Path, uri: &str) -> Result<UriSource, String> {
-    let relative = match uri::resolve(uri)? {
-        UriTarget::Data(bytes) => return Ok(UriSource::Data(bytes)),
-        UriTarget::Relative(relative) => relative,
-    };
-    let unreadable = |e: std::io::Error| format!("cannot read file {}: {e}", relative.display());
-    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
-    let canonical_folder = folder.canonicalize().map_err(unreadable)?;
-    let canonical = folder.join(&relative).canonicalize().map_err(unreadable)?;
-    if canonical.is_dir() {
-        return Err(format!("URI {uri:?} names a folder, not a file"));
-    }
-    if !uri::inside(&canonical_folder, &canonical) {
-        return Err(format!("URI {uri:?} leads out of the file's folder (through a symbolic link)"));
-    }
-    Ok(UriSource::File { path: canonical, relative })
-}
-
-/// The bytes a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused
-/// ([`resolve_buffer_uri`]'s rule). drafter-format's loader of baked files (`external_buffers`)
-/// calls this too, so the importer and every reader of baked files follow the same URIs.
-pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
-    match resolve_buffer_uri(folder, uri)? {
-        UriSource::Data(bytes) => Ok(bytes),
-        UriSource::File { path, relative } => {
-            std::fs::read(&path).map_err(|e| format!("cannot read file {}: {e}", relative.display()))
-        }
-    }
-}
-
 /// Reads accessor `accessor` as `N`-component float vectors, de-quantising integer types
 /// (normalised or not, KHR_mesh_quantization) and applying sparse substitution.
 fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<[f32; N]>, ParseError> {
@@ -407,59 +361,27 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
         ));
     }
     let count = accessor.count();
-    let component = accessor.data_type().size();
+    let ty = component_type(accessor.data_type());
+    let component = ty.size();
     let element = component * N;
     let normalized = accessor.normalized();
-    let data_type = accessor.data_type();
     let mut out = match accessor.view() {
         Some(view) => {
             let bytes = view_bytes(&view, buffers)?;
-            let stride = view.stride().unwrap_or(element).max(element);
             let start = accessor.offset();
-            let needed = if count == 0 {
-                Some(0)
-            } else {
-                (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(element))
+            // A stride below one element is read as packed, as before the shared decoder.
+            let stride = view.stride().unwrap_or(element).max(element);
+            let Ok(layout) = Layout::new(bytes.len(), Some(stride), start, count, element) else {
+                return Err(ParseError::at_json(
+                    pointer,
+                    format!(
+                        "{count} elements of {element} bytes (stride {stride}, offset {start}) do not fit in bufferView {} of {} bytes",
+                        view.index(),
+                        bytes.len()
+                    ),
+                ));
             };
-            match needed {
-                Some(n) if n <= bytes.len() => {}
-                _ => {
-                    return Err(ParseError::at_json(
-                        pointer,
-                        format!(
-                            "{count} elements of {element} bytes (stride {stride}, offset {start}) do not fit in bufferView {} of {} bytes",
-                            view.index(),
-                            bytes.len()
-                        ),
-                    ));
-                }
-            }
-            if data_type == DataType::F32 && stride == element {
-                // Tightly packed floats (positions and normals, mostly): one loop without the
-                // per-component type dispatch.
-                // In range when there is an element (checked above); an empty accessor may lie anywhere.
-                bytes
-                    .get(start..start + count * element)
-                    .unwrap_or_default()
-                    .chunks_exact(element)
-                    .map(|e| {
-                        std::array::from_fn(|c| {
-                            f32::from_le_bytes([e[4 * c], e[4 * c + 1], e[4 * c + 2], e[4 * c + 3]])
-                        })
-                    })
-                    .collect()
-            } else {
-                let mut values = Vec::with_capacity(count);
-                for i in 0..count {
-                    let at = start + i * stride;
-                    let mut v = [0.0f32; N];
-                    for (c, slot) in v.iter_mut().enumerate() {
-                        *slot = decode_component(&bytes[at + c * component..], data_type, normalized);
-                    }
-                    values.push(v);
-                }
-                values
-            }
+            accessor::read_vectors::<N>(bytes, &layout, ty, normalized)
         }
         None => {
             // No buffer view: zeros (then sparse). The count has no data behind it, so it is bounded
@@ -522,7 +444,7 @@ fn read_vectors<const N: usize>(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) 
             };
             let at = value_start + k * element;
             for (c, value) in slot.iter_mut().enumerate() {
-                *value = decode_component(&value_bytes[at + c * component..], data_type, normalized);
+                *value = ty.decode(&value_bytes[at + c * component..], normalized);
             }
         }
     }
@@ -546,29 +468,15 @@ fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&
     }
 }
 
-/// Decodes one component at the start of `b` (the caller guarantees the bytes exist). Normalised
-/// integers follow the glTF spec's `max(c / MAX, -1)` rule.
-#[inline]
-fn decode_component(b: &[u8], data_type: DataType, normalized: bool) -> f32 {
+/// The shared decoder's name for a component type.
+fn component_type(data_type: DataType) -> ComponentType {
     match data_type {
-        DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-        DataType::I8 => {
-            let v = b[0] as i8 as f32;
-            if normalized { (v / 127.0).max(-1.0) } else { v }
-        }
-        DataType::U8 => {
-            let v = b[0] as f32;
-            if normalized { v / 255.0 } else { v }
-        }
-        DataType::I16 => {
-            let v = i16::from_le_bytes([b[0], b[1]]) as f32;
-            if normalized { (v / 32767.0).max(-1.0) } else { v }
-        }
-        DataType::U16 => {
-            let v = u16::from_le_bytes([b[0], b[1]]) as f32;
-            if normalized { v / 65535.0 } else { v }
-        }
-        DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+        DataType::I8 => ComponentType::I8,
+        DataType::U8 => ComponentType::U8,
+        DataType::I16 => ComponentType::I16,
+        DataType::U16 => ComponentType::U16,
+        DataType::U32 => ComponentType::U32,
+        DataType::F32 => ComponentType::F32,
     }
 }
 
@@ -577,12 +485,13 @@ fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: us
     if accessor.dimensions() != Dimensions::Scalar {
         return Err(ParseError::at_json(pointer, "index accessor is not SCALAR"));
     }
-    let size = match accessor.data_type() {
-        DataType::U8 => 1,
-        DataType::U16 => 2,
-        DataType::U32 => 4,
-        other => return Err(ParseError::at_json(pointer, format!("index component type {other:?} is not unsigned"))),
-    };
+    let ty = component_type(accessor.data_type());
+    if !matches!(ty, ComponentType::U8 | ComponentType::U16 | ComponentType::U32) {
+        return Err(ParseError::at_json(
+            pointer,
+            format!("index component type {:?} is not unsigned", accessor.data_type()),
+        ));
+    }
     if accessor.sparse().is_some() || accessor.view().is_none() {
         // Sparse or view-less indices are legal but meaningless for geometry; read generically.
         let values = read_vectors::<1>(accessor, buffers)?;
@@ -595,14 +504,9 @@ fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: us
     let Some(view) = accessor.view() else { return Ok(Vec::new()) };
     let bytes = view_bytes(&view, buffers)?;
     let count = accessor.count();
-    let stride = view.stride().unwrap_or(size).max(size);
     let start = accessor.offset();
-    let needed = if count == 0 {
-        Some(0)
-    } else {
-        (count - 1).checked_mul(stride).and_then(|x| x.checked_add(start)).and_then(|x| x.checked_add(size))
-    };
-    if needed.is_none_or(|n| n > bytes.len()) {
+    let stride = view.stride().unwrap_or(ty.size()).max(ty.size());
+    let Ok(layout) = Layout::new(bytes.len(), Some(stride), start, count, ty.size()) else {
         return Err(ParseError::at_json(
             pointer,
             format!(
@@ -611,26 +515,9 @@ fn read_indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>], vertex_count: us
                 bytes.len()
             ),
         ));
-    }
-    let index = |at: usize| match size {
-        1 => bytes[at] as u32,
-        2 => u16::from_le_bytes([bytes[at], bytes[at + 1]]) as u32,
-        _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
     };
-    let out: Vec<u32> = if stride == size {
-        // Tightly packed (every index buffer we have seen): decoded per component type in one
-        // loop each, and checked in a second pass; one loop matching the type and checking the
-        // range per index was 17 ms of the dragon's serial 43 ms parse.
-        // In range when there is an index (checked above); an empty accessor may lie anywhere.
-        let data = bytes.get(start..start + count * size).unwrap_or_default();
-        match size {
-            1 => data.iter().map(|&b| u32::from(b)).collect(),
-            2 => data.chunks_exact(2).map(|c| u32::from(u16::from_le_bytes([c[0], c[1]]))).collect(),
-            _ => data.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect(),
-        }
-    } else {
-        (0..count).map(|i| index(start + i * stride)).collect()
-    };
+    // Decoded in one loop, then checked in a second pass.
+    let out = accessor::read_indices(bytes, &layout, ty).unwrap_or_default();
     if let Some(i) = out.iter().position(|&v| v as usize >= vertex_count) {
         check_index(out[i], i, vertex_count, &pointer)?;
     }
@@ -890,13 +777,5 @@ mod tests {
         assert_eq!(fan, vec![[1, 2, 0], [2, 3, 0]]);
         let (list, leftover) = assemble_triangles(Mode::Triangles, &[0, 1, 2, 3]);
         assert_eq!((list.len(), leftover), (1, 1));
-    }
-
-    #[test]
-    fn normalised_components_decode_per_spec() {
-        assert_eq!(decode_component(&[0x80], DataType::I8, true), -1.0);
-        assert_eq!(decode_component(&[0x7f], DataType::I8, true), 1.0);
-        assert_eq!(decode_component(&[0xff, 0xff], DataType::U16, true), 1.0);
-        assert_eq!(decode_component(&[0x10, 0x00], DataType::I16, false), 16.0);
     }
 }

@@ -21,7 +21,6 @@ use std::path::Path;
 use drafter_core::{Diagnostic, Diagnostics, Scene, SourceFormat};
 
 pub use error::{ImportError, ParseError, Place};
-pub use gltf_import::{UriSource, read_buffer_uri, resolve_buffer_uri};
 pub use obj::{material_libraries as obj_material_libraries, open_material_library as open_obj_material_library};
 pub use raw::RawMesh;
 
@@ -72,7 +71,7 @@ pub fn import_bytes_within(path: &Path, bytes: &[u8], limits: &Limits) -> Result
     let mut diagnostics = Diagnostics::new();
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let scene = match format {
-        SourceFormat::Glb => match drafter_core::meshopt::decompress_glb(bytes) {
+        SourceFormat::Glb => match drafter_format::meshopt::decompress_glb(bytes) {
             // EXT_meshopt_compression (drafter bake --compress, gltfpack -cc): the plain GLB.
             Ok(Some(plain)) => gltf_import::import(path, &plain, limits, &mut diagnostics)?,
             Ok(None) => gltf_import::import(path, bytes, limits, &mut diagnostics)?,
@@ -119,7 +118,7 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<SourceFormat, ImportEr
         return Err(ParseError::in_file("empty file").in_path(path));
     }
     let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    if drafter_core::glb::is_glb(bytes) {
+    if drafter_format::glb::is_glb(bytes) {
         return Ok(SourceFormat::Glb);
     }
     if bytes.starts_with(b"ply") {

@@ -194,7 +194,7 @@ fn glb_and_external_buffers_load() {
 
     // The same as GLB: JSON chunk + BIN chunk, buffer without uri.
     doc["buffers"][0].as_object_mut().expect("obj").remove("uri");
-    let glb = drafter_core::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
+    let glb = drafter_format::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
     let imported = drafter_io::import_bytes(Path::new("x.glb"), &glb).expect("glb");
     assert_eq!(imported.scene.format, SourceFormat::Glb);
     assert_eq!(imported.scene.meshes[0].positions, TRI.map(Vec3::from).to_vec());
@@ -417,7 +417,7 @@ fn what_the_gltf_crate_unwraps_is_refused_by_its_place() {
             .decode(doc["buffers"][0]["uri"].as_str().expect("uri").split_once(',').expect("data uri").1)
             .expect("base64");
         doc["buffers"][0].as_object_mut().expect("buffer").remove("uri");
-        let glb = drafter_core::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
+        let glb = drafter_format::glb::write(&serde_json::to_vec(&doc).expect("json"), &bin).expect("glb");
         let err = drafter_io::import_bytes(Path::new("mem.glb"), &glb).expect_err(what).to_string();
         assert_eq!(err, format!("mem.glb: {expected}"), "{what} (GLB)");
     }
@@ -441,7 +441,7 @@ fn a_json_chunk_that_is_a_glb_header_is_refused_as_json() {
     if cfg!(debug_assertions) {
         assert!(panics(|| drop(gltf::Gltf::from_slice(inner))), "the gltf crate no longer panics here");
     }
-    let glb = drafter_core::glb::write(inner, &[]).expect("glb");
+    let glb = drafter_format::glb::write(inner, &[]).expect("glb");
     let err = drafter_io::import_bytes(Path::new("nested.glb"), &glb).expect_err("refused").to_string();
     assert!(err.starts_with("nested.glb: line 1: invalid glTF JSON"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");

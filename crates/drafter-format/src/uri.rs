@@ -4,9 +4,10 @@
 //! also not when spelled with percent escapes (`%2e%2e/`) or backslashes. Anything else is refused
 //! with a message naming the URI.
 //!
-//! Pure: this module only looks at the string. The callers that read the file also canonicalize
-//! the joined path and check it is still inside the folder, which catches symbolic links leading
-//! out of it; [`inside`] is that check.
+//! [`resolve`] only looks at the string. [`resolve_buffer_uri`] and [`read_buffer_uri`], which the
+//! importer, the readers of baked files and the batch cache's key all use, also canonicalize the
+//! joined path and check it is still inside the folder ([`inside`]), which catches symbolic links
+//! leading out of it.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -81,6 +82,53 @@ fn percent_decode(s: &str) -> Option<String> {
         }
     }
     String::from_utf8(out).ok()
+}
+
+/// What a glTF buffer or image URI refers to: the bytes of a data URI, or a file.
+#[derive(Debug)]
+pub enum UriSource {
+    Data(Vec<u8>),
+    /// A file inside the glTF's folder: its canonical path, and the path the URI gives (for
+    /// messages).
+    File {
+        path: std::path::PathBuf,
+        relative: std::path::PathBuf,
+    },
+}
+
+/// What a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused: the rule of
+/// what may be followed is drafter-core's (`drafter_format::uri`); the joined path is then
+/// canonicalized and must stay inside the canonical folder, so a symbolic link cannot lead out of
+/// it either. [`read_buffer_uri`] reads what this resolves; the cache's key hashes the file
+/// without reading it into memory.
+pub fn resolve_buffer_uri(folder: &Path, uri: &str) -> Result<UriSource, String> {
+    let relative = match resolve(uri)? {
+        UriTarget::Data(bytes) => return Ok(UriSource::Data(bytes)),
+        UriTarget::Relative(relative) => relative,
+    };
+    let unreadable = |e: std::io::Error| format!("cannot read file {}: {e}", relative.display());
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    let canonical_folder = folder.canonicalize().map_err(unreadable)?;
+    let canonical = folder.join(&relative).canonicalize().map_err(unreadable)?;
+    if canonical.is_dir() {
+        return Err(format!("URI {uri:?} names a folder, not a file"));
+    }
+    if !inside(&canonical_folder, &canonical) {
+        return Err(format!("URI {uri:?} leads out of the file's folder (through a symbolic link)"));
+    }
+    Ok(UriSource::File { path: canonical, relative })
+}
+
+/// The bytes a glTF buffer URI refers to, for a glTF in `folder`, or why it is refused
+/// ([`resolve_buffer_uri`]'s rule). The importer (drafter-io) and the loader of baked files
+/// ([`crate::external_buffers`]) both call this, so they follow the same URIs.
+pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
+    match resolve_buffer_uri(folder, uri)? {
+        UriSource::Data(bytes) => Ok(bytes),
+        UriSource::File { path, relative } => {
+            std::fs::read(&path).map_err(|e| format!("cannot read file {}: {e}", relative.display()))
+        }
+    }
 }
 
 #[cfg(test)]

@@ -95,7 +95,7 @@ impl fmt::Display for CompressionStats {
     /// One line: views encoded, their bytes, and the whole file (plain → compressed).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { 0.0 };
-        let n = |x: u64| crate::thousands(x as usize);
+        let n = |x: u64| drafter_core::thousands(x as usize);
         write!(
             f,
             "{EXTENSION}: {} of {} buffer views, {} → {} bytes ({:.2}×); file {} → {} bytes ({:.2}×)",
