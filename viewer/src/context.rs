@@ -50,6 +50,7 @@ impl Gpu {
     /// groups when the instance has [`wgpu::InstanceFlags::DEBUG`] (the default of debug builds). On
     /// lavapipe the instance is therefore made again without that flag, unless `WGPU_DEBUG` asks
     /// for it explicitly; debug groups are then no-ops.
+    #[cfg(feature = "native")]
     pub fn headless() -> Result<Gpu, RenderError> {
         let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         let debug = descriptor.flags.contains(wgpu::InstanceFlags::DEBUG);
@@ -65,6 +66,7 @@ impl Gpu {
         Self::with_adapter(instance, adapter)
     }
 
+    #[cfg(feature = "native")]
     fn adapter(descriptor: wgpu::InstanceDescriptor) -> Result<(wgpu::Instance, wgpu::Adapter), RenderError> {
         let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
@@ -73,15 +75,24 @@ impl Gpu {
     }
 
     /// A device on `adapter` (the window chooses one compatible with its surface).
+    #[cfg(feature = "native")]
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
+        pollster::block_on(Self::request(instance, adapter))
+    }
+
+    /// A device on `adapter`, without blocking: the browser's way (`web/`), where the device
+    /// arrives through a promise. [`Self::with_adapter`] waits for the same request.
+    pub async fn request(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
         Self::check_capabilities(&adapter)?;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("drafter device"),
-            required_features: wgpu::Features::empty(),
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::Device(e.to_string()))?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("drafter device"),
+                required_features: wgpu::Features::empty(),
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| RenderError::Device(e.to_string()))?;
         Ok(Gpu { instance, adapter, device, queue })
     }
 

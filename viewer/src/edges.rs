@@ -26,7 +26,9 @@
 //! positions of each corner's first vertex, which the bake uses too.
 
 use std::ops::Range;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use drafter_core::Scene;
 use drafter_format::{BakedFile, HardEdgeClass, MeshSilhouettes};

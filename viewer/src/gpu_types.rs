@@ -23,7 +23,7 @@ pub struct Vertex {
     pub material: u32,
 }
 
-/// One mesh instance (`gbuffer.wgsl`, `shadow.wgsl`: `Instance`), in a storage buffer indexed by
+/// One mesh instance (`gbuffer.wgsl`, `shadow.wgsl`: `Instance`), in the instance table indexed by
 /// `instance_index`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -41,7 +41,7 @@ pub struct InstanceGpu {
     pub _pad: u32,
 }
 
-/// Per-part parameters (`gbuffer.wgsl`: `Part`), a storage buffer indexed by scene-wide part id.
+/// Per-part parameters (`gbuffer.wgsl`: `Part`), in the part table indexed by scene-wide part id.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct PartGpu {
@@ -244,7 +244,7 @@ pub const DISPLAY_UNSHARP: u32 = 4;
 /// `DisplayUniforms::flags` bit: composite the drop shadow.
 pub const DISPLAY_SHADOW: u32 = 8;
 
-/// One line of the lines pass (`lines.wgsl`: `Segment`), in a storage buffer indexed by
+/// One line of the lines pass (`lines.wgsl`: `Segment`), in a segment table indexed by
 /// `instance_index`: an edge in its mesh's object space, the model instance that places it, and its
 /// [`crate::edges::LineClass`].
 #[repr(C)]

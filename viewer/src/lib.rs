@@ -6,7 +6,7 @@
 //! line, shading and shadow conventions of Gooch et al. 1999 (../shared/papers/001_*):
 //!
 //! 1. [`passes::gbuffer`]: every mesh drawn once, instanced; per-part projector, gradient and style
-//!    from a storage buffer indexed by part id; writes colour, normal, linear depth and part id.
+//!    from a table indexed by part id ([`table`]); writes colour, normal, linear depth and part id.
 //!    Styles: [`Style`] (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`, `hatch`), reading
 //!    the NPR lookup textures the file embeds ([`lookups`]: γ and cel tables, cool-to-warm map,
 //!    hatching halftone, metal bands and highlights), each computed procedurally where it has none.
@@ -40,12 +40,21 @@
 //! # Ok(()) }
 //! ```
 //!
+//! # Platforms
+//! The default feature `native` adds the desktop side: [`window`] and [`panel`] (winit, egui),
+//! blocking device requests ([`Gpu::headless`], [`Renderer::new`]) and [`drawing`] (SVG and PDF).
+//! Without it the crate is the renderer alone and builds for `wasm32-unknown-unknown` (the browser
+//! page in `web/`, WebGPU or WebGL2): the same passes and WGSL, the device requested
+//! asynchronously with [`Gpu::request`], frames recorded with [`Renderer::encode_frame`].
+//!
 //! Invariant: the viewer renders what drafter-io and drafter-format read; it never runs a bake
 //! stage. A file without `DRAFTER_illustration` data renders with one part per instance and a
 //! bounding-box projector, and [`Model::notices`] says so.
 
 pub mod camera;
 pub mod context;
+pub mod controls;
+#[cfg(feature = "native")]
 pub mod drawing;
 pub mod edges;
 pub mod edit;
@@ -53,12 +62,15 @@ pub mod gpu_types;
 pub mod image;
 pub mod lookups;
 pub mod model;
+#[cfg(feature = "native")]
 pub mod panel;
 pub mod passes;
 pub mod renderer;
 pub mod scene;
 pub mod style;
+pub mod table;
 pub mod targets;
+#[cfg(feature = "native")]
 pub mod window;
 
 pub use camera::Camera;

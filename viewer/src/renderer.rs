@@ -3,7 +3,9 @@
 //! [`Renderer::encode_frame`] records the same frame into any encoder and target (the window and
 //! the benchmark use it).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use glam::Vec3;
 
@@ -20,7 +22,7 @@ use crate::passes::shadow::{self, ShadowPass};
 use crate::passes::upscale::UpscalePass;
 use crate::scene::SceneGpu;
 use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
-use crate::targets::{OUTPUT_FORMAT, SHADOW_REDUCTION, Target, Targets};
+use crate::targets::{SHADOW_REDUCTION, Target, Targets};
 
 /// A model on the GPU with what the camera fit needs.
 #[derive(Debug)]
@@ -113,8 +115,9 @@ pub struct Renderer {
 
 impl Renderer {
     /// A headless renderer on the default adapter (see [`Gpu::headless`]).
+    #[cfg(feature = "native")]
     pub fn new() -> Result<Renderer, RenderError> {
-        Self::with_gpu(Gpu::headless()?, OUTPUT_FORMAT)
+        Self::with_gpu(Gpu::headless()?, crate::targets::OUTPUT_FORMAT)
     }
 
     /// A renderer on `gpu` whose display pass writes `output_format`.
@@ -188,21 +191,21 @@ impl Renderer {
     }
 
     /// Uploads `model`'s part table again after an edit or a selection change: one write into the
-    /// parts storage buffer, nothing else (Lux et al. 2013 §4: no re-processing at edit time). The
+    /// part table, nothing else (Lux et al. 2013 §4: no re-processing at edit time). The
     /// model must be the one [`Self::set_model`] uploaded.
     pub fn update_parts(&mut self, model: &Model) -> Result<(), RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
         let parts = model.part_table();
         (scene.part_hints, scene.unhinted_parts) = style_hints(&parts);
         let bytes: &[u8] = bytemuck::cast_slice(&parts);
-        if bytes.len() as u64 > scene.gpu.buffers.parts.size() {
+        if !scene.gpu.buffers.parts.fits(crate::table::texels_of(bytes.len())) {
             return Err(RenderError::Options(format!(
                 "{} parts do not fit the uploaded part table; upload the model again",
                 parts.len()
             )));
         }
         if !bytes.is_empty() {
-            self.gpu.queue.write_buffer(&scene.gpu.buffers.parts, 0, bytes);
+            scene.gpu.buffers.parts.write(&self.gpu.queue, bytes);
         }
         Ok(())
     }
@@ -574,12 +577,29 @@ impl ErrorScopes {
     }
 
     fn pop(self) -> Result<(), RenderError> {
-        let validation = pollster::block_on(self.validation.pop());
-        let out_of_memory = pollster::block_on(self.out_of_memory.pop());
+        let validation = settle(self.validation.pop());
+        let out_of_memory = settle(self.out_of_memory.pop());
         match validation.or(out_of_memory) {
             Some(e) => Err(RenderError::Gpu(e.to_string())),
             None => Ok(()),
         }
+    }
+}
+
+/// The error a popped scope reports. Natively it blocks until the device answers. In the browser
+/// nothing may block: WebGL2 (wgpu-core) answers at once, and a WebGPU answer still pending after
+/// one poll is left to the device's uncaptured-error handler, which the page reports.
+#[cfg(feature = "native")]
+fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>>) -> Option<wgpu::Error> {
+    pollster::block_on(pop)
+}
+
+#[cfg(not(feature = "native"))]
+fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>>) -> Option<wgpu::Error> {
+    let mut pop = std::pin::pin!(pop);
+    match pop.as_mut().poll(&mut std::task::Context::from_waker(std::task::Waker::noop())) {
+        std::task::Poll::Ready(error) => error,
+        std::task::Poll::Pending => None,
     }
 }
 

@@ -1,5 +1,5 @@
-//! A [`Model`] uploaded to the GPU: one vertex and index buffer per batch, the storage buffers
-//! the passes index (instances, label → part, parts, materials) and the G-buffer's lookup textures.
+//! A [`Model`] uploaded to the GPU: one vertex and index buffer per batch, the tables
+//! ([`crate::table`]) the passes index (instances, label → part, parts, materials) and the G-buffer's lookup textures.
 
 use std::ops::Range;
 
@@ -8,6 +8,7 @@ use wgpu::util::DeviceExt;
 use crate::gpu_types::{MaterialGpu, PartGpu};
 use crate::model::Model;
 use crate::passes::gbuffer::LookupsGpu;
+use crate::table::Table;
 
 /// One draw of the G-buffer and shadow passes.
 #[derive(Debug)]
@@ -20,13 +21,13 @@ pub struct BatchGpu {
     pub instances: Range<u32>,
 }
 
-/// The storage buffers of a scene.
+/// The tables of a scene ([`crate::table`]).
 #[derive(Debug)]
 pub struct SceneBuffers {
-    pub instances: wgpu::Buffer,
-    pub label_to_part: wgpu::Buffer,
-    pub parts: wgpu::Buffer,
-    pub materials: wgpu::Buffer,
+    pub instances: Table,
+    pub label_to_part: Table,
+    pub parts: Table,
+    pub materials: Table,
 }
 
 /// Everything of a model on the GPU, with the bind groups of the geometry passes.
@@ -59,15 +60,7 @@ impl SceneGpu {
         shadow: &crate::passes::shadow::ShadowPass,
         frame: &wgpu::Buffer,
     ) -> SceneGpu {
-        let storage = |label: &str, contents: &[u8]| {
-            // Storage bindings must not be empty.
-            let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            })
-        };
+        let storage = |label: &str, contents: &[u8]| Table::with_contents(device, queue, label, contents);
         let parts: Vec<PartGpu> = model.part_table();
         let materials: &[MaterialGpu] = &model.materials;
         let buffers = SceneBuffers {

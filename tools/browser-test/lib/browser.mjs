@@ -7,7 +7,7 @@ export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
 export const WIDTH = 800;
 export const HEIGHT = 600;
 
-const ARGS = [
+export const ARGS = [
   '--use-angle=swiftshader', // WebGL on the CPU: these machines have no GPU
   '--enable-unsafe-swiftshader',
   '--ignore-gpu-blocklist',
@@ -39,6 +39,22 @@ export function killBrowser() {
 }
 
 /**
+ * Starts headless Chromium with the flags above (software WebGL 2) and registers it for
+ * killBrowser(). `timeoutMs` bounds any single DevTools call.
+ */
+export async function launchBrowser(timeoutMs) {
+  const browser = await puppeteer.launch({
+    executablePath: CHROMIUM,
+    headless: true,
+    args: ARGS,
+    timeout: 30_000, // to start the browser
+    protocolTimeout: timeoutMs + 10_000,
+  });
+  current = browser;
+  return browser;
+}
+
+/**
  * Opens `url`, waits (at most `timeoutMs`) until the page sets window.__result, and returns
  * { result, consoleErrors }. With `screenshot` (a path) and a successful result, saves the view as PNG.
  */
@@ -46,14 +62,7 @@ export async function runPage({ url, timeoutMs, screenshot }) {
   const deadline = Date.now() + timeoutMs;
   const left = () => Math.max(1000, deadline - Date.now());
   const consoleErrors = [];
-  const browser = await puppeteer.launch({
-    executablePath: CHROMIUM,
-    headless: true,
-    args: ARGS,
-    timeout: 30_000, // to start the browser
-    protocolTimeout: timeoutMs + 10_000, // any single DevTools call
-  });
-  current = browser;
+  const browser = await launchBrowser(timeoutMs);
   try {
     const page = await browser.newPage();
     await page.setViewport({ width: WIDTH, height: HEIGHT, deviceScaleFactor: 1 });

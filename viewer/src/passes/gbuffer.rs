@@ -2,10 +2,10 @@
 //!
 //! # How it works
 //! Every mesh is drawn **once**, instanced over all its placements: the vertex shader reads the
-//! instance's transform from a storage buffer, maps the vertex's part label through the
+//! instance's transform from the instance table ([`crate::table`]), maps the vertex's part label through the
 //! instance's slice of `label_to_part` to a scene-wide part id, and the fragment shader fetches that
 //! part's projector, gradient parameters and style from the part table. Algorithm 1 sets uniforms
-//! per object; doing it through a storage buffer instead keeps the frame time independent of the
+//! per object; doing it through a table instead keeps the frame time independent of the
 //! number of parts.
 //!
 //! The fragment shader writes four targets in one pass (multiple render targets): shaded colour,
@@ -85,9 +85,10 @@ use crate::gpu_types::{
     LOOKUP_COOL_TO_WARM_SPLASH, LOOKUP_HATCH, LOOKUP_METAL, LOOKUP_METAL_SPHERE, LookupUniforms, Vertex,
 };
 use crate::lookups::{self, BakedLookups, EnvMapping, LookupFormat, LookupImage};
-use crate::passes::{FILTERABLE, FLOAT, color_attachment, sampler_entry, storage_entry, texture_entry, uniform_entry};
+use crate::passes::{FILTERABLE, FLOAT, color_attachment, sampler_entry, texture_entry, uniform_entry};
 use crate::scene::SceneGpu;
 use crate::style::{HALFTONE_STROKE_SPACING_TEXELS, METAL_STRIPE_SCALE, RenderOptions, Style};
+use crate::table;
 use crate::targets::{COLOR_FORMAT, DEPTH_FORMAT, LINEAR_DEPTH_FORMAT, NORMAL_FORMAT, PART_ID_FORMAT, Targets};
 
 pub const LABEL: &str = "gbuffer";
@@ -280,10 +281,10 @@ impl GBufferPass {
         use wgpu::ShaderStages as S;
         let mut entries = vec![
             uniform_entry(0, S::VERTEX_FRAGMENT, false),
-            storage_entry(1, S::VERTEX),
-            storage_entry(2, S::VERTEX),
-            storage_entry(3, S::FRAGMENT),
-            storage_entry(4, S::FRAGMENT),
+            table::layout_entry(1, S::VERTEX),
+            table::layout_entry(2, S::VERTEX),
+            table::layout_entry(3, S::FRAGMENT),
+            table::layout_entry(4, S::FRAGMENT),
             uniform_entry(5, S::FRAGMENT, false),
         ];
         // The γ atlas is read with `textureLoad` (its procedural form is 32-bit float, which
@@ -392,10 +393,13 @@ impl GBufferPass {
     ) -> wgpu::BindGroup {
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: scene.instances.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: scene.label_to_part.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: scene.parts.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 4, resource: scene.materials.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&scene.instances.view) },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&scene.label_to_part.view),
+            },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&scene.parts.view) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&scene.materials.view) },
             wgpu::BindGroupEntry { binding: 5, resource: lookups.uniforms.as_entire_binding() },
         ];
         entries.extend(LOOKUP_BINDINGS.zip(&lookups.views).map(|(binding, view)| wgpu::BindGroupEntry {

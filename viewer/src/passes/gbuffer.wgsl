@@ -76,10 +76,45 @@ fn may_draw(style: u32) -> bool {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> instances: array<Instance>;
-@group(0) @binding(2) var<storage, read> label_to_part: array<u32>;
-@group(0) @binding(3) var<storage, read> parts: array<Part>;
-@group(0) @binding(4) var<storage, read> materials: array<Material>;
+// The scene's tables (table.rs; instance_at is in shared.wgsl).
+@group(0) @binding(1) var instance_table: texture_2d<u32>;
+@group(0) @binding(2) var label_table: texture_2d<u32>;
+@group(0) @binding(3) var part_table: texture_2d<u32>;
+@group(0) @binding(4) var material_table: texture_2d<u32>;
+
+// The part of label k of the scene (4 labels a texel).
+fn part_of_label(k: u32) -> u32 {
+    return textureLoad(label_table, table_coord(k / 4u), 0)[k % 4u];
+}
+
+// Part i: 6 texels.
+fn part_at(i: u32) -> Part {
+    let t = i * 6u;
+    var part: Part;
+    part.projector_row = bitcast<vec4<f32>>(textureLoad(part_table, table_coord(t), 0));
+    part.axis0 = bitcast<vec4<f32>>(textureLoad(part_table, table_coord(t + 1u), 0));
+    part.axis1 = bitcast<vec4<f32>>(textureLoad(part_table, table_coord(t + 2u), 0));
+    part.axis2 = bitcast<vec4<f32>>(textureLoad(part_table, table_coord(t + 3u), 0));
+    part.gradient = bitcast<vec4<f32>>(textureLoad(part_table, table_coord(t + 4u), 0));
+    let rest = textureLoad(part_table, table_coord(t + 5u), 0);
+    part.style_hint = rest.x;
+    part.flags = rest.y;
+    part.flat = bitcast<f32>(rest.z);
+    part.pad0 = rest.w;
+    return part;
+}
+
+// Material i: 2 texels.
+fn material_at(i: u32) -> Material {
+    var material: Material;
+    material.base_color = bitcast<vec4<f32>>(textureLoad(material_table, table_coord(i * 2u), 0));
+    let rest = bitcast<vec4<f32>>(textureLoad(material_table, table_coord(i * 2u + 1u), 0));
+    material.metallic = rest.x;
+    material.roughness = rest.y;
+    material.pad0 = rest.z;
+    material.pad1 = rest.w;
+    return material;
+}
 @group(0) @binding(5) var<uniform> lookups: Lookups;
 @group(0) @binding(6) var gamma_atlas: texture_2d<f32>;
 @group(0) @binding(7) var cel_atlas: texture_2d<f32>;
@@ -108,7 +143,7 @@ struct VertexOut {
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
-    let inst = instances[instance_index];
+    let inst = instance_at(instance_index);
     let position = inst.render_from_object * vec4<f32>(v.position_in_object, 1.0);
     let normal_from_object = mat3x3<f32>(inst.normal_col0.xyz, inst.normal_col1.xyz, inst.normal_col2.xyz);
     let label = min(v.label, max(inst.label_count, 1u) - 1u);
@@ -116,7 +151,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexO
     out.clip = frame.clip_from_render * position;
     out.position_in_render = position.xyz;
     out.normal_in_render = normal_from_object * v.normal_in_object;
-    out.part = label_to_part[inst.label_base + label];
+    out.part = part_of_label(inst.label_base + label);
     out.material = v.material;
     out.mirrored = inst.mirrored;
     return out;
@@ -408,12 +443,12 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> GBufferO
     s.n = normalize((frame.view_from_render * vec4<f32>(normal, 0.0)).xyz);
     s.l = normalize(frame.light_in_view.xyz);
     s.v = select(normalize(-position_in_view), vec3<f32>(0.0, 0.0, 1.0), ortho);
-    let material = materials[in.material];
+    let material = material_at(in.material);
     s.base = material.base_color.rgb;
     s.roughness = material.roughness;
     s.frag = in.clip.xy;
 
-    let part = parts[in.part];
+    let part = part_at(in.part);
     var style = frame.scene_style;
     if frame.use_part_styles != 0u && part.style_hint != NO_STYLE {
         style = part.style_hint;

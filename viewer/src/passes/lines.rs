@@ -37,11 +37,14 @@
 
 use crate::edges::{ModelLines, SilhouetteFrame};
 use crate::gpu_types::{LineSegmentGpu, LinesUniforms};
-use crate::passes::{FLOAT, UINT, color_attachment, storage_entry, texture_entry, uniform_entry};
+use crate::passes::{FLOAT, UINT, color_attachment, texture_entry, uniform_entry};
 use crate::style::{RenderOptions, Style};
+use crate::table::{self, Table};
 use crate::targets::Targets;
 
 pub const LABEL: &str = "lines";
+/// Table texels per segment (`segment_at` in lines.wgsl).
+const SEGMENT_TEXELS: u64 = (size_of::<LineSegmentGpu>() / crate::table::TEXEL_BYTES) as u64;
 
 /// Width of silhouettes, boundaries and part borders, output pixels.
 pub const OUTLINE_WIDTH_PX: f32 = 1.5;
@@ -94,11 +97,11 @@ pub fn uniforms(options: &RenderOptions, camera: &crate::Camera, target_height: 
     }
 }
 
-/// A storage buffer of segments with its bind group, grown on demand.
+/// A table of segments ([`crate::table`]) with its bind group, grown on demand.
 #[derive(Debug)]
 struct SegmentBuffer {
     label: &'static str,
-    buffer: wgpu::Buffer,
+    buffer: Table,
     bind_group: wgpu::BindGroup,
     capacity: u64,
     count: u32,
@@ -142,7 +145,7 @@ impl LinesPass {
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lines frame bind group layout"),
-            entries: &[uniform_entry(0, vf, false), uniform_entry(1, vf, false), storage_entry(2, vf)],
+            entries: &[uniform_entry(0, vf, false), uniform_entry(1, vf, false), table::layout_entry(2, vf)],
         });
         let targets_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lines targets bind group layout"),
@@ -150,7 +153,7 @@ impl LinesPass {
         });
         let segments_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lines segments bind group layout"),
-            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[table::layout_entry(0, wgpu::ShaderStages::VERTEX)],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lines pipeline layout"),
@@ -192,18 +195,14 @@ impl LinesPass {
     }
 
     fn segment_buffer(&self, device: &wgpu::Device, label: &'static str, capacity: u64) -> SegmentBuffer {
-        let capacity = capacity.max(1);
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: capacity * size_of::<LineSegmentGpu>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let buffer = Table::new(device, label, capacity.max(1) * SEGMENT_TEXELS);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(label),
             layout: &self.segments_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&buffer.view) }],
         });
+        // Segments beyond the largest table are not drawn (millions: far beyond any model here).
+        let capacity = buffer.capacity / SEGMENT_TEXELS;
         SegmentBuffer { label, buffer, bind_group, capacity, count: 0 }
     }
 
@@ -214,7 +213,7 @@ impl LinesPass {
         queue: &wgpu::Queue,
         lines: ModelLines,
         frame: &wgpu::Buffer,
-        instances: &wgpu::Buffer,
+        instances: &Table,
     ) -> LinesScene {
         let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lines frame bind group"),
@@ -222,13 +221,13 @@ impl LinesPass {
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: self.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: instances.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&instances.view) },
             ],
         });
         let hard_segments = lines.hard_segments();
         let mut hard = self.segment_buffer(device, "lines hard edges", hard_segments.len() as u64);
-        queue.write_buffer(&hard.buffer, 0, bytemuck::cast_slice(&hard_segments));
-        hard.count = hard_segments.len() as u32;
+        hard.buffer.write(queue, bytemuck::cast_slice(&hard_segments));
+        hard.count = hard_segments.len().min(hard.capacity as usize) as u32;
         let silhouettes = self.segment_buffer(device, "lines silhouettes", 1024);
         LinesScene { lines, frame_bind_group, hard, silhouettes, last: None }
     }
@@ -266,8 +265,8 @@ impl LinesPass {
         if needed > scene.silhouettes.capacity {
             scene.silhouettes = self.segment_buffer(device, scene.silhouettes.label, needed.next_power_of_two());
         }
-        queue.write_buffer(&scene.silhouettes.buffer, 0, bytemuck::cast_slice(&silhouettes.segments));
-        scene.silhouettes.count = needed as u32;
+        scene.silhouettes.buffer.write(queue, bytemuck::cast_slice(&silhouettes.segments));
+        scene.silhouettes.count = needed.min(scene.silhouettes.capacity) as u32;
         scene.last = Some(silhouettes);
     }
 

@@ -28,10 +28,22 @@ const CONTOUR_DEPTH_JUMP: f32 = 0.1;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> lines: Lines;
-@group(0) @binding(2) var<storage, read> instances: array<Instance>;
+@group(0) @binding(2) var instance_table: texture_2d<u32>;
 @group(1) @binding(0) var linear_depth_tex: texture_2d<f32>;
 @group(1) @binding(1) var part_id_tex: texture_2d<u32>;
-@group(2) @binding(0) var<storage, read> segments: array<Segment>;
+@group(2) @binding(0) var segment_table: texture_2d<u32>;
+
+// Segment i of the bound table (table.rs): 2 texels.
+fn segment_at(i: u32) -> Segment {
+    let first = textureLoad(segment_table, table_coord(i * 2u), 0);
+    let second = textureLoad(segment_table, table_coord(i * 2u + 1u), 0);
+    var s: Segment;
+    s.a = bitcast<vec3<f32>>(first.xyz);
+    s.instance = first.w;
+    s.b = bitcast<vec3<f32>>(second.xyz);
+    s.kind = second.w;
+    return s;
+}
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
@@ -54,8 +66,8 @@ fn is_outline(kind: u32) -> bool {
 
 @vertex
 fn vs_main(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
-    let s = segments[i];
-    let inst = instances[s.instance];
+    let s = segment_at(i);
+    let inst = instance_at(s.instance);
     var a = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.a, 1.0))).xyz;
     var b = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.b, 1.0))).xyz;
     var out: VertexOut;

@@ -39,7 +39,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu_types::{MAX_SOFT_PLANES, ShadowLayerGpu, ShadowResolveGpu};
-use crate::passes::{color_attachment, fullscreen_pipeline, storage_entry, texture_entry, uniform_entry};
+use crate::passes::{color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
 use crate::scene::SceneGpu;
 use crate::style::ShadowMode;
 use crate::targets::{SHADOW_MASK_FORMAT, SHADOW_STENCIL_FORMAT, Targets};
@@ -214,7 +214,7 @@ impl ShadowPass {
         let module = device.create_shader_module(super::shader_source!("shadow.wgsl"));
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow scene bind group layout"),
-            entries: &[storage_entry(0, S::VERTEX)],
+            entries: &[crate::table::layout_entry(0, S::VERTEX)],
         });
         let layer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow layer bind group layout"),
@@ -371,7 +371,10 @@ impl ShadowPass {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow scene bind group"),
             layout: &self.scene_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: scene.instances.as_entire_binding() }],
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&scene.instances.view),
+            }],
         })
     }
 

@@ -17,7 +17,7 @@ struct Resolve {
     inverse_scales: array<vec4<f32>, 4>,
 }
 
-@group(0) @binding(0) var<storage, read> instances: array<Instance>;
+@group(0) @binding(0) var instance_table: texture_2d<u32>;
 @group(1) @binding(0) var<uniform> layer: ShadowLayer;
 
 struct VertexIn {
@@ -29,7 +29,7 @@ struct VertexIn {
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> @builtin(position) vec4<f32> {
-    let p = (instances[instance_index].render_from_object * vec4<f32>(v.position_in_object, 1.0)).xyz;
+    let p = (instance_at(instance_index).render_from_object * vec4<f32>(v.position_in_object, 1.0)).xyz;
     let light = layer.light_position.xyz;
     // The ray from the light through p meets the plane y = h at t; points at or above the light's
     // height cast no shadow and are pushed far along their ray instead.

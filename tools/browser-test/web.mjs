@@ -1,0 +1,191 @@
+#!/usr/bin/env node
+// Drives drafter's own browser page (web/page, built by scripts/web) in headless Chromium with
+// software WebGL 2 (SwiftShader), for cli/tests/web.rs and the figures of docs/web.md.
+//
+// Usage: node tools/browser-test/web.mjs COMMAND PAGE_DIR FILE [options]
+//   PAGE_DIR: the built page (index.html, drafter-viewer.js, drafter_web.js, drafter_web_bg.wasm).
+//   FILE: the model, served from its folder.
+//   shots --out DIR --styles a,b,... [--size WxH] [--view AZ,EL] [--edges] [--lines] [--shadow S]
+//         [--frames N] [--no-src]
+//       Loads the page with FILE, then draws each style and saves the canvas as DIR/STYLE.png.
+//       Prints {ok, backend, summary, timings, shots, frameMs, consoleErrors}: timings in ms from
+//       the navigation's start (wasmReady, fileFetched, modelLoaded, firstFrame); with --frames,
+//       frameMs holds N full frames of the first style, each timed from recording until the GPU
+//       finished it (a one-pixel readPixels waits for it, as `drafter bench render` waits).
+//   interact [--size WxH]
+//       A scripted left drag over the canvas, then the key 3 (gooch). Prints {ok, before, after,
+//       keyStyle, pixelsChanged, consoleErrors}.
+//   bad [--max-triangles N]
+//       Loads FILE, which should be refused. Prints {ok, state, message, ms, canvasBlank,
+//       consoleErrors}; ok when the page shows an error message within the timeout.
+// Common: --backend webgpu|webgl2 (default webgl2), --timeout S (default 120).
+// Every command prints one JSON line and exits 0 when ok, 1 otherwise, 2 on wrong usage.
+
+import { mkdirSync, writeFileSync } from 'node:fs';
+import path from 'node:path';
+import process from 'node:process';
+
+import { launchBrowser, killBrowser } from './lib/browser.mjs';
+import { startServer } from './lib/server.mjs';
+
+function parse(argv) {
+  const [command, pageDir, file, ...rest] = argv;
+  const options = { backend: 'webgl2', timeout: '120', size: '800x600', view: '35,25', shadow: 'none' };
+  for (let i = 0; i < rest.length; i++) {
+    const name = rest[i].replace(/^--/, '');
+    if (['edges', 'lines', 'no-src'].includes(name)) options[name] = true;
+    else options[name] = rest[++i];
+  }
+  if (!command || !pageDir || !file) throw new Error('usage: web.mjs shots|interact|bad PAGE_DIR FILE [options]');
+  return { command, pageDir: path.resolve(pageDir), file: path.resolve(file), options };
+}
+
+async function main() {
+  let args;
+  try {
+    args = parse(process.argv.slice(2));
+  } catch (err) {
+    console.error(err.message);
+    process.exit(2);
+  }
+  const { command, pageDir, file, options } = args;
+  const timeoutMs = Number(options.timeout) * 1000;
+  const watchdog = setTimeout(() => {
+    console.log(JSON.stringify({ ok: false, error: `watchdog: no answer in ${options.timeout} s` }));
+    killBrowser();
+    process.exit(1);
+  }, timeoutMs + 20_000);
+  const server = await startServer({ toolRoot: pageDir, modelDir: path.dirname(file) });
+  const browser = await launchBrowser(timeoutMs);
+  const consoleErrors = [];
+  let result;
+  try {
+    const [w, h] = options.size.split('x').map(Number);
+    const page = await browser.newPage();
+    await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
+    page.on('console', (msg) => msg.type() === 'error' && consoleErrors.push(msg.text()));
+    page.on('pageerror', (err) => consoleErrors.push(`page error: ${err.message ?? err}`));
+    const params = new URLSearchParams({
+      src: `/model/${encodeURIComponent(path.basename(file))}`,
+      size: options.size,
+      view: options.view,
+      shadow: options.shadow,
+      backend: options.backend,
+      controls: 'none',
+    });
+    // --no-src: the page's own model (what `drafter web` wrote beside it), served from PAGE_DIR.
+    if (options['no-src']) params.delete('src');
+    if (options.edges) params.set('edges', '1');
+    if (options.lines) params.set('lines', '1');
+    if (options['max-triangles']) params.set('max-triangles', options['max-triangles']);
+    const started = Date.now();
+    await page.goto(`${server.url}/index.html?${params}`, { waitUntil: 'domcontentloaded', timeout: timeoutMs });
+    const settled = await page
+      .waitForFunction(
+        () => ['ready', 'error'].includes(document.getElementById('viewer')?.state),
+        { timeout: timeoutMs, polling: 100 },
+      )
+      .then(() => true)
+      .catch(() => false);
+    const status = await page.evaluate(() => {
+      const v = document.getElementById('viewer');
+      return {
+        state: v.state,
+        message: v.message,
+        summary: v.summary,
+        timings: v.timings,
+        backend: v.viewer?.backend() ?? null,
+      };
+    });
+    const ms = Date.now() - started;
+    if (command === 'bad') {
+      // A refused file shows its message over the canvas; the canvas itself was never drawn.
+      const shown = await page.evaluate(() => {
+        const box = document.getElementById('viewer').shadowRoot.querySelector('.message');
+        return !box.hidden && box.textContent.length > 0 ? box.textContent : '';
+      });
+      result = { ok: settled && status.state === 'error' && shown !== '', state: status.state, message: shown, ms };
+    } else if (!settled || status.state !== 'ready') {
+      result = { ok: false, state: status.state, message: status.message || 'page did not finish loading', ms };
+    } else if (command === 'shots') {
+      mkdirSync(options.out, { recursive: true });
+      const shots = {};
+      for (const style of options.styles.split(',')) {
+        const url = await page.evaluate((style) => {
+          const v = document.getElementById('viewer');
+          v.viewer.set_style(style);
+          v.draw(false);
+          return v.canvas.toDataURL('image/png'); // same task as the draw: the buffer is intact
+        }, style);
+        const out = path.join(options.out, `${style}.png`);
+        writeFileSync(out, Buffer.from(url.split(',')[1], 'base64'));
+        shots[style] = out;
+      }
+      let frameMs = [];
+      if (options.frames) {
+        frameMs = await page.evaluate(
+          (style, n) => {
+            const v = document.getElementById('viewer');
+            v.viewer.set_style(style);
+            const gl = v.canvas.getContext('webgl2'); // wgpu's own context on WebGL2, else null
+            const pixel = new Uint8Array(4);
+            const times = [];
+            for (let k = 0; k < n; k++) {
+              const t0 = performance.now();
+              v.draw(false);
+              gl?.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+              times.push(performance.now() - t0);
+            }
+            return times;
+          },
+          options.styles.split(',')[0],
+          Number(options.frames),
+        );
+      }
+      result = { ok: true, backend: status.backend, summary: status.summary, timings: status.timings, shots, frameMs };
+    } else if (command === 'interact') {
+      const pixels = () =>
+        page.evaluate(() => {
+          const v = document.getElementById('viewer');
+          v.draw(false);
+          return v.canvas.toDataURL('image/png');
+        });
+      const state = () => page.evaluate(() => JSON.parse(document.getElementById('viewer').viewer.state()));
+      const before = await state();
+      const firstImage = await pixels();
+      // A left drag across the middle of the canvas, in steps, as a user's.
+      await page.mouse.move(w / 2, h / 2);
+      await page.mouse.down();
+      for (let k = 1; k <= 10; k++) await page.mouse.move(w / 2 + 12 * k, h / 2 + 3 * k);
+      await page.mouse.up();
+      const after = await state();
+      const secondImage = await pixels();
+      await page.keyboard.press('3');
+      const keyStyle = (await state()).style;
+      const dragged = after.azimuth !== before.azimuth && after.elevation !== before.elevation;
+      result = {
+        ok: dragged && firstImage !== secondImage && keyStyle === 'gooch',
+        before,
+        after,
+        keyStyle,
+        pixelsChanged: firstImage !== secondImage,
+      };
+    } else {
+      result = { ok: false, error: `unknown command ${command}` };
+    }
+  } catch (err) {
+    result = { ok: false, error: String(err?.stack ?? err) };
+  } finally {
+    await browser.close().catch(() => {});
+    killBrowser();
+    await server.close();
+    clearTimeout(watchdog);
+  }
+  result.consoleErrors = consoleErrors;
+  // A refused file may log the refusal; any other console error fails the run.
+  if (command !== 'bad' && consoleErrors.length > 0) result.ok = false;
+  console.log(JSON.stringify(result));
+  process.exit(result.ok ? 0 : 1);
+}
+
+main();

@@ -1,0 +1,252 @@
+//! drafter's viewer in the browser: the viewer's renderer (`drafter-viewer` without its `native`
+//! feature) compiled to WebAssembly, drawing into a canvas through WebGPU, or WebGL2 where the
+//! browser has no WebGPU adapter. The same passes and WGSL as `drafter render` and `drafter view`;
+//! only the device request (asynchronous here) and the surface are the browser's.
+//!
+//! The page (`web/page/`) owns the DOM: it reads the file (a URL or a dropped file), turns mouse,
+//! wheel and key events into the calls below, and asks for a frame when something changed. The
+//! view controls are the window's own ([`drafter_viewer::controls`]), so a drag, the wheel and the
+//! keys do here what they do in `drafter view`. Editing stays in the desktop window.
+//!
+//! Everything here is wasm32-only: natively this crate is empty (`cargo build --workspace` builds
+//! it without any of the browser's crates). Built by `scripts/web`.
+#![cfg(target_arch = "wasm32")]
+
+use std::path::Path;
+
+use drafter_viewer::controls::{Action, Orbit, PIXELS_PER_LINE, action_for_char};
+use drafter_viewer::{Enhancements, Gpu, Model, RenderOptions, Renderer, ShadowMode, Style};
+use wasm_bindgen::prelude::*;
+
+/// The most triangles the page loads by default (the page's `max-triangles` parameter changes
+/// it): a tab's memory, not the renderer, is the limit (the dragon's 871k load in a few seconds).
+pub const DEFAULT_MAX_TRIANGLES: u64 = 5_000_000;
+
+/// Reports panics on the console (the page shows the last console error too).
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(|info| {
+        web_sys::console::error_1(&format!("drafter: {info}").into());
+    }));
+}
+
+/// A renderer on one canvas, with at most one model.
+#[wasm_bindgen]
+#[derive(Debug)]
+pub struct Viewer {
+    renderer: Renderer,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    options: RenderOptions,
+    orbit: Orbit,
+    model: Option<Model>,
+    backend: String,
+}
+
+fn js_error(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+#[wasm_bindgen]
+impl Viewer {
+    /// A viewer drawing into `canvas`. `backend`: `"webgpu"`, `"webgl2"`, or anything else for
+    /// WebGPU where the browser gives an adapter and WebGL2 otherwise.
+    pub async fn create(canvas: web_sys::HtmlCanvasElement, backend: &str) -> Result<Viewer, JsError> {
+        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let backends = match backend {
+            "webgpu" => wgpu::Backends::BROWSER_WEBGPU,
+            "webgl2" => wgpu::Backends::GL,
+            _ => wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL,
+        };
+        let descriptor =
+            wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() };
+        // WebGPU only where an adapter answers: `navigator.gpu` alone does not promise one.
+        let instance = wgpu::util::new_instance_with_webgpu_detection(descriptor).await;
+        let surface = instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+            .map_err(|e| js_error(format!("cannot draw into the canvas: {e}")))?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| js_error(format!("this browser gives no WebGPU or WebGL2 adapter: {e}")))?;
+        let capabilities = surface.get_capabilities(&adapter);
+        // As the window does: display values end to end, so a non-sRGB 8-bit surface.
+        let format = [wgpu::TextureFormat::Rgba8Unorm, wgpu::TextureFormat::Bgra8Unorm]
+            .into_iter()
+            .find(|f| capabilities.formats.contains(f))
+            .or_else(|| capabilities.formats.iter().copied().find(|f| !f.is_srgb()))
+            .or_else(|| capabilities.formats.first().copied())
+            .ok_or_else(|| js_error("the canvas supports no texture format"))?;
+        let gpu = Gpu::request(instance, adapter).await.map_err(js_error)?;
+        let backend = gpu.description();
+        let interactive_scale = gpu.interactive_scale();
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width,
+            height,
+            present_mode: wgpu::PresentMode::Fifo,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: capabilities.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        surface.configure(&gpu.device, &config);
+        let renderer = Renderer::with_gpu(gpu, format).map_err(js_error)?;
+        let options = RenderOptions { size: (width, height), interactive_scale, ..RenderOptions::default() };
+        Ok(Viewer { renderer, surface, config, options, orbit: Orbit::default(), model: None, backend })
+    }
+
+    /// The adapter: "name (backend, device type)".
+    pub fn backend(&self) -> String {
+        self.backend.clone()
+    }
+
+    /// Loads a model from its bytes (`name` for messages and to tell the format); refuses one that
+    /// lists more than `max_triangles` triangles. Returns a JSON summary (triangles, parts,
+    /// notices, hard edges). The view is reset.
+    pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<String, JsError> {
+        let limits = drafter_io::Limits { max_triangles: max_triangles.max(0.0) as u64 };
+        let model = Model::load_bytes_within(Path::new(name), bytes, &limits).map_err(js_error)?;
+        self.renderer.set_model(&model).map_err(js_error)?;
+        self.orbit = Orbit::default();
+        let summary = serde_json::json!({
+            "name": name,
+            "triangles": model.triangle_count(),
+            "parts": model.parts.len(),
+            "hardEdges": self.renderer.hard_edge_count(),
+            "notices": model.notices,
+        });
+        self.model = Some(model);
+        Ok(summary.to_string())
+    }
+
+    /// Follows the canvas's new size in pixels.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        let (width, height) = (width.max(1), height.max(1));
+        if (width, height) != (self.config.width, self.config.height) {
+            self.config.width = width;
+            self.config.height = height;
+            self.surface.configure(&self.renderer.gpu().device, &self.config);
+        }
+        self.options.size = (width, height);
+    }
+
+    /// Draws a frame into the canvas; `interactive`: the reduced frame of a drag (see
+    /// `RenderOptions::interactive`). Returns the milliseconds spent recording and submitting (the
+    /// browser draws after this returns).
+    pub fn render(&mut self, interactive: bool) -> Result<f64, JsError> {
+        if self.model.is_none() {
+            return Err(js_error("no model loaded"));
+        }
+        let start = web_time::Instant::now();
+        self.orbit.apply(&mut self.options);
+        self.options.interactive = interactive;
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            _ => {
+                self.surface.configure(&self.renderer.gpu().device, &self.config);
+                return Ok(0.0);
+            }
+        };
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let device = self.renderer.gpu().device.clone();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("web frame") });
+        self.renderer.encode_frame(&self.options, &mut encoder, Some(&view)).map_err(js_error)?;
+        let queue = &self.renderer.gpu().queue;
+        queue.submit([encoder.finish()]);
+        queue.present(frame);
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Turns the object by a drag of (`dx`, `dy`) CSS pixels, as the window's left drag does.
+    pub fn rotate(&mut self, dx: f32, dy: f32) {
+        self.orbit.rotate(dx, dy);
+    }
+
+    /// Pans by a drag of (`dx`, `dy`) canvas pixels (right or middle drag).
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        self.orbit.pan_by(dx, dy, self.options.size);
+    }
+
+    /// Zooms by a wheel movement of `pixels` (positive: closer).
+    pub fn zoom(&mut self, pixels: f32) {
+        self.orbit.zoom_by(pixels / PIXELS_PER_LINE);
+    }
+
+    /// Sets the view: azimuth and elevation in degrees, and the zoom (as `drafter render --view`).
+    pub fn set_view(&mut self, azimuth_deg: f32, elevation_deg: f32, zoom: f32) {
+        self.orbit.view.azimuth_deg = azimuth_deg;
+        self.orbit.view.elevation_deg = elevation_deg;
+        self.orbit.zoom = zoom;
+        self.orbit.pan = [0.0, 0.0];
+    }
+
+    /// What a typed key does, as in the window (`1`–`7` styles, `s` next style, `e` edges, `l`
+    /// lines, `h` next shadow, `o` orthographic, `r` reset): `"redraw"` when the frame changed,
+    /// `"screenshot"` for `p` (the page saves the canvas), `""` otherwise.
+    pub fn key(&mut self, key: &str) -> String {
+        let mut chars = key.chars();
+        let (Some(c), None) = (chars.next(), chars.next()) else { return String::new() };
+        match action_for_char(c) {
+            Some(Action::Screenshot) => "screenshot".into(),
+            Some(Action::Quit) | None => String::new(),
+            Some(action) => {
+                action.apply(&mut self.options, &mut self.orbit);
+                "redraw".into()
+            }
+        }
+    }
+
+    /// Sets the scene's style by name (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`,
+    /// `hatch`).
+    pub fn set_style(&mut self, name: &str) -> Result<(), JsError> {
+        self.options.style = name.parse::<Style>().map_err(js_error)?;
+        Ok(())
+    }
+
+    /// Image-space edges (outlines, creases, the depth unsharp mask) on or off.
+    pub fn set_edges(&mut self, on: bool) {
+        self.options.enhancements = if on { Enhancements::ALL } else { Enhancements::default() };
+    }
+
+    /// The baked lines with this view's silhouettes on or off.
+    pub fn set_lines(&mut self, on: bool) {
+        self.options.lines = on;
+    }
+
+    /// The drop shadow: `none`, `hard`, `penumbra` or `soft`.
+    pub fn set_shadow(&mut self, name: &str) -> Result<(), JsError> {
+        self.options.shadow = ShadowMode::ALL
+            .into_iter()
+            .find(|m| m.name() == name)
+            .ok_or_else(|| js_error(format!("unknown shadow '{name}'")))?;
+        Ok(())
+    }
+
+    /// Orthographic projection on or off.
+    pub fn set_orthographic(&mut self, on: bool) {
+        self.options.orthographic = on;
+    }
+
+    /// The frame's settings as JSON: style, edges, lines, shadow, orthographic, view and zoom.
+    pub fn state(&self) -> String {
+        serde_json::json!({
+            "style": self.options.style.name(),
+            "edges": self.options.enhancements.any(),
+            "lines": self.options.lines,
+            "shadow": self.options.shadow.name(),
+            "orthographic": self.options.orthographic,
+            "azimuth": self.orbit.view.azimuth_deg,
+            "elevation": self.orbit.view.elevation_deg,
+            "zoom": self.orbit.zoom,
+            "pan": self.orbit.pan,
+            "size": [self.options.size.0, self.options.size.1],
+        })
+        .to_string()
+    }
+}
