@@ -285,14 +285,16 @@ pub fn load_silhouettes(
     // What answers each kind of view, as the file records it (node counts and predicted speedups
     // are not stored; a mesh the bake gave no hierarchy reads as brute force by choice).
     let none = HierarchyChoice::BruteForce(BruteForceReason::Disabled);
-    let orthographic = match (s.orthographic.as_str(), &s.gauss_map) {
-        ("gaussMap", Some(g)) => {
+    let orthographic = match (s.orthographic, &s.gauss_map) {
+        (drafter_format::OrthographicHierarchy::GaussMap, Some(g)) => {
             HierarchyChoice::GaussMap { max_depth: g.max_depth.min(255) as u8, nodes: 0, predicted_speedup: 0.0 }
         }
         _ => none,
     };
-    let perspective = match (s.perspective.as_str(), &s.cone_bvh) {
-        ("coneBvh", Some(_)) => HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 },
+    let perspective = match (s.perspective, &s.cone_bvh) {
+        (drafter_format::PerspectiveHierarchy::ConeBvh, Some(_)) => {
+            HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 }
+        }
         _ => none,
     };
     let arrays = |gauss: bool, bvh: bool| SilhouetteArrays {

@@ -108,11 +108,6 @@ impl LookupImage {
 /// bake writes (the spec's `mapping` / `highlightMapping`).
 pub use drafter_textures::EnvMapping;
 
-/// The mapping a file names, in the spelling the bake writes (`octahedral`, `normal_sphere`).
-fn parse_mapping(name: &str) -> Option<EnvMapping> {
-    serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()
-}
-
 /// The γ atlas: row `r` holds `curves[r]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GammaLookup {
@@ -311,19 +306,12 @@ impl Decoder<'_> {
     fn cool_to_warm(&mut self, c: &CoolToWarmTexture) -> Option<CoolToWarmLookup> {
         let image = self.image(c.index, LookupFormat::Rgba8)?;
         let light = Vec3::new(c.light_in_eye[0] as f32, c.light_in_eye[1] as f32, c.light_in_eye[2] as f32);
-        let factored = match c.encoding.as_str() {
-            "factored" => Some(true),
-            "colour" => Some(false),
-            _ => None,
-        };
-        match (parse_mapping(&c.mapping), factored, light.try_normalize()) {
-            (Some(mapping), Some(factored), Some(light_in_eye)) => {
-                Some(CoolToWarmLookup { image, mapping, factored, light_in_eye, splash_back: c.splash_back })
+        let factored = c.encoding == drafter_format::CoolToWarmEncoding::Factored;
+        match light.try_normalize() {
+            Some(light_in_eye) => {
+                Some(CoolToWarmLookup { image, mapping: c.mapping, factored, light_in_eye, splash_back: c.splash_back })
             }
-            _ => self.reject(
-                &image.name,
-                format!("mapping {:?}, encoding {:?} or light {light} not understood", c.mapping, c.encoding),
-            ),
+            None => self.reject(&image.name, format!("light {light} is not a direction")),
         }
     }
 
@@ -348,10 +336,7 @@ impl Decoder<'_> {
     fn metal(&mut self, m: &MetalTexture) -> Option<MetalLookup> {
         let bands = self.image(m.bands.index, LookupFormat::R8)?;
         let highlights = self.image(m.highlights.index, LookupFormat::R8)?;
-        match parse_mapping(&m.highlight_mapping) {
-            Some(mapping) => Some(MetalLookup { bands, highlights, mapping }),
-            None => self.reject("metal", format!("highlight mapping {:?} not understood", m.highlight_mapping)),
-        }
+        Some(MetalLookup { bands, highlights, mapping: m.highlight_mapping })
     }
 }
 
@@ -464,14 +449,6 @@ mod tests {
             writer.finish().unwrap();
         }
         out
-    }
-
-    #[test]
-    fn mappings_are_read_in_the_bakes_spelling() {
-        assert_eq!(parse_mapping("octahedral"), Some(EnvMapping::Octahedral));
-        assert_eq!(parse_mapping("normal_sphere"), Some(EnvMapping::NormalSphere));
-        assert_eq!(parse_mapping("NormalSphere"), None);
-        assert_eq!(parse_mapping(""), None);
     }
 
     #[test]

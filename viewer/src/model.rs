@@ -459,18 +459,8 @@ fn part_curve(gpu: &PartGpu) -> TransferCurve {
 
 /// Reads the `DRAFTER_illustration` data of a glTF/GLB; `None` for other formats and plain glTF.
 fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedFile>, LoadError> {
-    let Ok((json, _)) = drafter_format::split_container(bytes) else { return Ok(None) };
-    let marker = drafter_format::EXTENSION.as_bytes();
-    if !json.windows(marker.len()).any(|w| w == marker) {
-        return Ok(None);
-    }
-    // drafter-format resolves the buffer URI, confined to the file's folder as the importer does.
-    let external = drafter_format::external_buffers(path);
-    match drafter_format::read(bytes, &external) {
-        Ok(baked) => Ok(Some(baked)),
-        Err(FormatError::NotBaked(_)) => Ok(None),
-        Err(source) => Err(LoadError::Baked { path: path.display().to_string(), source }),
-    }
+    drafter_format::read_if_baked(path, bytes)
+        .map_err(|source| LoadError::Baked { path: path.display().to_string(), source })
 }
 
 /// Reads both normal sets of a baked glTF/GLB (see [`read_baked`] for the buffer resolution).

@@ -402,15 +402,14 @@ fn check_output(
     let Some(input) = input else { return Ok(()) };
     // The input and, for a .gltf, the files its buffers and images name (beside it).
     let mut inputs = vec![input.to_path_buf()];
-    if let Ok(doc) = serde_json::from_slice::<serde_json::Value>(input_bytes) {
-        for key in ["buffers", "images"] {
-            for item in doc.get(key).and_then(serde_json::Value::as_array).into_iter().flatten() {
-                if let Some(uri) = item.get("uri").and_then(serde_json::Value::as_str)
-                    && !uri.starts_with("data:")
-                {
-                    inputs.push(input.with_file_name(uri));
-                }
-            }
+    let (buffers, images) = drafter_format::uri::file_uris(input_bytes);
+    let folder = input.parent().unwrap_or(Path::new(""));
+    for uri in buffers.iter().chain(&images) {
+        // drafter-format's rule, as the importer follows the URI; one it refuses is never read.
+        if let Ok(drafter_format::uri::UriSource::File { path, .. }) =
+            drafter_format::uri::resolve_buffer_uri(folder, uri)
+        {
+            inputs.push(path);
         }
     }
     let same = |a: &Path, b: &Path| match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {

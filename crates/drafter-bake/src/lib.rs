@@ -691,16 +691,20 @@ fn silhouettes_of(
             xyz.copy_from_slice(&e.silhouette_normals.decoded(j).unwrap_or(glam::Vec3::ZERO).to_array());
         }
     });
-    let choice = |c: HierarchyChoice| match c {
-        HierarchyChoice::GaussMap { .. } => "gaussMap",
-        HierarchyChoice::ConeBvh { .. } => "coneBvh",
-        HierarchyChoice::BruteForce(_) => "bruteForce",
+    use drafter_format::{OrthographicHierarchy as Ortho, PerspectiveHierarchy as Persp};
+    let orthographic = match arrays.orthographic {
+        HierarchyChoice::GaussMap { .. } => Ortho::GaussMap,
+        _ => Ortho::BruteForce,
+    };
+    let perspective = match arrays.perspective {
+        HierarchyChoice::ConeBvh { .. } => Persp::ConeBvh,
+        _ => Persp::BruteForce,
     };
     Some(MeshSilhouettes {
         candidate_normals,
         candidate_corners: corners,
-        orthographic: choice(arrays.orthographic).to_owned(),
-        perspective: choice(arrays.perspective).to_owned(),
+        orthographic,
+        perspective,
         gauss_map: arrays.gauss_map.map(|g| GaussMapData {
             base: g.base,
             max_depth: g.max_depth,

@@ -187,13 +187,13 @@ pub(crate) fn bake(
                 let metal = record.metal.get_or_insert_with(|| MetalTexture {
                     bands: TextureRef { index: u32::MAX },
                     highlights: TextureRef { index: u32::MAX },
-                    highlight_mapping: String::new(),
+                    highlight_mapping: Default::default(),
                     parts: metal_parts.clone(),
                     metallic_threshold: shortest(threshold),
                 });
                 if let TextureKind::MetalHighlights { mapping } = &texture.kind {
                     metal.highlights.index = first;
-                    metal.highlight_mapping = snake_name(mapping);
+                    metal.highlight_mapping = *mapping;
                 } else {
                     metal.bands.index = first;
                 }
@@ -201,8 +201,8 @@ pub(crate) fn bake(
             TextureKind::CoolToWarm { mapping, encoding, light_in_eye, splash_back } => {
                 record.cool_to_warm.push(CoolToWarmTexture {
                     index: first,
-                    mapping: snake_name(mapping),
-                    encoding: snake_name(encoding),
+                    mapping: *mapping,
+                    encoding: *encoding,
                     light_in_eye: light_in_eye.map(shortest),
                     splash_back: *splash_back,
                 });
@@ -261,11 +261,6 @@ fn sampler_of(texture: &Texture) -> SamplerDesc {
 /// 0.800000011920929), so the record shows the configured values.
 fn shortest(x: f32) -> f64 {
     x.to_string().parse().unwrap_or(f64::from(x))
-}
-
-/// The serde (snake_case) name of a unit enum value.
-fn snake_name<T: Serialize>(value: &T) -> String {
-    serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
 }
 
 #[cfg(test)]

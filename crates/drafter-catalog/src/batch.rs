@@ -469,7 +469,7 @@ fn input_size(path: &Path) -> u64 {
     }
     let Ok(text) = std::fs::read(path) else { return own };
     let folder = path.parent().unwrap_or(Path::new(""));
-    own + crate::cache::gltf_file_uris(&text)
+    own + drafter_format::uri::file_uris(&text)
         .0
         .into_iter()
         .filter_map(|uri| drafter_format::uri::relative_path(&uri).ok())

@@ -222,34 +222,8 @@ fn json_of_file(path: &Path) -> std::io::Result<Vec<u8>> {
 /// The URIs of files a glTF's JSON names beside it, buffers then images, in document order; data
 /// URIs are part of the bytes already. Empty for anything that is not a JSON object.
 fn external_uris(json: &[u8]) -> Vec<String> {
-    let (buffers, images) = gltf_file_uris(json);
+    let (buffers, images) = drafter_format::uri::file_uris(json);
     buffers.into_iter().chain(images).collect()
-}
-
-/// The buffer and image URIs of a glTF's JSON that name files (not data URIs), in document order.
-/// Only these members are decoded (the rest of the document is skipped, not built), since a batch
-/// reads them for every glTF it is given. Empty for anything that is not such a JSON object.
-pub(crate) fn gltf_file_uris(json: &[u8]) -> (Vec<String>, Vec<String>) {
-    #[derive(serde::Deserialize)]
-    struct Document {
-        #[serde(default)]
-        buffers: Vec<Item>,
-        #[serde(default)]
-        images: Vec<Item>,
-    }
-    #[derive(serde::Deserialize)]
-    struct Item {
-        #[serde(default)]
-        uri: Option<String>,
-    }
-    let start = json.iter().position(|b| !b.is_ascii_whitespace());
-    if start.is_none_or(|i| json[i] != b'{') {
-        return (Vec::new(), Vec::new());
-    }
-    let Ok(doc) = serde_json::from_slice::<Document>(json) else { return (Vec::new(), Vec::new()) };
-    let files =
-        |items: Vec<Item>| items.into_iter().filter_map(|i| i.uri).filter(|u| !u.starts_with("data:")).collect();
-    (files(doc.buffers), files(doc.images))
 }
 
 /// What `drafter cache stats` prints.

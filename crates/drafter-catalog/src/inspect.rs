@@ -53,26 +53,14 @@ pub struct BakedSummary {
 
 /// Reads the extension if the file is a baked glTF; `None` for anything else.
 fn read_baked(path: &Path, bytes: &[u8]) -> Result<Option<BakedSummary>, Error> {
-    let (json, _) = match drafter_format::split_container(bytes) {
-        Ok(parts) => parts,
-        Err(_) => return Ok(None),
-    };
-    if !json.windows(drafter_format::EXTENSION.len()).any(|w| w == drafter_format::EXTENSION.as_bytes()) {
-        return Ok(None);
-    }
-    // drafter-format resolves the buffer URI, confined to the file's folder as the importer does.
-    let external = drafter_format::external_buffers(path);
-    match drafter_format::read(bytes, &external) {
-        Ok(baked) => Ok(Some(BakedSummary {
-            parts: baked.parts().into_iter().cloned().collect(),
-            labelled_primitives: baked.primitive_labels.len(),
-            sections: drafter_format::byte_sections(bytes, &external)
-                .map_err(|e| Error::Input(format!("{}: {e}", path.display())))?,
-            root: baked.root,
-        })),
-        Err(drafter_format::FormatError::NotBaked(_)) => Ok(None),
-        Err(e) => Err(Error::Input(format!("{}: {e}", path.display()))),
-    }
+    let failed = |e: drafter_format::FormatError| Error::Input(format!("{}: {e}", path.display()));
+    let Some(baked) = drafter_format::read_if_baked(path, bytes).map_err(failed)? else { return Ok(None) };
+    Ok(Some(BakedSummary {
+        parts: baked.parts().into_iter().cloned().collect(),
+        labelled_primitives: baked.primitive_labels.len(),
+        sections: drafter_format::byte_sections(bytes, &drafter_format::external_buffers(path)).map_err(failed)?,
+        root: baked.root,
+    }))
 }
 
 #[derive(Debug, Serialize)]

@@ -6,6 +6,7 @@
 
 pub use drafter_core::ObbMethod;
 pub use drafter_core::gradient::TransferCurve;
+pub use drafter_textures::{CoolToWarmEncoding, EnvMapping};
 use serde::{Deserialize, Serialize};
 
 /// The extension's name, as listed in `extensionsUsed` (never in `extensionsRequired`).
@@ -143,9 +144,9 @@ pub struct CoolToWarmTexture {
     /// The glTF texture.
     pub index: u32,
     /// `octahedral` or `normal_sphere` (formulas in the spec).
-    pub mapping: String,
+    pub mapping: EnvMapping,
     /// `factored` (RGB = base, A = object-colour weight: `clamp(rgb + a·k_d)`) or `colour`.
-    pub encoding: String,
+    pub encoding: CoolToWarmEncoding,
     /// Unit direction towards the light in eye space the map was baked for.
     pub light_in_eye: [f64; 3],
     /// Whether the splash-back multiplier is included (Fig. 10(b)).
@@ -172,7 +173,7 @@ pub struct MetalTexture {
     /// R8 highlights, indexed by the eye-space normal through `highlightMapping`.
     pub highlights: TextureRef,
     /// `octahedral` or `normal_sphere`.
-    pub highlight_mapping: String,
+    pub highlight_mapping: EnvMapping,
     /// Ids of the parts the bake found metal (style hint `metal`, or material metallic factor at
     /// or above `metallicThreshold`).
     pub parts: Vec<u32>,
@@ -402,6 +403,28 @@ pub struct MeshExtension {
     pub silhouettes: Option<SilhouettesRecord>,
 }
 
+/// What answers orthographic silhouette queries of a mesh (`silhouettes.orthographic`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum OrthographicHierarchy {
+    /// The Gauss map of `silhouettes.gaussMap` (Gooch et al. 1999).
+    GaussMap,
+    /// Every candidate tested.
+    #[default]
+    BruteForce,
+}
+
+/// What answers perspective silhouette queries of a mesh (`silhouettes.perspective`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum PerspectiveHierarchy {
+    /// The normal-cone BVH of `silhouettes.coneBvh`.
+    ConeBvh,
+    /// Every candidate tested.
+    #[default]
+    BruteForce,
+}
+
 /// The silhouette candidates of a mesh and the hierarchies that answer "which are silhouettes from
 /// here" (Gooch et al. 1999 Gauss map for orthographic views, a normal-cone BVH for eye points).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -413,10 +436,10 @@ pub struct SilhouettesRecord {
     /// of the edge's first vertex: a silhouette for view direction u iff (n1·u) and (n2·u) have
     /// strictly opposite signs, for an eye iff n1·(e − v) and n2·(e − v) do.
     pub candidates: u32,
-    /// `gaussMap` or `bruteForce`: what answers orthographic views.
-    pub orthographic: String,
-    /// `coneBvh` or `bruteForce`: what answers perspective views.
-    pub perspective: String,
+    /// What answers orthographic views.
+    pub orthographic: OrthographicHierarchy,
+    /// What answers perspective views.
+    pub perspective: PerspectiveHierarchy,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_map: Option<GaussMapRecord>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -530,5 +553,22 @@ mod tests {
             assert!(error.contains(value), "{field}: {error}");
         }
         assert!(serde_json::from_value::<ObbMethod>("best".into()).is_err());
+    }
+
+    #[test]
+    fn enums_are_written_and_read_in_the_specs_spelling() {
+        assert_eq!(json(&EnvMapping::Octahedral), "\"octahedral\"");
+        assert_eq!(json(&EnvMapping::NormalSphere), "\"normal_sphere\"");
+        assert_eq!(json(&CoolToWarmEncoding::Factored), "\"factored\"");
+        assert_eq!(json(&CoolToWarmEncoding::Colour), "\"colour\"");
+        assert_eq!(json(&OrthographicHierarchy::GaussMap), "\"gaussMap\"");
+        assert_eq!(json(&OrthographicHierarchy::BruteForce), "\"bruteForce\"");
+        assert_eq!(json(&PerspectiveHierarchy::ConeBvh), "\"coneBvh\"");
+        assert!(serde_json::from_str::<EnvMapping>("\"NormalSphere\"").is_err());
+        assert!(serde_json::from_str::<PerspectiveHierarchy>("\"gaussMap\"").is_err());
+    }
+
+    fn json<T: Serialize>(value: &T) -> String {
+        serde_json::to_string(value).unwrap()
     }
 }

@@ -31,16 +31,17 @@ mod writer;
 
 pub use edit::{replace_part_records, validate as validate_part_record};
 pub use ext::{
-    BoxRecord, CelTableRecord, CelTexture, ConeBvhRecord, CoolToWarmTexture, EDGE_VISIBILITY_EXTENSION,
-    ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, FORMAT_VERSION, GaussMapRecord, GradientRecord, GradientTexture,
-    HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture, NodeExtension, NormalsInfo, ObbMethod,
-    PartRecord, PartStyle, PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef,
-    TexturesRecord, TransferCurve, UnknownStyle,
+    BoxRecord, CelTableRecord, CelTexture, ConeBvhRecord, CoolToWarmEncoding, CoolToWarmTexture,
+    EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, EnvMapping, FORMAT_VERSION, GaussMapRecord,
+    GradientRecord, GradientTexture, HardEdgeClass, HatchingTexture, InputInfo, MeshExtension, MetalTexture,
+    NodeExtension, NormalsInfo, ObbMethod, OrthographicHierarchy, PartRecord, PartStyle, PerspectiveHierarchy,
+    PrimitiveExtension, ProjectorRecord, RootExtension, SilhouettesRecord, TextureRef, TexturesRecord, TransferCurve,
+    UnknownStyle,
 };
 pub use external::external_buffers;
 pub use reader::{
-    BakedFile, ByteSections, EmbeddedPng, PrimitiveNormals, byte_sections, read, read_floats, read_normal_sets,
-    read_scalars, read_textures, split_container,
+    BakedFile, ByteSections, EmbeddedPng, PrimitiveNormals, byte_sections, read, read_floats, read_if_baked,
+    read_normal_sets, read_scalars, read_textures, split_container,
 };
 pub use writer::{
     BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,

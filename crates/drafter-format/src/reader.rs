@@ -58,6 +58,22 @@ pub fn split_container(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), FormatErr
     Ok((chunks.json, chunks.bin))
 }
 
+/// The extension's records of the file at `path` (its bytes), or `None` when it is not a baked
+/// glTF: not a glTF container, or no `DRAFTER_illustration` in its JSON. The one answer to "is this
+/// file baked?" for the viewer and inspect; a .gltf's buffer is loaded by [`crate::external_buffers`].
+pub fn read_if_baked(path: &std::path::Path, bytes: &[u8]) -> Result<Option<BakedFile>, FormatError> {
+    let Ok((json, _)) = split_container(bytes) else { return Ok(None) };
+    let marker = EXTENSION.as_bytes();
+    if !json.windows(marker.len()).any(|w| w == marker) {
+        return Ok(None);
+    }
+    match read(bytes, &crate::external_buffers(path)) {
+        Ok(baked) => Ok(Some(baked)),
+        Err(FormatError::NotBaked(_)) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 /// The PNG bytes of one texture the extension refers to.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct EmbeddedPng {

@@ -131,6 +131,33 @@ pub fn read_buffer_uri(folder: &Path, uri: &str) -> Result<Vec<u8>, String> {
     }
 }
 
+/// The buffer and image URIs of a glTF's JSON that name files (not data URIs), in document order.
+/// Only these members are decoded (the rest of the document is skipped, not built), since a batch
+/// reads them for every glTF it is given (the cache's key, the batch's sizes, `bake`'s check that
+/// the output is none of the input's files). Empty for anything that is not such a JSON object.
+pub fn file_uris(json: &[u8]) -> (Vec<String>, Vec<String>) {
+    #[derive(serde::Deserialize)]
+    struct Document {
+        #[serde(default)]
+        buffers: Vec<Item>,
+        #[serde(default)]
+        images: Vec<Item>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Item {
+        #[serde(default)]
+        uri: Option<String>,
+    }
+    let start = json.iter().position(|b| !b.is_ascii_whitespace());
+    if start.is_none_or(|i| json[i] != b'{') {
+        return (Vec::new(), Vec::new());
+    }
+    let Ok(doc) = serde_json::from_slice::<Document>(json) else { return (Vec::new(), Vec::new()) };
+    let files =
+        |items: Vec<Item>| items.into_iter().filter_map(|i| i.uri).filter(|u| !u.starts_with("data:")).collect();
+    (files(doc.buffers), files(doc.images))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

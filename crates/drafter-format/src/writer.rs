@@ -202,10 +202,10 @@ pub struct MeshSilhouettes {
     /// 6 floats per candidate: both face normals as decoded from `silhouetteNormals`. Derived, not
     /// stored.
     pub candidate_normals: Vec<f32>,
-    /// `gaussMap` or `bruteForce`.
-    pub orthographic: String,
-    /// `coneBvh` or `bruteForce`.
-    pub perspective: String,
+    /// What answers orthographic views.
+    pub orthographic: crate::OrthographicHierarchy,
+    /// What answers perspective views.
+    pub perspective: crate::PerspectiveHierarchy,
     pub gauss_map: Option<GaussMapData>,
     pub cone_bvh: Option<ConeBvhData>,
 }
@@ -794,8 +794,8 @@ fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord
     });
     SilhouettesRecord {
         candidates: sil.candidate_corners.len() as u32,
-        orthographic: sil.orthographic.clone(),
-        perspective: sil.perspective.clone(),
+        orthographic: sil.orthographic,
+        perspective: sil.perspective,
         gauss_map,
         cone_bvh,
     }
