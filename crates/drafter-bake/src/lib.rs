@@ -253,34 +253,8 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     timed("textures", start.elapsed());
 
     let start = begin("write");
-    let bounds = scene.world_bounds();
-    let center = if bounds.is_empty() { DVec3::ZERO } else { (bounds.min + bounds.max) * 0.5 };
-    let root = RootExtension {
-        version: FORMAT_VERSION.to_owned(),
-        generator: GENERATOR.to_owned(),
-        input: config.input.clone(),
-        settings: settings_echo(config),
-        scene_center: center.to_array(),
-        part_count: parts.len() as u32,
-        normals: config.normals.enabled.then(|| NormalsInfo {
-            strength: f64::from(config.normals.options.enhance.strength),
-            iterations: config.normals.options.enhance.iterations,
-            crease_angle_deg: f64::from(config.normals.options.crease.crease_angle_deg),
-            enhanced_in_normal: config.normals.enhanced_in_normal,
-        }),
-        textures: None,
-    };
-    let instance_parts: Vec<Vec<PartRecord>> = parts
-        .instances
-        .iter()
-        .map(|ip| records[ip.first_part.index()..ip.first_part.index() + ip.part_count as usize].to_vec())
-        .collect();
-    let mut mesh_labels: Vec<Option<Vec<u32>>> = vec![None; scene.meshes.len()];
-    for (inst, ip) in scene.instances.iter().zip(&parts.instances) {
-        if let MeshLabels::PerTriangle(table) = &ip.labels {
-            mesh_labels[inst.mesh.index()].get_or_insert_with(|| table.labels().to_vec());
-        }
-    }
+    let root = root_record(scene, config, parts.len() as u32);
+    let (instance_parts, mesh_labels) = part_records_and_labels(scene, &parts, &records);
     let (textures_summary, embedded) = match baked_textures {
         Some(b) => (Some(b.summary), Some(b.embedded)),
         None => (None, None),
@@ -311,18 +285,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
 
     let sections = written.sections;
     let mut written = written;
-    let compression = match (config.compress, &config.container) {
-        (Compression::None, _) => None,
-        (Compression::Meshopt, Container::Glb) => {
-            let (main, stats) = drafter_format::meshopt::compress_glb(&written.main)
-                .map_err(|e| BakeError::Internal { stage: "write", message: format!("compression: {e}") })?;
-            written.main = main;
-            Some(stats)
-        }
-        (Compression::Meshopt, Container::Gltf { .. }) => {
-            return Err(BakeError::Config("compression (meshopt) writes .glb files only".into()));
-        }
-    };
+    let compression = compress(config, &mut written)?;
     timed("write", start.elapsed());
     let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
     diagnostics.sort_by_key(|d| d.kind);
@@ -342,6 +305,68 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     };
     begin("done");
     Ok(Baked { written, report, textures: texture_images })
+}
+
+/// The root record of the file: provenance, settings, scene centre and the normal stage's
+/// parameters (the embedded textures' indices are added by the writer).
+fn root_record(scene: &Scene, config: &BakeConfig, part_count: u32) -> RootExtension {
+    let bounds = scene.world_bounds();
+    let center = if bounds.is_empty() { DVec3::ZERO } else { (bounds.min + bounds.max) * 0.5 };
+    RootExtension {
+        version: FORMAT_VERSION.to_owned(),
+        generator: GENERATOR.to_owned(),
+        input: config.input.clone(),
+        settings: settings_echo(config),
+        scene_center: center.to_array(),
+        part_count,
+        normals: config.normals.enabled.then(|| NormalsInfo {
+            strength: f64::from(config.normals.options.enhance.strength),
+            iterations: config.normals.options.enhance.iterations,
+            crease_angle_deg: f64::from(config.normals.options.crease.crease_angle_deg),
+            enhanced_in_normal: config.normals.enhanced_in_normal,
+        }),
+        textures: None,
+    }
+}
+
+/// Each instance's part records, and each mesh's per-triangle part labels (from the first
+/// instance that has them; instances of one mesh share its labels).
+fn part_records_and_labels(
+    scene: &Scene,
+    parts: &Parts,
+    records: &[PartRecord],
+) -> (Vec<Vec<PartRecord>>, Vec<Option<Vec<u32>>>) {
+    let instance_parts = parts
+        .instances
+        .iter()
+        .map(|ip| records[ip.first_part.index()..ip.first_part.index() + ip.part_count as usize].to_vec())
+        .collect();
+    let mut mesh_labels: Vec<Option<Vec<u32>>> = vec![None; scene.meshes.len()];
+    for (inst, ip) in scene.instances.iter().zip(&parts.instances) {
+        if let MeshLabels::PerTriangle(table) = &ip.labels {
+            mesh_labels[inst.mesh.index()].get_or_insert_with(|| table.labels().to_vec());
+        }
+    }
+    (instance_parts, mesh_labels)
+}
+
+/// Compresses the written .glb in place when the configuration asks for it.
+fn compress(
+    config: &BakeConfig,
+    written: &mut Written,
+) -> Result<Option<drafter_format::meshopt::CompressionStats>, BakeError> {
+    match (config.compress, &config.container) {
+        (Compression::None, _) => Ok(None),
+        (Compression::Meshopt, Container::Glb) => {
+            let (main, stats) = drafter_format::meshopt::compress_glb(&written.main)
+                .map_err(|e| BakeError::Internal { stage: "write", message: format!("compression: {e}") })?;
+            written.main = main;
+            Ok(Some(stats))
+        }
+        (Compression::Meshopt, Container::Gltf { .. }) => {
+            Err(BakeError::Config("compression (meshopt) writes .glb files only".into()))
+        }
+    }
 }
 
 /// What the normals stage hands on: per-mesh vertex data, the primitives split within 16-bit

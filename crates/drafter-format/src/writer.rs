@@ -378,25 +378,10 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             // passed (drafter-bake passes none; `tests/edge_extension.rs` there checks both).
             let edges =
                 out.primitive_edges[m].get(g).and_then(Option::as_ref).filter(|e| e.visibility.iter().any(|&b| b != 0));
-            let mut hard_edge_classes = None;
-            if let Some(edges) = edges {
-                let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
-                let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
-                let mut ext = json!({"visibility": visibility, "material": material});
-                if !edges.silhouette_normals.is_empty() {
-                    ext["silhouetteNormals"] = doc.push_unit_vec3(&edges.silhouette_normals).into();
-                }
-                if !edges.hard_edge_classes.is_empty() {
-                    hard_edge_classes = Some(doc.push_typed_scalars(
-                        UNSIGNED_BYTE,
-                        &edges.hard_edge_classes,
-                        edges.hard_edge_classes.len(),
-                    ) as u32);
-                }
-                let prim = primitive_mut(&mut doc, m, primitive)?;
-                extension_slot(prim).insert(EDGE_VISIBILITY_EXTENSION.into(), ext);
-                doc.use_extension(EDGE_VISIBILITY_EXTENSION);
-            }
+            let hard_edge_classes = match edges {
+                Some(edges) => write_edges(&mut doc, (m, primitive), edges, &mut edge_material)?,
+                None => None,
+            };
             if part_labels.is_none() && enhanced_normal.is_none() && hard_edge_classes.is_none() {
                 continue;
             }
@@ -405,36 +390,10 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             extension_slot(prim).insert(EXTENSION.into(), ext);
         }
         if let Some(sil) = &out.mesh_silhouettes[m] {
-            let encoded: usize = out.primitive_edges[m].iter().flatten().map(|e| e.silhouette_normals.len() / 2).sum();
-            if encoded != sil.candidate_corners.len() || 6 * encoded != sil.candidate_normals.len() {
-                return Err(FormatError::Inconsistent(format!(
-                    "mesh {m}: {} silhouette candidates, but its primitives encode {encoded} edges as 1",
-                    sil.candidate_corners.len()
-                )));
-            }
-            let record = silhouettes_record(&mut doc, sil);
-            let ext = serde_json::to_value(MeshExtension { silhouettes: Some(record) })?;
-            let mesh_json =
-                doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
-            extension_slot(mesh_json).insert(EXTENSION.into(), ext);
+            write_silhouettes(&mut doc, m, sil, &out.primitive_edges[m])?;
         }
     }
-    let mut root = out.root.clone();
-    if let Some(textures) = &out.textures {
-        root.textures = Some(write_textures(&mut doc, textures)?);
-    }
-    let root_ext = serde_json::to_value(&root)?;
-    let root = doc.json.entry("extensions").or_insert_with(|| json!({}));
-    if !root.is_object() {
-        // The source's was `null` or another non-object (which glTF does not allow, and serde
-        // takes as "none"): left as it was, the file had no root record and did not read back
-        // (drafter-fuzz, issue 47's campaign).
-        *root = json!({});
-    }
-    if let Value::Object(map) = root {
-        map.insert(EXTENSION.into(), root_ext);
-    }
-    doc.use_extension(EXTENSION);
+    write_root(&mut doc, out)?;
     if emptied.iter().any(|e| !e.is_empty()) {
         drop_emptied(&mut doc, &emptied, &mut notes);
     }
@@ -451,6 +410,71 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
             Ok(Written { main, bin: Some(bin), notes, sections })
         }
     }
+}
+
+/// Writes one primitive's `EXT_mesh_primitive_edge_visibility` (its edge material created on
+/// first use) and returns the accessor of its hard-edge classes, if it has any.
+fn write_edges(
+    doc: &mut Doc,
+    (m, primitive): (usize, usize),
+    edges: &PrimitiveEdges,
+    edge_material: &mut Option<usize>,
+) -> Result<Option<u32>, FormatError> {
+    let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
+    let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
+    let mut ext = json!({"visibility": visibility, "material": material});
+    if !edges.silhouette_normals.is_empty() {
+        ext["silhouetteNormals"] = doc.push_unit_vec3(&edges.silhouette_normals).into();
+    }
+    let hard_edge_classes = (!edges.hard_edge_classes.is_empty())
+        .then(|| doc.push_typed_scalars(UNSIGNED_BYTE, &edges.hard_edge_classes, edges.hard_edge_classes.len()) as u32);
+    let prim = primitive_mut(doc, m, primitive)?;
+    extension_slot(prim).insert(EDGE_VISIBILITY_EXTENSION.into(), ext);
+    doc.use_extension(EDGE_VISIBILITY_EXTENSION);
+    Ok(hard_edge_classes)
+}
+
+/// Writes mesh `m`'s silhouette record, after checking it against the edges its primitives encode.
+fn write_silhouettes(
+    doc: &mut Doc,
+    m: usize,
+    sil: &MeshSilhouettes,
+    edges: &[Option<PrimitiveEdges>],
+) -> Result<(), FormatError> {
+    let encoded: usize = edges.iter().flatten().map(|e| e.silhouette_normals.len() / 2).sum();
+    if encoded != sil.candidate_corners.len() || 6 * encoded != sil.candidate_normals.len() {
+        return Err(FormatError::Inconsistent(format!(
+            "mesh {m}: {} silhouette candidates, but its primitives encode {encoded} edges as 1",
+            sil.candidate_corners.len()
+        )));
+    }
+    let record = silhouettes_record(doc, sil);
+    let ext = serde_json::to_value(MeshExtension { silhouettes: Some(record) })?;
+    let mesh_json =
+        doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
+    extension_slot(mesh_json).insert(EXTENSION.into(), ext);
+    Ok(())
+}
+
+/// Writes the root record (with the embedded textures' indices) into the document's extensions.
+fn write_root(doc: &mut Doc, out: &BakeOutput) -> Result<(), FormatError> {
+    let mut root = out.root.clone();
+    if let Some(textures) = &out.textures {
+        root.textures = Some(write_textures(doc, textures)?);
+    }
+    let root_ext = serde_json::to_value(&root)?;
+    let root = doc.json.entry("extensions").or_insert_with(|| json!({}));
+    if !root.is_object() {
+        // The source's was `null` or another non-object (which glTF does not allow, and serde
+        // takes as "none"): left as it was, the file had no root record and did not read back
+        // (drafter-fuzz, issue 47's campaign).
+        *root = json!({});
+    }
+    if let Value::Object(map) = root {
+        map.insert(EXTENSION.into(), root_ext);
+    }
+    doc.use_extension(EXTENSION);
+    Ok(())
 }
 
 /// Appends the PNG images (buffer views), their samplers and textures after the document's own,

@@ -336,93 +336,115 @@ impl Grouping<'_> {
                 continue;
             }
             // 2. Degenerate faces: bridge their neighbours, then join the first of them.
-            for (i, &d) in faces.iter().enumerate() {
-                if !self.geometry.is_degenerate(d as usize) {
-                    continue;
-                }
-                linked.clear();
-                let c = self.corner_of(d as usize, v32);
-                for e in self.edges_at(d as usize, c) {
-                    if e == EDGE_NONE {
-                        continue;
-                    }
-                    for &g in self.topology.faces_of_edge(e as usize) {
-                        if !self.geometry.is_degenerate(g as usize) && !linked.contains(&g) {
-                            linked.push(g);
-                        }
-                    }
-                }
-                for a in 0..linked.len() {
-                    for b in a + 1..linked.len() {
-                        let (f, g) = (linked[a], linked[b]);
-                        let shares_edge = self.topology.face_edges[f as usize]
-                            .iter()
-                            .any(|&e| e != EDGE_NONE && self.topology.faces_of_edge(e as usize).contains(&g));
-                        // Faces that already share an edge were decided in step 1.
-                        if !shares_edge
-                            && self.smooth(f as usize, g as usize, v32)
-                            && let (Some(x), Some(y)) = (local(f), local(g))
-                        {
-                            union(&mut parent, x, y);
-                        }
-                    }
-                }
-                let target = linked
-                    .iter()
-                    .copied()
-                    .find(|&g| self.same_input_vertex(d as usize, g as usize, v32))
-                    .or_else(|| {
-                        faces.iter().copied().find(|&g| {
-                            g != d
-                                && !self.geometry.is_degenerate(g as usize)
-                                && self.same_input_vertex(d as usize, g as usize, v32)
-                        })
-                    })
-                    .or_else(|| {
-                        faces.iter().copied().find(|&g| g != d && self.same_input_vertex(d as usize, g as usize, v32))
-                    });
-                if let Some(j) = target.and_then(local) {
-                    union(&mut parent, i, j);
-                }
-            }
-
+            self.bridge_degenerate(faces, v32, &mut parent, &mut linked);
             // 3. Number the groups in order of their first face and emit their corners.
-            group_of_root.clear();
-            group_of_root.resize(faces.len(), u32::MAX);
-            members.clear();
-            let mut group_count = 0u32;
-            for (i, &f) in faces.iter().enumerate() {
-                let root = find(&mut parent, i) as usize;
-                if group_of_root[root] == u32::MAX {
-                    group_of_root[root] = group_count;
-                    group_count += 1;
-                }
-                let face = self.topology.faces[f as usize];
-                for (k, &w) in face.iter().enumerate() {
-                    if w == v32 {
-                        members.push((group_of_root[root], f * 3 + k as u32));
-                    }
-                }
-            }
-            members.sort_unstable();
-            let mut start = 0;
-            while start < members.len() {
-                let group = members[start].0;
-                let mut end = start;
-                let mut source = u32::MAX;
-                while end < members.len() && members[end].0 == group {
-                    let corner = members[end].1 as usize;
-                    source = source.min(self.mesh.triangles[corner / 3][corner % 3]);
-                    out.corners.push(members[end].1);
-                    end += 1;
-                }
-                out.group_sizes.push((end - start) as u32);
-                out.sources.push(source);
-                out.welded.push(v32);
-                start = end;
-            }
+            self.emit_groups(faces, v32, &mut parent, (&mut group_of_root, &mut members), &mut out);
         }
         out
+    }
+
+    /// Step 2 of [`Self::group_vertices`]: each degenerate face around `v` bridges its neighbours
+    /// (smooth pairs that share no edge are joined) and joins the first face it shares the input
+    /// vertex with.
+    #[inline]
+    fn bridge_degenerate(&self, faces: &[u32], v32: u32, parent: &mut [u32], linked: &mut Vec<u32>) {
+        let local = |g: u32| faces.binary_search(&g).ok();
+        for (i, &d) in faces.iter().enumerate() {
+            if !self.geometry.is_degenerate(d as usize) {
+                continue;
+            }
+            linked.clear();
+            let c = self.corner_of(d as usize, v32);
+            for e in self.edges_at(d as usize, c) {
+                if e == EDGE_NONE {
+                    continue;
+                }
+                for &g in self.topology.faces_of_edge(e as usize) {
+                    if !self.geometry.is_degenerate(g as usize) && !linked.contains(&g) {
+                        linked.push(g);
+                    }
+                }
+            }
+            for a in 0..linked.len() {
+                for b in a + 1..linked.len() {
+                    let (f, g) = (linked[a], linked[b]);
+                    let shares_edge = self.topology.face_edges[f as usize]
+                        .iter()
+                        .any(|&e| e != EDGE_NONE && self.topology.faces_of_edge(e as usize).contains(&g));
+                    // Faces that already share an edge were decided in step 1.
+                    if !shares_edge
+                        && self.smooth(f as usize, g as usize, v32)
+                        && let (Some(x), Some(y)) = (local(f), local(g))
+                    {
+                        union(parent, x, y);
+                    }
+                }
+            }
+            let target = linked
+                .iter()
+                .copied()
+                .find(|&g| self.same_input_vertex(d as usize, g as usize, v32))
+                .or_else(|| {
+                    faces.iter().copied().find(|&g| {
+                        g != d
+                            && !self.geometry.is_degenerate(g as usize)
+                            && self.same_input_vertex(d as usize, g as usize, v32)
+                    })
+                })
+                .or_else(|| {
+                    faces.iter().copied().find(|&g| g != d && self.same_input_vertex(d as usize, g as usize, v32))
+                });
+            if let Some(j) = target.and_then(local) {
+                union(parent, i, j);
+            }
+        }
+    }
+
+    /// Step 3 of [`Self::group_vertices`]: numbers the groups around `v` in order of their first
+    /// face and emits their corners, sources and welded vertex into `out`.
+    #[inline]
+    fn emit_groups(
+        &self,
+        faces: &[u32],
+        v32: u32,
+        parent: &mut [u32],
+        (group_of_root, members): (&mut Vec<u32>, &mut Vec<(u32, u32)>),
+        out: &mut ChunkGroups,
+    ) {
+        group_of_root.clear();
+        group_of_root.resize(faces.len(), u32::MAX);
+        members.clear();
+        let mut group_count = 0u32;
+        for (i, &f) in faces.iter().enumerate() {
+            let root = find(parent, i) as usize;
+            if group_of_root[root] == u32::MAX {
+                group_of_root[root] = group_count;
+                group_count += 1;
+            }
+            let face = self.topology.faces[f as usize];
+            for (k, &w) in face.iter().enumerate() {
+                if w == v32 {
+                    members.push((group_of_root[root], f * 3 + k as u32));
+                }
+            }
+        }
+        members.sort_unstable();
+        let mut start = 0;
+        while start < members.len() {
+            let group = members[start].0;
+            let mut end = start;
+            let mut source = u32::MAX;
+            while end < members.len() && members[end].0 == group {
+                let corner = members[end].1 as usize;
+                source = source.min(self.mesh.triangles[corner / 3][corner % 3]);
+                out.corners.push(members[end].1);
+                end += 1;
+            }
+            out.group_sizes.push((end - start) as u32);
+            out.sources.push(source);
+            out.welded.push(v32);
+            start = end;
+        }
     }
 }
 

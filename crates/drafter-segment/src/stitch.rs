@@ -73,146 +73,10 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
     }
     let segments = free_segments(topo, labelling);
     let point = |v: u32| topo.welded_positions[v as usize].as_dvec3();
-    let length = |s: &Segment| point(s.a).distance(point(s.b));
-    let tol = limits.tolerance.max(0.0);
-
-    // Grid: cells about twice the median free segment, never below the tolerance.
-    let lengths: Vec<f64> = segments.iter().map(length).collect();
-    let median = {
-        let mut sorted = lengths.clone();
-        let mid = sorted.len() / 2;
-        if sorted.is_empty() { 0.0 } else { *sorted.select_nth_unstable_by(mid, f64::total_cmp).1 }
-    };
-    let mut region = Aabb::EMPTY;
-    for s in &segments {
-        region.extend(point(s.a));
-        region.extend(point(s.b));
-    }
-    if region.is_empty() {
-        return None;
-    }
-    region.min -= tol;
-    region.max += tol;
-    // A segment is registered piece by piece, each piece at most a cell long, so that with the
-    // tolerance at most a quarter cell a piece touches at most 3 cells per axis. The cells double
-    // until the pieces fit a budget linear in the segments (a few very long edges among short ones
-    // would otherwise be cut into millions of pieces), so the entries are at most 27 times that.
-    let extent = region.diagonal();
-    if !extent.is_finite() {
-        return None;
-    }
-    let mut cell = (2.0 * median).max(4.0 * tol).max(extent / MAX_CELLS_PER_AXIS).max(f64::MIN_POSITIVE);
-    let budget = (4 * segments.len() + (1 << 16)) as f64;
-    while lengths.iter().map(|&l| (l / cell).ceil().max(1.0)).sum::<f64>() > budget {
-        cell *= 2.0;
-    }
-    let max_coord = f64::from(u32::MAX - 1);
-    let cell_of = |p: DVec3| {
-        let c = ((p - region.min) / cell).floor().clamp(DVec3::ZERO, DVec3::splat(max_coord));
-        (c.x as u32, c.y as u32, c.z as u32)
-    };
-    let mut entries: Vec<((u32, u32, u32), u32)> = segments
-        .par_iter()
-        .enumerate()
-        .with_min_len(1024)
-        .fold(Vec::new, |mut out, (i, s)| {
-            let (p, q) = (point(s.a), point(s.b));
-            let pieces = (p.distance(q) / cell).ceil().max(1.0);
-            let n = pieces as u32;
-            for k in 0..n {
-                let (x, y) = (p.lerp(q, f64::from(k) / pieces), p.lerp(q, f64::from(k + 1) / pieces));
-                let (lo, hi) = (cell_of(x.min(y) - tol), cell_of(x.max(y) + tol));
-                for cz in lo.2..=hi.2 {
-                    for cy in lo.1..=hi.1 {
-                        for cx in lo.0..=hi.0 {
-                            out.push(((cx, cy, cz), i as u32));
-                        }
-                    }
-                }
-            }
-            out
-        })
-        .reduce(Vec::new, |mut a, mut b| {
-            a.append(&mut b);
-            a
-        });
-    entries.par_sort_unstable();
-    entries.dedup();
-
-    // The labels whose free segments pass within `tol` of `p`, other than `own`, sorted.
-    let tol2 = tol * tol;
-    let near_labels = |p: DVec3, own: u32, out: &mut Vec<u32>| {
-        out.clear();
-        let key = cell_of(p);
-        let start = entries.partition_point(|e| e.0 < key);
-        let end = start + entries[start..].partition_point(|e| e.0 == key);
-        if end - start > MAX_CELL_ENTRIES {
-            return; // a crowded cell (many free edges through one point) is not searched
-        }
-        for &(_, i) in &entries[start..end] {
-            let s = segments[i as usize];
-            if s.label != own && point_segment_distance_squared(p, point(s.a), point(s.b)) <= tol2 {
-                out.push(s.label);
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-    };
-
-    // The labels that cover each segment: all three samples near one of their free segments.
-    let cover: Vec<(u32, u32)> = segments
-        .par_iter()
-        .enumerate()
-        .with_min_len(1024)
-        .fold(Vec::new, |mut out, (i, s)| {
-            let (p, q) = (point(s.a), point(s.b));
-            let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
-            near_labels(p, s.label, &mut x);
-            if x.is_empty() {
-                return out;
-            }
-            near_labels(q, s.label, &mut y);
-            near_labels((p + q) * 0.5, s.label, &mut z);
-            out.extend(
-                x.iter().filter(|l| y.binary_search(l).is_ok() && z.binary_search(l).is_ok()).map(|&l| (i as u32, l)),
-            );
-            out
-        })
-        .reduce(Vec::new, |mut a, mut b| {
-            a.append(&mut b);
-            a
-        });
-    let mut cover = cover;
-    cover.par_sort_unstable();
-
-    let k = labelling.count as usize;
-    let (mut free_length, mut sealed_length) = (vec![0.0f64; k], vec![0.0f64; k]);
-    for (s, len) in segments.iter().zip(&lengths) {
-        free_length[s.label as usize] += len;
-    }
-    let mut shares: Vec<(u32, u32, f64)> = Vec::with_capacity(cover.len());
-    for run in cover.chunk_by(|x, y| x.0 == y.0) {
-        let i = run[0].0 as usize;
-        let (a, len) = (segments[i].label, lengths[i]);
-        sealed_length[a as usize] += len;
-        shares.extend(run.iter().map(|&(_, b)| (a, b, len)));
-    }
-    // Summed per (label, coverer) in segment order, so the sums do not depend on the threads.
-    shares.sort_by_key(|x| (x.0, x.1));
-    let mut uf = UnionFind::new(k);
-    let mut glued = 0;
-    for run in shares.chunk_by(|x, y| x.0 == y.0 && x.1 == y.1) {
-        let (a, b) = (run[0].0, run[0].1);
-        let shared: f64 = run.iter().map(|x| x.2).sum();
-        let free = free_length[a as usize];
-        if sealed_length[a as usize] >= limits.sealed_fraction * free
-            && shared >= limits.share_fraction * free
-            && uf.find(a) != uf.find(b)
-        {
-            uf.union(a, b);
-            glued += 1;
-        }
-    }
+    let lengths: Vec<f64> = segments.iter().map(|s| point(s.a).distance(point(s.b))).collect();
+    let grid = SegmentGrid::new(topo, &segments, &lengths, limits.tolerance.max(0.0))?;
+    let cover = covering_labels(topo, &segments, &grid);
+    let (mut uf, glued) = glue(labelling.count as usize, &segments, &lengths, &cover, limits);
     if glued == 0 {
         return None;
     }
@@ -239,6 +103,178 @@ pub(crate) fn stitch_cracks(topo: &Topology, labelling: &Labelling, limits: &Sti
         }
     }
     Some(StitchOutcome { labels: new_labels, count, open, glued })
+}
+
+/// The free segments registered in a uniform grid of cells, for "which labels' free segments pass
+/// within the tolerance of this point".
+struct SegmentGrid {
+    min: DVec3,
+    cell: f64,
+    tol: f64,
+    /// (cell, segment) pairs, sorted.
+    entries: Vec<((u32, u32, u32), u32)>,
+}
+
+impl SegmentGrid {
+    /// `None` when the segments span nothing or an infinite region.
+    fn new(topo: &Topology, segments: &[Segment], lengths: &[f64], tol: f64) -> Option<Self> {
+        let point = |v: u32| topo.welded_positions[v as usize].as_dvec3();
+        // Cells about twice the median free segment, never below the tolerance.
+        let median = {
+            let mut sorted = lengths.to_vec();
+            let mid = sorted.len() / 2;
+            if sorted.is_empty() { 0.0 } else { *sorted.select_nth_unstable_by(mid, f64::total_cmp).1 }
+        };
+        let mut region = Aabb::EMPTY;
+        for s in segments {
+            region.extend(point(s.a));
+            region.extend(point(s.b));
+        }
+        if region.is_empty() {
+            return None;
+        }
+        region.min -= tol;
+        region.max += tol;
+        // A segment is registered piece by piece, each piece at most a cell long, so that with the
+        // tolerance at most a quarter cell a piece touches at most 3 cells per axis. The cells double
+        // until the pieces fit a budget linear in the segments (a few very long edges among short ones
+        // would otherwise be cut into millions of pieces), so the entries are at most 27 times that.
+        let extent = region.diagonal();
+        if !extent.is_finite() {
+            return None;
+        }
+        let mut cell = (2.0 * median).max(4.0 * tol).max(extent / MAX_CELLS_PER_AXIS).max(f64::MIN_POSITIVE);
+        let budget = (4 * segments.len() + (1 << 16)) as f64;
+        while lengths.iter().map(|&l| (l / cell).ceil().max(1.0)).sum::<f64>() > budget {
+            cell *= 2.0;
+        }
+        let mut grid = SegmentGrid { min: region.min, cell, tol, entries: Vec::new() };
+        let mut entries: Vec<((u32, u32, u32), u32)> = segments
+            .par_iter()
+            .enumerate()
+            .with_min_len(1024)
+            .fold(Vec::new, |mut out, (i, s)| {
+                let (p, q) = (point(s.a), point(s.b));
+                let pieces = (p.distance(q) / cell).ceil().max(1.0);
+                let n = pieces as u32;
+                for k in 0..n {
+                    let (x, y) = (p.lerp(q, f64::from(k) / pieces), p.lerp(q, f64::from(k + 1) / pieces));
+                    let (lo, hi) = (grid.cell_of(x.min(y) - tol), grid.cell_of(x.max(y) + tol));
+                    for cz in lo.2..=hi.2 {
+                        for cy in lo.1..=hi.1 {
+                            for cx in lo.0..=hi.0 {
+                                out.push(((cx, cy, cz), i as u32));
+                            }
+                        }
+                    }
+                }
+                out
+            })
+            .reduce(Vec::new, |mut a, mut b| {
+                a.append(&mut b);
+                a
+            });
+        entries.par_sort_unstable();
+        entries.dedup();
+        grid.entries = entries;
+        Some(grid)
+    }
+
+    fn cell_of(&self, p: DVec3) -> (u32, u32, u32) {
+        let max_coord = f64::from(u32::MAX - 1);
+        let c = ((p - self.min) / self.cell).floor().clamp(DVec3::ZERO, DVec3::splat(max_coord));
+        (c.x as u32, c.y as u32, c.z as u32)
+    }
+
+    /// The labels whose free segments pass within the tolerance of `p`, other than `own`, sorted.
+    fn near_labels(&self, topo: &Topology, segments: &[Segment], p: DVec3, own: u32, out: &mut Vec<u32>) {
+        let point = |v: u32| topo.welded_positions[v as usize].as_dvec3();
+        out.clear();
+        let key = self.cell_of(p);
+        let start = self.entries.partition_point(|e| e.0 < key);
+        let end = start + self.entries[start..].partition_point(|e| e.0 == key);
+        if end - start > MAX_CELL_ENTRIES {
+            return; // a crowded cell (many free edges through one point) is not searched
+        }
+        let tol2 = self.tol * self.tol;
+        for &(_, i) in &self.entries[start..end] {
+            let s = segments[i as usize];
+            if s.label != own && point_segment_distance_squared(p, point(s.a), point(s.b)) <= tol2 {
+                out.push(s.label);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
+/// The labels that cover each segment, as sorted (segment, label) pairs: all three samples of the
+/// segment (its ends and middle) lie near one of the label's free segments.
+fn covering_labels(topo: &Topology, segments: &[Segment], grid: &SegmentGrid) -> Vec<(u32, u32)> {
+    let point = |v: u32| topo.welded_positions[v as usize].as_dvec3();
+    let mut cover: Vec<(u32, u32)> = segments
+        .par_iter()
+        .enumerate()
+        .with_min_len(1024)
+        .fold(Vec::new, |mut out, (i, s)| {
+            let (p, q) = (point(s.a), point(s.b));
+            let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+            grid.near_labels(topo, segments, p, s.label, &mut x);
+            if x.is_empty() {
+                return out;
+            }
+            grid.near_labels(topo, segments, q, s.label, &mut y);
+            grid.near_labels(topo, segments, (p + q) * 0.5, s.label, &mut z);
+            out.extend(
+                x.iter().filter(|l| y.binary_search(l).is_ok() && z.binary_search(l).is_ok()).map(|&l| (i as u32, l)),
+            );
+            out
+        })
+        .reduce(Vec::new, |mut a, mut b| {
+            a.append(&mut b);
+            a
+        });
+    cover.par_sort_unstable();
+    cover
+}
+
+/// Unites each label with the labels that cover enough of its free length (`limits`), when
+/// enough of it is sealed at all; the union-find and the number of unions.
+fn glue(
+    k: usize,
+    segments: &[Segment],
+    lengths: &[f64],
+    cover: &[(u32, u32)],
+    limits: &StitchLimits,
+) -> (UnionFind, usize) {
+    let (mut free_length, mut sealed_length) = (vec![0.0f64; k], vec![0.0f64; k]);
+    for (s, len) in segments.iter().zip(lengths) {
+        free_length[s.label as usize] += len;
+    }
+    let mut shares: Vec<(u32, u32, f64)> = Vec::with_capacity(cover.len());
+    for run in cover.chunk_by(|x, y| x.0 == y.0) {
+        let i = run[0].0 as usize;
+        let (a, len) = (segments[i].label, lengths[i]);
+        sealed_length[a as usize] += len;
+        shares.extend(run.iter().map(|&(_, b)| (a, b, len)));
+    }
+    // Summed per (label, coverer) in segment order, so the sums do not depend on the threads.
+    shares.sort_by_key(|x| (x.0, x.1));
+    let mut uf = UnionFind::new(k);
+    let mut glued = 0;
+    for run in shares.chunk_by(|x, y| x.0 == y.0 && x.1 == y.1) {
+        let (a, b) = (run[0].0, run[0].1);
+        let shared: f64 = run.iter().map(|x| x.2).sum();
+        let free = free_length[a as usize];
+        if sealed_length[a as usize] >= limits.sealed_fraction * free
+            && shared >= limits.share_fraction * free
+            && uf.find(a) != uf.find(b)
+        {
+            uf.union(a, b);
+            glued += 1;
+        }
+    }
+    (uf, glued)
 }
 
 /// The free segments of the open labels, in face order.
