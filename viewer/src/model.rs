@@ -204,16 +204,7 @@ impl Model {
         let node_parts: HashMap<u32, &[PartRecord]> = baked
             .map(|b| b.nodes.iter().map(|(node, ext)| (*node, ext.parts.as_slice())).collect())
             .unwrap_or_default();
-        // Ids are dense `0..partCount`, one per part record: a count beyond the records present is
-        // a broken (or hostile) file, and is never used to size an allocation.
-        let records = baked.map_or(0, |b| b.nodes.iter().map(|(_, ext)| ext.parts.len()).sum::<usize>());
-        let declared = baked.map_or(0, |b| b.root.part_count);
-        let baked_part_count = declared.min(u32::try_from(records).unwrap_or(u32::MAX));
-        if declared > baked_part_count {
-            notices.push(format!(
-                "partCount {declared} but {records} part records: ids from {baked_part_count} on are drawn as unbaked parts"
-            ));
-        }
+        let baked_part_count = baked_part_count(baked, &mut notices);
 
         let mut parts: Vec<Option<Part>> = vec![None; baked_part_count as usize];
         let mut fallback_parts = Vec::new();
@@ -224,9 +215,7 @@ impl Model {
         let mut batches = Vec::new();
         let mut fit_points = Vec::new();
         let mut hull_candidates = Vec::new();
-        let mut bad_ids = 0usize;
-        let mut missing_node_parts = 0usize;
-        let mut short_part_lists = 0usize;
+        let mut faults = RecordFaults::default();
 
         for (mesh_index, mesh) in scene.meshes.iter().enumerate() {
             let labels = &triangle_labels[mesh_index];
@@ -240,12 +229,12 @@ impl Model {
                 match records {
                     Some(records) => {
                         if (records.len() as u32) < label_count {
-                            short_part_lists += 1;
+                            faults.short_part_lists += 1;
                         }
                         for label in 0..label_count as usize {
                             let record = records.get(label).unwrap_or(&records[0]);
                             if record.id >= baked_part_count {
-                                bad_ids += 1;
+                                faults.bad_ids += 1;
                                 label_to_part.push(u32::MAX); // patched below to a fallback part
                                 continue;
                             }
@@ -258,7 +247,7 @@ impl Model {
                     }
                     None => {
                         if baked.is_some() {
-                            missing_node_parts += 1;
+                            faults.missing_node_parts += 1;
                         }
                         let id = baked_part_count + fallback_parts.len() as u32;
                         let world = mesh.bounds().transformed(&instance.world_from_object);
@@ -282,14 +271,7 @@ impl Model {
                 let object = mesh.bounds();
                 if !object.is_empty() {
                     let render_from_object = DMat4::from_translation(-origin) * instance.world_from_object;
-                    fit_points.extend((0..8).map(|i| {
-                        let corner = DVec3::new(
-                            if i & 1 == 0 { object.min.x } else { object.max.x },
-                            if i & 2 == 0 { object.min.y } else { object.max.y },
-                            if i & 4 == 0 { object.min.z } else { object.max.z },
-                        );
-                        render_from_object.transform_point3(corner).as_vec3()
-                    }));
+                    fit_points.extend(object.corners().map(|c| render_from_object.transform_point3(c).as_vec3()));
                     hull_candidates.extend(support.iter().map(|&p| render_from_object.transform_point3(p).as_vec3()));
                 }
             }
@@ -307,36 +289,11 @@ impl Model {
             }
         }
 
-        if bad_ids > 0 {
-            notices.push(format!("{bad_ids} part references with an id ≥ partCount: drawn as unbaked parts"));
-        }
-        if missing_node_parts > 0 {
-            notices.push(format!(
-                "{missing_node_parts} instances have no baked parts: each drawn as one part with a bounding-box projector"
-            ));
-        }
-        if short_part_lists > 0 {
-            notices.push(format!(
-                "{short_part_lists} instances have fewer parts than their mesh has labels: extra labels use part 0 of the node"
-            ));
-        }
+        faults.report(&mut notices);
 
-        // Ids the file declares but no node uses get a neutral placeholder so indexing stays dense.
-        let parts: Vec<Part> = parts
-            .into_iter()
-            .enumerate()
-            .map(|(id, p)| p.unwrap_or_else(|| fallback_part(id as u32, "", &bounds, origin)))
-            .chain(fallback_parts)
-            .collect();
+        let parts = dense_parts(parts, fallback_parts, &bounds, origin);
 
-        let mut materials =
-            vec![MaterialGpu { base_color: DEFAULT_BASE_COLOR, metallic: 0.0, roughness: 1.0, _pad: [0.0; 2] }];
-        materials.extend(scene.materials.iter().map(|m| MaterialGpu {
-            base_color: m.base_color,
-            metallic: m.metallic,
-            roughness: m.roughness,
-            _pad: [0.0; 2],
-        }));
+        let materials = material_table(scene);
 
         let lines = baked
             .map(|b| crate::edges::ModelLines::from_scene(scene, b, &instance_mesh, &instance_world_from_object))
@@ -450,6 +407,72 @@ impl Model {
             })
             .collect()
     }
+}
+
+/// The baked part ids in use: `partCount`, but never more than the part records present. Ids are
+/// dense `0..partCount`, one per record: a count beyond the records is a broken (or hostile) file,
+/// and is never used to size an allocation.
+fn baked_part_count(baked: Option<&BakedFile>, notices: &mut Vec<String>) -> u32 {
+    let records = baked.map_or(0, |b| b.nodes.iter().map(|(_, ext)| ext.parts.len()).sum::<usize>());
+    let declared = baked.map_or(0, |b| b.root.part_count);
+    let count = declared.min(u32::try_from(records).unwrap_or(u32::MAX));
+    if declared > count {
+        notices.push(format!(
+            "partCount {declared} but {records} part records: ids from {count} on are drawn as unbaked parts"
+        ));
+    }
+    count
+}
+
+/// What was wrong with a file's part records, counted while the instances are mapped to parts.
+#[derive(Default)]
+struct RecordFaults {
+    bad_ids: usize,
+    missing_node_parts: usize,
+    short_part_lists: usize,
+}
+
+impl RecordFaults {
+    fn report(&self, notices: &mut Vec<String>) {
+        let RecordFaults { bad_ids, missing_node_parts, short_part_lists } = *self;
+        if bad_ids > 0 {
+            notices.push(format!("{bad_ids} part references with an id ≥ partCount: drawn as unbaked parts"));
+        }
+        if missing_node_parts > 0 {
+            notices.push(format!(
+                "{missing_node_parts} instances have no baked parts: each drawn as one part with a bounding-box projector"
+            ));
+        }
+        if short_part_lists > 0 {
+            notices.push(format!(
+                "{short_part_lists} instances have fewer parts than their mesh has labels: extra labels use part 0 of the node"
+            ));
+        }
+    }
+}
+
+/// The baked parts by id, then the fallback parts: ids the file declares but no node uses get a
+/// neutral placeholder so indexing stays dense.
+fn dense_parts(baked: Vec<Option<Part>>, fallback: Vec<Part>, bounds: &Aabb, origin: DVec3) -> Vec<Part> {
+    baked
+        .into_iter()
+        .enumerate()
+        .map(|(id, p)| p.unwrap_or_else(|| fallback_part(id as u32, "", bounds, origin)))
+        .chain(fallback)
+        .collect()
+}
+
+/// The material table the G-buffer indexes: entry 0 the default material, then the scene's.
+fn material_table(scene: &Scene) -> Vec<MaterialGpu> {
+    let mut materials =
+        vec![MaterialGpu { base_color: DEFAULT_BASE_COLOR, metallic: 0.0, roughness: 1.0, _pad: [0.0; 2] }];
+    materials.extend(scene.materials.iter().map(|m| MaterialGpu {
+        base_color: m.base_color,
+        metallic: m.metallic,
+        roughness: m.roughness,
+        _pad: [0.0; 2],
+    }));
+    materials
 }
 
 /// The transfer curve of a part record (`gradient.w` is its index in [`TransferCurve::ALL`]).

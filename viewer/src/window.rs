@@ -807,6 +807,106 @@ impl App<'_> {
         }
     }
 
+    /// The cursor moved: a drag past the click slop orbits, pans, draws the lasso or drives the
+    /// manipulator.
+    fn cursor_moved(&mut self, position: PhysicalPosition<f64>) -> Result<(), WindowError> {
+        let (dx, dy) = ((position.x - self.cursor.x) as f32, (position.y - self.cursor.y) as f32);
+        self.cursor = position;
+        let now = DVec2::new(position.x, position.y);
+        if let Some(press) = self.pressed.as_mut() {
+            let moved = (position.x - press.at.x).hypot(position.y - press.at.y);
+            press.dragged |= moved > CLICK_SLOP_PX;
+            if press.dragged {
+                let button = press.button;
+                // Cheaper frames while the mouse drags (half resolution on lavapipe's
+                // per-pixel cost); full quality again on release.
+                self.options.interactive = true;
+                if let Some(path) = self.lasso.as_mut() {
+                    if path.last().is_none_or(|last| last.distance(now) >= 2.0) {
+                        path.push(now);
+                    }
+                } else if self.editor.dragging() {
+                    if let Some(view) = self.screen_view() {
+                        let ids = self.editor.drag_to(&view, now);
+                        self.parts_changed(&ids)?;
+                    }
+                } else {
+                    match button {
+                        MouseButton::Left => self.orbit.rotate(dx, dy),
+                        MouseButton::Right | MouseButton::Middle => {
+                            self.orbit.pan_by(dx, dy, self.options.size);
+                        }
+                        _ => {}
+                    }
+                }
+                self.request_redraw();
+            }
+        }
+        Ok(())
+    }
+
+    /// A button came up: ends a lasso, a manipulator drag or a click (selection, or the anchor
+    /// tool's centring).
+    fn mouse_released(&mut self) -> Result<(), WindowError> {
+        let Some(press) = self.pressed.take() else { return Ok(()) };
+        if std::mem::take(&mut self.options.interactive) {
+            self.request_redraw();
+        }
+        if let Some((since, frames)) = self.drag_frames.take()
+            && std::env::var_os("DRAFTER_VIEW_STATS").is_some()
+        {
+            // The first frame opens the interval: frames after it over its length.
+            let seconds = since.elapsed().as_secs_f64();
+            let rate = f64::from(frames.saturating_sub(1)) / seconds.max(1e-9);
+            println!("drag: {frames} frames in {seconds:.2} s, {rate:.1} frames/s");
+        }
+        if press.button != MouseButton::Left {
+            return Ok(());
+        }
+        let at = DVec2::new(press.at.x, press.at.y);
+        if let Some(path) = self.lasso.take() {
+            if press.dragged {
+                if let Some(view) = self.screen_view() {
+                    let boxes: Vec<(u32, PartBox)> = self
+                        .model
+                        .parts
+                        .iter()
+                        .filter_map(|p| Some((p.id, PartBox::from_record(&p.record.as_ref()?.obb))))
+                        .collect();
+                    let inside = parts_in_lasso(&path, &view, &boxes);
+                    self.editor.selection.lasso(&inside, self.modifiers.shift_key());
+                    self.selection_changed()?;
+                }
+            } else {
+                self.click_select(at)?;
+            }
+        } else if self.editor.dragging() {
+            if self.editor.end() {
+                let ids = self.editor.selection.parts.clone();
+                self.list_edited(&ids);
+                self.refresh_title();
+            } else if !press.dragged {
+                // A click with a tool: the anchor tool centres the anchor under the
+                // cursor when the click lands on a selected part; any other click
+                // selects.
+                let hit = self.part_at(at)?;
+                let on_selection = hit.is_some_and(|id| self.editor.selection.contains(id));
+                if self.tool == Some(Tool::Anchor) && on_selection {
+                    if let Some(view) = self.screen_view() {
+                        let ids = self.editor.centre_anchor(&view, at);
+                        self.parts_changed(&ids)?;
+                        self.list_edited(&ids);
+                    }
+                } else {
+                    self.click_select(at)?;
+                }
+            }
+        } else if !press.dragged {
+            self.click_select(at)?;
+        }
+        Ok(())
+    }
+
     fn handle(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) -> Result<(), WindowError> {
         if !matches!(event, WindowEvent::RedrawRequested)
             && let Some(state) = self.state.as_mut()
@@ -845,40 +945,7 @@ impl App<'_> {
             }
             WindowEvent::RedrawRequested => self.redraw()?,
             WindowEvent::ModifiersChanged(modifiers) => self.modifiers = modifiers.state(),
-            WindowEvent::CursorMoved { position, .. } => {
-                let (dx, dy) = ((position.x - self.cursor.x) as f32, (position.y - self.cursor.y) as f32);
-                self.cursor = position;
-                let now = DVec2::new(position.x, position.y);
-                if let Some(press) = self.pressed.as_mut() {
-                    let moved = (position.x - press.at.x).hypot(position.y - press.at.y);
-                    press.dragged |= moved > CLICK_SLOP_PX;
-                    if press.dragged {
-                        let button = press.button;
-                        // Cheaper frames while the mouse drags (half resolution on lavapipe's
-                        // per-pixel cost); full quality again on release.
-                        self.options.interactive = true;
-                        if let Some(path) = self.lasso.as_mut() {
-                            if path.last().is_none_or(|last| last.distance(now) >= 2.0) {
-                                path.push(now);
-                            }
-                        } else if self.editor.dragging() {
-                            if let Some(view) = self.screen_view() {
-                                let ids = self.editor.drag_to(&view, now);
-                                self.parts_changed(&ids)?;
-                            }
-                        } else {
-                            match button {
-                                MouseButton::Left => self.orbit.rotate(dx, dy),
-                                MouseButton::Right | MouseButton::Middle => {
-                                    self.orbit.pan_by(dx, dy, self.options.size);
-                                }
-                                _ => {}
-                            }
-                        }
-                        self.request_redraw();
-                    }
-                }
-            }
+            WindowEvent::CursorMoved { position, .. } => self.cursor_moved(position)?,
             WindowEvent::MouseInput { state: button_state, button, .. } => match button_state {
                 ElementState::Pressed => {
                     self.not_quitting();
@@ -894,64 +961,7 @@ impl App<'_> {
                         }
                     }
                 }
-                ElementState::Released => {
-                    let Some(press) = self.pressed.take() else { return Ok(()) };
-                    if std::mem::take(&mut self.options.interactive) {
-                        self.request_redraw();
-                    }
-                    if let Some((since, frames)) = self.drag_frames.take()
-                        && std::env::var_os("DRAFTER_VIEW_STATS").is_some()
-                    {
-                        // The first frame opens the interval: frames after it over its length.
-                        let seconds = since.elapsed().as_secs_f64();
-                        let rate = f64::from(frames.saturating_sub(1)) / seconds.max(1e-9);
-                        println!("drag: {frames} frames in {seconds:.2} s, {rate:.1} frames/s");
-                    }
-                    if press.button != MouseButton::Left {
-                        return Ok(());
-                    }
-                    let at = DVec2::new(press.at.x, press.at.y);
-                    if let Some(path) = self.lasso.take() {
-                        if press.dragged {
-                            if let Some(view) = self.screen_view() {
-                                let boxes: Vec<(u32, PartBox)> = self
-                                    .model
-                                    .parts
-                                    .iter()
-                                    .filter_map(|p| Some((p.id, PartBox::from_record(&p.record.as_ref()?.obb))))
-                                    .collect();
-                                let inside = parts_in_lasso(&path, &view, &boxes);
-                                self.editor.selection.lasso(&inside, self.modifiers.shift_key());
-                                self.selection_changed()?;
-                            }
-                        } else {
-                            self.click_select(at)?;
-                        }
-                    } else if self.editor.dragging() {
-                        if self.editor.end() {
-                            let ids = self.editor.selection.parts.clone();
-                            self.list_edited(&ids);
-                            self.refresh_title();
-                        } else if !press.dragged {
-                            // A click with a tool: the anchor tool centres the anchor under the
-                            // cursor when the click lands on a selected part; any other click
-                            // selects.
-                            let hit = self.part_at(at)?;
-                            let on_selection = hit.is_some_and(|id| self.editor.selection.contains(id));
-                            if self.tool == Some(Tool::Anchor) && on_selection {
-                                if let Some(view) = self.screen_view() {
-                                    let ids = self.editor.centre_anchor(&view, at);
-                                    self.parts_changed(&ids)?;
-                                    self.list_edited(&ids);
-                                }
-                            } else {
-                                self.click_select(at)?;
-                            }
-                        }
-                    } else if !press.dragged {
-                        self.click_select(at)?;
-                    }
-                }
+                ElementState::Released => self.mouse_released()?,
             },
             WindowEvent::MouseWheel { delta, .. } => {
                 let lines = match delta {

@@ -157,18 +157,25 @@ impl Aabb {
         if self.is_empty() { 0.0 } else { (self.max - self.min).length() }
     }
 
+    /// The eight corners, x varying fastest, then y, then z.
+    pub fn corners(&self) -> impl Iterator<Item = DVec3> + use<> {
+        let (min, max) = (self.min, self.max);
+        (0..8).map(move |i| {
+            DVec3::new(
+                if i & 1 == 0 { min.x } else { max.x },
+                if i & 2 == 0 { min.y } else { max.y },
+                if i & 4 == 0 { min.z } else { max.z },
+            )
+        })
+    }
+
     /// The box around the eight corners of `self` under `m`.
     pub fn transformed(&self, m: &DMat4) -> Aabb {
         let mut out = Aabb::EMPTY;
         if self.is_empty() {
             return out;
         }
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { self.min.x } else { self.max.x },
-                if i & 2 == 0 { self.min.y } else { self.max.y },
-                if i & 4 == 0 { self.min.z } else { self.max.z },
-            );
+        for c in self.corners() {
             out.extend(m.transform_point3(c));
         }
         out

@@ -208,6 +208,50 @@ pub struct ShadowPass {
     resolve_bind_group: wgpu::BindGroup,
 }
 
+/// Each layer's stencil test: a pixel counts once per layer (the first fragment there increments).
+const ONCE: wgpu::StencilFaceState = wgpu::StencilFaceState {
+    compare: wgpu::CompareFunction::Equal,
+    fail_op: wgpu::StencilOperation::Keep,
+    depth_fail_op: wgpu::StencilOperation::Keep,
+    pass_op: wgpu::StencilOperation::IncrementClamp,
+};
+
+/// The layers add up in the mask.
+const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent::REPLACE,
+};
+
+/// The layers' uniform buffer (one aligned slot per layer, bound at a dynamic offset) and its bind
+/// group, with the slot stride.
+fn layer_uniforms(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgpu::Buffer, wgpu::BindGroup, u64) {
+    let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+    let stride = (size_of::<ShadowLayerGpu>() as u64).div_ceil(alignment) * alignment;
+    let layers = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("shadow layers"),
+        size: stride * MAX_LAYERS as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("shadow layer bind group"),
+        layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &layers,
+                offset: 0,
+                size: wgpu::BufferSize::new(size_of::<ShadowLayerGpu>() as u64),
+            }),
+        }],
+    });
+    (layers, bind_group, stride)
+}
+
 impl ShadowPass {
     pub fn new(device: &wgpu::Device) -> ShadowPass {
         use wgpu::ShaderStages as S;
@@ -243,20 +287,6 @@ impl ShadowPass {
             bind_group_layouts: &[None, None, Some(&resolve_layout)],
             immediate_size: 0,
         });
-        let once = wgpu::StencilFaceState {
-            compare: wgpu::CompareFunction::Equal,
-            fail_op: wgpu::StencilOperation::Keep,
-            depth_fail_op: wgpu::StencilOperation::Keep,
-            pass_op: wgpu::StencilOperation::IncrementClamp,
-        };
-        let additive = wgpu::BlendState {
-            color: wgpu::BlendComponent {
-                src_factor: wgpu::BlendFactor::One,
-                dst_factor: wgpu::BlendFactor::One,
-                operation: wgpu::BlendOperation::Add,
-            },
-            alpha: wgpu::BlendComponent::REPLACE,
-        };
         let layer_pipeline = |label: &str, format, blend, depth_stencil| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -283,12 +313,12 @@ impl ShadowPass {
         let pipeline = layer_pipeline(
             "shadow layer pipeline",
             SHADOW_MASK_FORMAT,
-            Some(additive),
+            Some(ADDITIVE),
             Some(wgpu::DepthStencilState {
                 format: SHADOW_STENCIL_FORMAT,
                 depth_write_enabled: Some(false),
                 depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: wgpu::StencilState { front: once, back: once, read_mask: 0xff, write_mask: 0xff },
+                stencil: wgpu::StencilState { front: ONCE, back: ONCE, read_mask: 0xff, write_mask: 0xff },
                 bias: wgpu::DepthBiasState::default(),
             }),
         );
@@ -304,26 +334,7 @@ impl ShadowPass {
             &[],
         );
 
-        let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
-        let stride = (size_of::<ShadowLayerGpu>() as u64).div_ceil(alignment) * alignment;
-        let layers = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadow layers"),
-            size: stride * MAX_LAYERS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let layers_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow layer bind group"),
-            layout: &layer_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &layers,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(size_of::<ShadowLayerGpu>() as u64),
-                }),
-            }],
-        });
+        let (layers, layers_bind_group, stride) = layer_uniforms(device, &layer_layout);
         let ground_map = crate::targets::Target::new(
             device,
             "shadow ground map",
