@@ -250,13 +250,8 @@ mod tests {
     fn exact_path_matches_integer_arithmetic() {
         // Integer coordinates near 2^30: differences are exact in f64, products are not, and i128
         // evaluates the determinant exactly. Near-coplanar points make the float filter give up.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |range: i64| -> i64 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % (2 * range as u64 + 1)) as i64 - range
-        };
+        let mut rng = drafter_core::rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = |range: i64| -> i64 { rng.below(2 * range as u64 + 1) as i64 - range };
         let big = 1i64 << 30;
         for _ in 0..3000 {
             let a = [next(big), next(big), next(big)];
@@ -277,13 +272,8 @@ mod tests {
 
     #[test]
     fn filter_and_exact_agree_on_random_inputs() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.unit_f64() - 0.5;
         for _ in 0..2000 {
             let a = [next(), next(), next()];
             let b = [next(), next(), next()];

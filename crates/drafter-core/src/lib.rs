@@ -17,6 +17,7 @@ pub mod gradient;
 mod ids;
 mod obb_method;
 mod param;
+pub mod rng;
 mod scene;
 pub mod snorm;
 mod topology;

@@ -199,13 +199,8 @@ mod tests {
 
     /// xorshift64: uniform values in [−1, 1).
     fn uniform(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        }
+        let mut rng = crate::rng::XorShift64::new(seed);
+        move || rng.signed_f32()
     }
 
     fn worst_error_deg(round_trip: impl Fn(Vec3) -> Vec3) -> f32 {

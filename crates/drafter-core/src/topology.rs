@@ -918,13 +918,8 @@ mod tests {
     /// Independent recount with a hash map over many random meshes.
     #[test]
     fn edges_match_hashmap_reference() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = |m: u32| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % m as u64) as u32
-        };
+        let mut rng = crate::rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut rnd = |m: u32| rng.below(u64::from(m)) as u32;
         for _ in 0..200 {
             let nv = 3 + rnd(30);
             let p: Vec<Vec3> = (0..nv).map(|_| Vec3::new(rnd(4) as f32, rnd(4) as f32, rnd(4) as f32)).collect();
@@ -1039,13 +1034,8 @@ mod tests {
 
     /// A seeded xorshift generator of integers below its argument.
     fn xorshift(seed: u64) -> impl FnMut(u32) -> u32 {
-        let mut state = seed;
-        move |m| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % u64::from(m)) as u32
-        }
+        let mut rng = crate::rng::XorShift64::new(seed);
+        move |m| rng.below(u64::from(m)) as u32
     }
 
     /// `count` positions on a grid of `grid` steps of `step` per axis, many repeated; one in eight

@@ -573,18 +573,11 @@ OFF
 
     #[test]
     fn garbage_never_panics() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = drafter_core::rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
         let alphabet = b"OFF 0123456789-.#\n e";
         for _ in 0..2000 {
-            let len = (state % 64) as usize;
-            let bytes: Vec<u8> = (0..len)
-                .map(|_| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
-                    alphabet[(state % alphabet.len() as u64) as usize]
-                })
-                .collect();
+            let len = rng.below(64) as usize;
+            let bytes: Vec<u8> = (0..len).map(|_| alphabet[rng.below(alphabet.len() as u64) as usize]).collect();
             let _ = read(&bytes);
         }
     }

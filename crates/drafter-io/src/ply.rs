@@ -941,13 +941,8 @@ end_header
 
     #[test]
     fn garbage_never_panics() {
-        let mut state = 0xdead_beef_cafe_f00du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = drafter_core::rng::XorShift64::new(0xdead_beef_cafe_f00du64);
+        let mut next = || rng.next();
         let ascii = ASCII.as_bytes();
         let binary = binary(&binary_body());
         for _ in 0..3000 {

@@ -43,13 +43,8 @@ pub fn icosa_directions() -> Vec<Vec3> {
 /// that place normals, boxes and eyes by hand.
 #[cfg(test)]
 pub(crate) fn xorshift(seed: u64) -> impl FnMut() -> f32 {
-    let mut s = seed;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-    }
+    let mut rng = drafter_core::rng::XorShift64::new(seed);
+    move || rng.signed_f32()
 }
 
 /// A seeded xorshift64* generator of views: deterministic, no dependency.
@@ -61,7 +56,7 @@ impl ViewRng {
         Self(seed.max(1).wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
     }
 
-    fn next_u64(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
@@ -71,6 +66,16 @@ impl ViewRng {
     /// Uniform in [0, 1).
     pub fn unit(&mut self) -> f32 {
         (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    /// Uniform below `n` (any `n`; 0 counts as 1).
+    pub fn below(&mut self, n: u32) -> u32 {
+        (self.next_u64() % u64::from(n.max(1))) as u32
     }
 
     /// Uniform direction on the sphere.

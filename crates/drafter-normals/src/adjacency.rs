@@ -581,13 +581,8 @@ mod tests {
     /// A bumpy grid in shuffled face order, with a far vertex (damped neighbours), a degenerate face,
     /// a boundary, and a second piece.
     fn shuffled_grid(side: u32, seed: u64) -> Topology {
-        let mut state = seed;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut rng = drafter_core::rng::XorShift64::new(seed);
+        let mut next = move || rng.unit_f64() as f32;
         let id = |x: u32, y: u32| y * (side + 1) + x;
         let mut positions: Vec<glam::Vec3> = (0..=side)
             .flat_map(|y| (0..=side).map(move |x| (x, y)))

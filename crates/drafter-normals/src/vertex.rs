@@ -549,13 +549,8 @@ mod tests {
     /// spanning twelve decades, plus the axes and the zero pair.
     #[test]
     fn angle_matches_atan2() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.unit_f64();
         let mut worst = 0.0f64;
         for _ in 0..200_000 {
             let sine = next() * 10f64.powf(next() * 12.0 - 6.0);

@@ -145,13 +145,11 @@ mod tests {
     #[test]
     fn concurrent_unions_give_the_sequential_partition() {
         let n = 20_000u32;
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15);
         let pairs: Vec<(u32, u32)> = (0..15_000)
             .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                ((state % n as u64) as u32, ((state >> 32) % n as u64) as u32)
+                let s = rng.next();
+                ((s % n as u64) as u32, ((s >> 32) % n as u64) as u32)
             })
             .collect();
         let mut sequential = UnionFind::new(n as usize);

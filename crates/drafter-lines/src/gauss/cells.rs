@@ -360,14 +360,9 @@ mod tests {
             let cells = base_cells(base);
             assert_eq!(cells.len(), faces);
             // Every direction lies in exactly one cell (up to boundaries).
-            let mut s = 1u64;
+            let mut rng = drafter_core::rng::XorShift64::new(1);
             for _ in 0..2000 {
-                let mut r = || {
-                    s ^= s << 13;
-                    s ^= s >> 7;
-                    s ^= s << 17;
-                    (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-                };
+                let mut r = || rng.signed_f64();
                 let p = DVec3::new(r(), r(), r()).normalize();
                 let inside = cells.iter().filter(|c| c.score(p) > 1e-12).count();
                 assert!(inside <= 1);
