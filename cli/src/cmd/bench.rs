@@ -42,6 +42,9 @@ pub enum What {
     /// Silhouettes per view: brute force against the hierarchies (a baked file's stored ones, as loaded; else built), speedup, counts and
     /// mismatches (`--views N|icosa`, `--perspective`).
     Silhouettes(super::bench_silhouettes::Args),
+    /// Line drawings: time per view against accuracy at several tolerances (agreement with the
+    /// finest drawing), SVG size, and brute-force ray casting side by side (extrapolated).
+    Draw(super::bench_draw::Args),
 }
 
 #[derive(Debug, clap::Args)]
@@ -134,6 +137,7 @@ pub fn run(args: Args) -> Result<()> {
         What::Render(args) => render(args),
         What::Parts(args) => parts(args),
         What::Silhouettes(args) => super::bench_silhouettes::run(args),
+        What::Draw(args) => super::bench_draw::run(args),
     }
 }
 

@@ -3,6 +3,7 @@
 pub mod bake;
 pub mod batch;
 pub mod bench;
+pub mod bench_draw;
 pub mod bench_silhouettes;
 pub mod bench_sweep;
 pub mod cache;
