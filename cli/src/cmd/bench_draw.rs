@@ -197,7 +197,7 @@ fn share_within(points: &[(DVec2, f64)], of: &[(DVec2, f64)], radius: f64) -> f6
     // A grid of cells `radius` wide: a near point lies in the 3 × 3 cells around.
     let cell = |p: DVec2| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
     let mut grid: Vec<((i64, i64), DVec2)> = of.iter().map(|&(p, _)| (cell(p), p)).collect();
-    grid.sort_by(|a, b| a.0.cmp(&b.0));
+    grid.sort_by_key(|e| e.0);
     let near = |p: DVec2| {
         let (cx, cy) = cell(p);
         (-1..=1).any(|dx| {
