@@ -95,3 +95,44 @@ fn bad_input_and_bad_options_end_with_exit_2_and_no_file() {
         assert!(!svg.exists(), "{args:?}: no output");
     }
 }
+
+/// `drafter bench draw`: the finest tolerance is its own reference (100 % both ways), a coarser one
+/// still holds nearly all of the reference's length, fewer strokes make smaller SVGs, and brute
+/// force is timed beside the drawing.
+#[test]
+fn bench_draw_charts_tolerance_against_agreement() {
+    let dir = common::scratch("bench-draw");
+    let baked = dir.join("sample.glb");
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb");
+    assert!(common::bake(&sample, &baked, &[]).status.success());
+    let run = common::run(&[
+        "bench",
+        "draw",
+        baked.to_str().unwrap(),
+        "--views",
+        "2",
+        "--tolerances",
+        "1,0",
+        "--brute-samples",
+        "100",
+        "--json",
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "2 views × 2 tolerances");
+    for view in 0..2 {
+        let row = |t: f64| rows.iter().find(|r| r["view"] == view && r["tolerance_px"].as_f64() == Some(t)).unwrap();
+        let (fine, coarse) = (row(0.0), row(1.0));
+        for key in ["visible_reference_covered", "visible_covered_by_reference", "hidden_covered_by_reference"] {
+            assert_eq!(fine[key].as_f64(), Some(1.0), "{key}: {fine}");
+        }
+        assert!(coarse["visible_reference_covered"].as_f64().unwrap() > 0.9, "{coarse}");
+        assert!(coarse["visible_covered_by_reference"].as_f64().unwrap() > 0.99, "{coarse}");
+        assert!(coarse["strokes"].as_u64() <= fine["strokes"].as_u64(), "{coarse} {fine}");
+        assert!(coarse["svg_bytes"].as_u64() <= fine["svg_bytes"].as_u64());
+    }
+    let brute = report["brute"].as_array().unwrap();
+    assert_eq!(brute.len(), 2);
+    assert!(brute.iter().all(|b| b["samples"].as_u64() == Some(100) && b["ns_per_sample"].as_f64().unwrap() > 0.0));
+}
