@@ -834,6 +834,58 @@ fn coordinate(v: f64) -> String {
     if text == "-0" { "0".to_string() } else { text.to_string() }
 }
 
+/// Brute force, the reference the drawing is checked and timed against (`viewer/tests/drawing.rs`,
+/// `drafter bench draw`): a point is hidden when any triangle of the scene crosses the segment from
+/// it to the eye, tested triangle by triangle in world space (Möller–Trumbore in f64). Independent
+/// of the drawing's method: no projection, no BVH, no interval clipping.
+pub mod brute {
+    use glam::{DVec3, Vec3};
+
+    use crate::model::Model;
+
+    /// Every triangle of `model` in world space.
+    pub fn world_triangles(model: &Model) -> Vec<[DVec3; 3]> {
+        let mut out = Vec::new();
+        for batch in &model.batches {
+            for instance in batch.instances.clone() {
+                let world = model.instance_world_from_object[instance as usize];
+                for t in batch.indices.chunks_exact(3) {
+                    let p = |k: usize| {
+                        world.transform_point3(Vec3::from(batch.vertices[t[k] as usize].position_in_object).as_dvec3())
+                    };
+                    out.push([p(0), p(1), p(2)]);
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether a triangle crosses the open segment from `p` to `q` (parameter in (10⁻⁶, 1)).
+    pub fn blocked(p: DVec3, q: DVec3, triangles: &[[DVec3; 3]]) -> bool {
+        let d = q - p;
+        triangles.iter().any(|t| {
+            let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+            let h = d.cross(e2);
+            let det = e1.dot(h);
+            if det.abs() < 1e-300 {
+                return false;
+            }
+            let s = p - t[0];
+            let u = s.dot(h) / det;
+            if !(0.0..=1.0).contains(&u) {
+                return false;
+            }
+            let qv = s.cross(e1);
+            let v = d.dot(qv) / det;
+            if v < 0.0 || u + v > 1.0 {
+                return false;
+            }
+            let t_hit = e2.dot(qv) / det;
+            t_hit > 1e-6 && t_hit < 1.0
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

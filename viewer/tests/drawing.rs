@@ -9,51 +9,10 @@ mod common;
 
 use drafter_viewer::Model;
 use drafter_viewer::View;
+use drafter_viewer::drawing::brute::{blocked, world_triangles};
 use drafter_viewer::drawing::{self, DrawOptions, Hidden};
 use drafter_viewer::edges::{LineClass, WorldView};
-use glam::{DVec2, DVec3, Vec3};
-
-/// Every triangle of `model` in world space.
-fn world_triangles(model: &Model) -> Vec<[DVec3; 3]> {
-    let mut out = Vec::new();
-    for batch in &model.batches {
-        for instance in batch.instances.clone() {
-            let world = model.instance_world_from_object[instance as usize];
-            for t in batch.indices.chunks_exact(3) {
-                let p = |k: usize| {
-                    world.transform_point3(Vec3::from(batch.vertices[t[k] as usize].position_in_object).as_dvec3())
-                };
-                out.push([p(0), p(1), p(2)]);
-            }
-        }
-    }
-    out
-}
-
-/// Whether a triangle crosses the open segment from `p` to `q` (parameter in (ε, 1)).
-fn blocked(p: DVec3, q: DVec3, triangles: &[[DVec3; 3]]) -> bool {
-    let d = q - p;
-    triangles.iter().any(|t| {
-        let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-        let h = d.cross(e2);
-        let det = e1.dot(h);
-        if det.abs() < 1e-300 {
-            return false;
-        }
-        let s = p - t[0];
-        let u = s.dot(h) / det;
-        if !(0.0..=1.0).contains(&u) {
-            return false;
-        }
-        let qv = s.cross(e1);
-        let v = d.dot(qv) / det;
-        if v < 0.0 || u + v > 1.0 {
-            return false;
-        }
-        let t_hit = e2.dot(qv) / det;
-        t_hit > 1e-6 && t_hit < 1.0
-    })
-}
+use glam::DVec2;
 
 /// Samples `per_edge` points on every `stride`-th edge and counts disagreements with brute force
 /// beyond `tolerance_px` of a change point. Returns (samples compared, disagreements, hidden

@@ -19,9 +19,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use drafter_viewer::View;
+use drafter_viewer::drawing::brute::{blocked, world_triangles};
 use drafter_viewer::drawing::{self, DrawOptions, Drawing, Hidden};
 use drafter_viewer::edges::WorldView;
-use glam::{DVec2, DVec3, Vec3};
+use glam::DVec2;
 use serde::Serialize;
 
 use crate::cmd::out;
@@ -246,48 +247,6 @@ fn brute_force(model: &drafter_viewer::Model, options: &DrawOptions, view: usize
     std::hint::black_box(hidden);
     let ns_per_sample = elapsed * 1e9 / points.len().max(1) as f64;
     Brute { view, samples: points.len(), ns_per_sample, edge_px, extrapolated_s: ns_per_sample * edge_px * 1e-9 }
-}
-
-/// Every triangle of `model` in world space.
-fn world_triangles(model: &drafter_viewer::Model) -> Vec<[DVec3; 3]> {
-    let mut out = Vec::new();
-    for batch in &model.batches {
-        for instance in batch.instances.clone() {
-            let world = model.instance_world_from_object[instance as usize];
-            for t in batch.indices.chunks_exact(3) {
-                let p = |k: usize| {
-                    world.transform_point3(Vec3::from(batch.vertices[t[k] as usize].position_in_object).as_dvec3())
-                };
-                out.push([p(0), p(1), p(2)]);
-            }
-        }
-    }
-    out
-}
-
-/// Whether a triangle crosses the open segment from `p` to `q` (Möller–Trumbore in f64).
-fn blocked(p: DVec3, q: DVec3, triangles: &[[DVec3; 3]]) -> bool {
-    let d = q - p;
-    triangles.iter().any(|t| {
-        let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-        let h = d.cross(e2);
-        let det = e1.dot(h);
-        if det.abs() < 1e-300 {
-            return false;
-        }
-        let s = p - t[0];
-        let u = s.dot(h) / det;
-        if !(0.0..=1.0).contains(&u) {
-            return false;
-        }
-        let qv = s.cross(e1);
-        let v = d.dot(qv) / det;
-        if v < 0.0 || u + v > 1.0 {
-            return false;
-        }
-        let t_hit = e2.dot(qv) / det;
-        t_hit > 1e-6 && t_hit < 1.0
-    })
 }
 
 fn print_table(r: &Report) -> Result<()> {
