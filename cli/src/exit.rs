@@ -6,6 +6,21 @@ use std::process::ExitCode;
 
 pub use drafter_catalog::exit::{BAD_INPUT, INTERNAL, IO_FAILURE, SOME_FAILED};
 
+/// `drafter web` without the built browser page (`scripts/web` builds it).
+pub const MISSING_PAGE: u8 = 5;
+
+/// The browser page `drafter web` copies is not built (exit code 5).
+#[derive(Debug)]
+pub struct MissingPage(pub String);
+
+impl std::fmt::Display for MissingPage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for MissingPage {}
+
 /// An error caused by the user's input or options (exit code 2), as opposed to a bug.
 #[derive(Debug)]
 pub struct BadInput(pub String);
@@ -45,6 +60,9 @@ pub fn code_of(err: &anyhow::Error) -> u8 {
         }
         if e.is::<IoFailure>() {
             return IO_FAILURE;
+        }
+        if e.is::<MissingPage>() {
+            return MISSING_PAGE;
         }
         if let Some(drafter_io::ImportError::Io { source, .. }) = e.downcast_ref::<drafter_io::ImportError>() {
             let users = matches!(source.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::IsADirectory);

@@ -48,6 +48,9 @@ enum Command {
     /// edit their gradients (anchor, scale, direction, q/f/p), save them into the file (Ctrl+S) or
     /// export them as bake overrides (Ctrl+E).
     View(cmd::view::Args),
+    /// Write a folder for any static host: the browser page (the viewer compiled to WebAssembly,
+    /// built by scripts/web) and the model; orbit, styles, edges, lines, shadows in a browser.
+    Web(cmd::web::Args),
 }
 
 fn main() -> ExitCode {
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Draw(args) => cmd::draw::run(args),
         Command::Bench(args) => cmd::bench::run(args),
         Command::View(args) => cmd::view::run(args),
+        Command::Web(args) => cmd::web::run(args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

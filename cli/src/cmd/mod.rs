@@ -11,6 +11,7 @@ pub mod draw;
 pub mod inspect;
 pub mod render;
 pub mod view;
+pub mod web;
 
 use std::io::Write;
 
