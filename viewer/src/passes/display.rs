@@ -78,7 +78,7 @@ pub struct DisplayPass {
 impl DisplayPass {
     /// A display pass writing `format` (the output texture's, or a window surface's).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> DisplayPass {
-        let module = device.create_shader_module(wgpu::include_wgsl!("display.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("display.wgsl", "fullscreen.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display bind group layout"),
             entries: &[

@@ -45,12 +45,6 @@ fn has(flag: u32) -> bool {
 @group(0) @binding(6) var shadow_tex: texture_2d<f32>;
 @group(0) @binding(7) var linear_sampler: sampler;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 fn clamp_xy(p: vec2<i32>) -> vec2<i32> {
     return clamp(p, vec2<i32>(0), vec2<i32>(textureDimensions(id_tex)) - 1);
 }

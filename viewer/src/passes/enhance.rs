@@ -67,7 +67,7 @@ pub struct EnhanceBindings {
 
 impl EnhancePass {
     pub fn new(device: &wgpu::Device) -> EnhancePass {
-        let module = device.create_shader_module(wgpu::include_wgsl!("enhance.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("enhance.wgsl", "fullscreen.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("enhance bind group layout"),
             entries: &[

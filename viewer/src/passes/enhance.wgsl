@@ -17,12 +17,6 @@ struct Enhance {
 @group(0) @binding(1) var depth_tex: texture_2d<f32>;
 @group(0) @binding(2) var id_tex: texture_2d<u32>;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 // Linear depth, background pixels at the far depth when filling (first direction).
 fn depth_at(p: vec2<i32>) -> f32 {
     let q = clamp(p, vec2<i32>(0), vec2<i32>(textureDimensions(depth_tex)) - 1);

@@ -277,7 +277,7 @@ fn upload_image(device: &wgpu::Device, queue: &wgpu::Queue, image: &LookupImage)
 
 impl GBufferPass {
     pub fn new(device: &wgpu::Device) -> GBufferPass {
-        let module = device.create_shader_module(super::shader_source!("gbuffer.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("gbuffer.wgsl", "shared.wgsl"));
         use wgpu::ShaderStages as S;
         let mut entries = vec![
             uniform_entry(0, S::VERTEX_FRAGMENT, false),

@@ -141,7 +141,7 @@ pub struct LinesPass {
 impl LinesPass {
     /// A lines pass blending over a `format` target (the display pass's output).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> LinesPass {
-        let module = device.create_shader_module(super::shader_source!("lines.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("lines.wgsl", "shared.wgsl"));
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lines frame bind group layout"),

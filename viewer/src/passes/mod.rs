@@ -10,15 +10,15 @@ pub mod lines;
 pub mod shadow;
 pub mod upscale;
 
-/// The WGSL of a pass that draws the scene: `shared.wgsl` (the `Frame` and `Instance` structs,
-/// declared once) followed by the pass's own source.
+/// The WGSL of a pass: the shared files it names, then its own source. `shared.wgsl` holds what
+/// every pass that draws the scene declares (the `Frame` and `Instance` structs, the tables);
+/// `fullscreen.wgsl` the full-screen triangle of the image passes. So each is written once.
 macro_rules! shader_source {
-    ($file:literal) => {
+    ($file:literal $(, $shared:literal)*) => {
         wgpu::ShaderModuleDescriptor {
             label: Some($file),
             source: wgpu::ShaderSource::Wgsl(std::borrow::Cow::Borrowed(concat!(
-                include_str!("shared.wgsl"),
-                "\n",
+                $(include_str!($shared), "\n",)*
                 include_str!($file)
             ))),
         }
@@ -169,6 +169,10 @@ mod tests {
                     "{file} declares {name} again: use shared.wgsl"
                 );
             }
+            assert!(
+                !source.contains("fn vs_fullscreen"),
+                "{file} writes the full-screen triangle again: use fullscreen.wgsl"
+            );
         }
     }
 }

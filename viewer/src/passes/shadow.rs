@@ -255,7 +255,8 @@ fn layer_uniforms(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgp
 impl ShadowPass {
     pub fn new(device: &wgpu::Device) -> ShadowPass {
         use wgpu::ShaderStages as S;
-        let module = device.create_shader_module(super::shader_source!("shadow.wgsl"));
+        let module =
+            device.create_shader_module(super::shader_source!("shadow.wgsl", "shared.wgsl", "fullscreen.wgsl"));
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow scene bind group layout"),
             entries: &[crate::table::layout_entry(0, S::VERTEX)],

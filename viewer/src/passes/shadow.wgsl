@@ -51,12 +51,6 @@ fn fs_main() -> @location(0) vec4<f32> {
 @group(2) @binding(1) var ground_map: texture_2d<f32>;
 @group(2) @binding(2) var map_sampler: sampler;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 // The soft shadow at a mask pixel: the camera ray meets the ground at x; the shadow of plane k,
 // moved to the ground, is the ground shadow scaled by s_k about the light's foot point f, so its
 // value at x is the map at f + (x − f) / s_k. The planes are averaged.

@@ -27,7 +27,7 @@ pub struct UpscalePass {
 impl UpscalePass {
     /// An upscale pass writing `format` (the display pass's).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> UpscalePass {
-        let module = device.create_shader_module(wgpu::include_wgsl!("upscale.wgsl"));
+        let module = device.create_shader_module(super::shader_source!("upscale.wgsl", "fullscreen.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("upscale bind group layout"),
             entries: &[texture_entry(0, FILTERABLE), sampler_entry(1)],
