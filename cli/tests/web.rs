@@ -83,19 +83,28 @@ fn render(file: &Path, style: &str, extra: &[&str], out: &Path) -> Image {
 }
 
 /// Every style of `file` in the page against the native render, with the page's flags `flags`
-/// (`--edges`, `--lines`, `--shadow S`, which `drafter render` takes too).
+/// (`--edges`, `--lines`, `--shadow S`, which `drafter render` takes too), on WebGL2.
 fn compare_styles(name: &str, file: &Path, flags: &[&str]) {
+    compare_styles_on("webgl2", name, file, flags);
+}
+
+/// The same on the page's `backend` (`webgl2`, or `webgpu`: Dawn on SwiftShader's Vulkan); the
+/// page must have used it.
+fn compare_styles_on(backend: &str, name: &str, file: &Path, flags: &[&str]) {
     let dir = common::scratch(&format!("web-{name}"));
     let shots = dir.join("page");
     let styles = STYLES.join(",");
-    let mut args = vec!["--out", shots.to_str().expect("utf-8"), "--styles", &styles];
+    let mut args = vec!["--out", shots.to_str().expect("utf-8"), "--styles", &styles, "--backend", backend];
     args.extend(flags);
     let json = web("shots", file, &args);
     assert!(json["ok"] == true, "{name}: {json}");
+    let expected = if backend == "webgpu" { "BrowserWebGpu" } else { "Gl" };
+    assert!(json["backend"].as_str().is_some_and(|b| b.contains(expected)), "{name}: not on {backend}: {json}");
     let mut report = Vec::new();
     let mut worst = 0.0f64;
     for style in STYLES {
-        let native = render(file, style, flags, &dir.join(format!("native-{style}.png")));
+        let native_flags: Vec<&str> = flags.iter().copied().filter(|f| *f != "--capture").collect();
+        let native = render(file, style, &native_flags, &dir.join(format!("native-{style}.png")));
         let page = Image::from_png(&std::fs::read(shots.join(format!("{style}.png"))).expect("shot")).expect("PNG");
         let diff = page.diff(&native, LEVELS).unwrap_or_else(|| panic!("{name} {style}: the sizes differ"));
         worst = worst.max(diff.fraction_over);
@@ -126,6 +135,19 @@ fn the_sample_matches_drafter_render_in_every_style() {
     let file = sample();
     compare_styles("assembly", &file, &[]);
     compare_styles("assembly-illustrated", &file, &["--edges", "--lines", "--shadow", "soft"]);
+}
+
+/// The page's offscreen capture (`viewer.capture()`, its screenshot where a canvas cannot be read
+/// back, as on WebGPU) and a file compressed with EXT_meshopt_compression (decoded by the
+/// module's meshoptimizer) match `drafter render` too.
+#[test]
+fn the_capture_and_a_compressed_file_match_drafter_render() {
+    let file = sample();
+    compare_styles("assembly-capture", &file, &["--edges", "--lines", "--shadow", "soft", "--capture"]);
+    let dir = common::scratch("web-bake-compressed");
+    let compressed = dir.join("assembly-compressed.glb");
+    common::bake(&root().join("samples/assembly.glb"), &compressed, &["--compress"]);
+    compare_styles("assembly-compressed", &compressed, &["--edges", "--lines"]);
 }
 
 #[test]
@@ -192,6 +214,16 @@ fn drafter_web_writes_a_folder_for_a_static_host() {
     let index = std::fs::read_to_string(out.join("index.html")).expect("index.html");
     assert!(index.contains("data-model=\"assembly.glb\""), "{index}");
     assert!(out.join("assembly.glb").is_file() && out.join("drafter_web_bg.wasm").is_file());
+    // The budgets: the folder of the sample within 4 MB, the module within 3 MB gzip.
+    let folder: u64 = std::fs::read_dir(&out)
+        .expect("the folder")
+        .map(|e| e.expect("an entry").metadata().expect("metadata").len())
+        .sum();
+    let gzip =
+        Command::new("gzip").args(["-9", "-c"]).arg(out.join("drafter_web_bg.wasm")).output().expect("gzip runs");
+    eprintln!("the sample's folder: {folder} bytes; the module: {} bytes gzip -9", gzip.stdout.len());
+    assert!(folder <= 4_000_000, "the sample's folder is {folder} bytes");
+    assert!(gzip.status.success() && gzip.stdout.len() <= 3_000_000, "the module is {} bytes gzip", gzip.stdout.len());
     // The folder shows its own model, without a src parameter.
     let shots = dir.join("shots");
     let args = ["--out", shots.to_str().expect("utf-8"), "--styles", "gooch", "--no-src"];

@@ -6,8 +6,10 @@
 //   PAGE_DIR: the built page (index.html, drafter-viewer.js, drafter_web.js, drafter_web_bg.wasm).
 //   FILE: the model, served from its folder.
 //   shots --out DIR --styles a,b,... [--size WxH] [--view AZ,EL] [--edges] [--lines] [--shadow S]
-//         [--frames N] [--no-src]
-//       Loads the page with FILE, then draws each style and saves the canvas as DIR/STYLE.png.
+//         [--frames N] [--no-src] [--capture]
+//       Loads the page with FILE, then draws each style and saves the canvas as DIR/STYLE.png
+//       (with --capture, and always on WebGPU: the pixels of viewer.capture(), the same frame
+//       drawn offscreen).
 //       Prints {ok, backend, summary, timings, shots, frameMs, consoleErrors}: timings in ms from
 //       the navigation's start (wasmReady, fileFetched, modelLoaded, firstFrame); with --frames,
 //       frameMs holds N full frames of the first style, each timed from recording until the GPU
@@ -18,7 +20,8 @@
 //   bad [--max-triangles N]
 //       Loads FILE, which should be refused. Prints {ok, state, message, ms, canvasBlank,
 //       consoleErrors}; ok when the page shows an error message within the timeout.
-// Common: --backend webgpu|webgl2 (default webgl2), --timeout S (default 120).
+// Common: --backend webgpu|webgl2 (default webgl2; webgpu starts Chromium with WebGPU on SwiftShader's
+// Vulkan, or with DRAFTER_WEBGPU_ARGS), --timeout S (default 120).
 // Every command prints one JSON line and exits 0 when ok, 1 otherwise, 2 on wrong usage.
 
 import { mkdirSync, writeFileSync } from 'node:fs';
@@ -26,6 +29,9 @@ import path from 'node:path';
 import process from 'node:process';
 
 import { launchBrowser, killBrowser } from './lib/browser.mjs';
+
+// WebGPU without a GPU: Dawn on Chromium's bundled SwiftShader Vulkan.
+const WEBGPU_ARGS = (process.env.DRAFTER_WEBGPU_ARGS ?? '--enable-unsafe-webgpu --enable-features=Vulkan --use-webgpu-adapter=swiftshader').split(' ');
 import { startServer } from './lib/server.mjs';
 
 function parse(argv) {
@@ -33,7 +39,7 @@ function parse(argv) {
   const options = { backend: 'webgl2', timeout: '120', size: '800x600', view: '35,25', shadow: 'none' };
   for (let i = 0; i < rest.length; i++) {
     const name = rest[i].replace(/^--/, '');
-    if (['edges', 'lines', 'no-src'].includes(name)) options[name] = true;
+    if (['edges', 'lines', 'no-src', 'capture'].includes(name)) options[name] = true;
     else options[name] = rest[++i];
   }
   if (!command || !pageDir || !file) throw new Error('usage: web.mjs shots|interact|bad PAGE_DIR FILE [options]');
@@ -56,7 +62,7 @@ async function main() {
     process.exit(1);
   }, timeoutMs + 20_000);
   const server = await startServer({ toolRoot: pageDir, modelDir: path.dirname(file) });
-  const browser = await launchBrowser(timeoutMs);
+  const browser = await launchBrowser(timeoutMs, options.backend === 'webgpu' ? WEBGPU_ARGS : []);
   const consoleErrors = [];
   let result;
   try {
@@ -111,14 +117,31 @@ async function main() {
       mkdirSync(options.out, { recursive: true });
       const shots = {};
       for (const style of options.styles.split(',')) {
-        const url = await page.evaluate((style) => {
-          const v = document.getElementById('viewer');
-          v.viewer.set_style(style);
-          v.draw(false);
-          return v.canvas.toDataURL('image/png'); // same task as the draw: the buffer is intact
-        }, style);
         const out = path.join(options.out, `${style}.png`);
-        writeFileSync(out, Buffer.from(url.split(',')[1], 'base64'));
+        if (options.backend === 'webgpu' || options.capture) {
+          // A WebGPU canvas cannot be read back here (its texture is gone once presented, and
+          // SwiftShader's WebGPU canvas reads empty even in the frame's task): the page's
+          // viewer.capture() renders the same frame offscreen and returns its pixels.
+          const url = await page.evaluate(async (style) => {
+            const v = document.getElementById('viewer');
+            v.viewer.set_style(style);
+            const rgba = await v.viewer.capture();
+            const c = document.createElement('canvas');
+            c.width = v.canvas.width;
+            c.height = v.canvas.height;
+            c.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(rgba.buffer), c.width, c.height), 0, 0);
+            return c.toDataURL('image/png');
+          }, style);
+          writeFileSync(out, Buffer.from(url.split(',')[1], 'base64'));
+        } else {
+          const url = await page.evaluate((style) => {
+            const v = document.getElementById('viewer');
+            v.viewer.set_style(style);
+            v.draw(false);
+            return v.canvas.toDataURL('image/png'); // same task as the draw: the buffer is intact
+          }, style);
+          writeFileSync(out, Buffer.from(url.split(',')[1], 'base64'));
+        }
         shots[style] = out;
       }
       let frameMs = [];
@@ -174,7 +197,7 @@ async function main() {
       result = { ok: false, error: `unknown command ${command}` };
     }
   } catch (err) {
-    result = { ok: false, error: String(err?.stack ?? err) };
+    result = { ok: false, error: String(err?.stack ?? err), consoleErrors };
   } finally {
     await browser.close().catch(() => {});
     killBrowser();

@@ -77,5 +77,5 @@ pub use camera::Camera;
 pub use context::{Gpu, RenderError};
 pub use image::{Image, ImageDiff, PngError};
 pub use model::{LoadError, Model, Part};
-pub use renderer::{FrameInfo, PartMap, Renderer};
+pub use renderer::{FrameInfo, PartMap, Readback, Renderer};
 pub use style::{Enhancements, RenderOptions, ShadowMode, Style, UnknownStyle, View};

@@ -395,6 +395,15 @@ impl Renderer {
 
     /// Renders one frame offscreen and reads it back, down-sampled to `options.size`.
     pub fn render(&mut self, options: &RenderOptions) -> Result<Image, RenderError> {
+        let readback = self.submit_render(options)?;
+        map_blocking(&self.gpu.device, &readback.buffer)?;
+        readback.image()
+    }
+
+    /// Records and submits one offscreen frame and its copy into a buffer, which the caller maps
+    /// for reading ([`Readback::buffer`]; [`Self::render`] waits for it, the browser awaits it)
+    /// and then reads with [`Readback::image`].
+    pub fn submit_render(&mut self, options: &RenderOptions) -> Result<Readback, RenderError> {
         use wgpu::TextureFormat as F;
         let swap_red_blue = match self.output_format {
             F::Rgba8Unorm | F::Rgba8UnormSrgb => false,
@@ -408,7 +417,7 @@ impl Renderer {
         let info = self.encode_frame(options, &mut encoder, None)?;
         let (w, h) = info.target_size;
         let bytes_per_row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("render readback"),
             size: u64::from(bytes_per_row) * u64::from(h),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -423,7 +432,7 @@ impl Renderer {
         encoder.copy_texture_to_buffer(
             source.texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
+                buffer: &buffer,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(bytes_per_row),
@@ -433,12 +442,8 @@ impl Renderer {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([encoder.finish()]);
-        let mut rgba = read_buffer(&device, &readback, bytes_per_row, w, h)?;
         guard.pop()?;
-        if swap_red_blue {
-            rgba.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
-        }
-        Ok(Image { width: w, height: h, rgba }.downsample(options.supersample))
+        Ok(Readback { buffer, bytes_per_row, size: (w, h), swap_red_blue, supersample: options.supersample })
     }
 
     /// The part drawn at target pixel (`x`, `y`) of the last frame (the G-buffer's part-id target,
@@ -500,7 +505,8 @@ impl Renderer {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(device, &readback, bytes_per_row, w, h)?;
+        map_blocking(device, &readback)?;
+        let bytes = rows(&readback, bytes_per_row, w, h)?;
         guard.pop()?;
         Ok(bytes.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
     }
@@ -529,28 +535,54 @@ pub fn world_view(camera: &Camera, origin: glam::DVec3) -> crate::edges::WorldVi
 }
 
 /// Maps `buffer` and copies `height` rows of `width × 4` bytes out of its padded rows.
-fn read_buffer(
-    device: &wgpu::Device,
-    buffer: &wgpu::Buffer,
-    bytes_per_row: u32,
-    width: u32,
-    height: u32,
-) -> Result<Vec<u8>, RenderError> {
+/// Maps `buffer` for reading and waits for it (natively; the browser cannot wait).
+fn map_blocking(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<(), RenderError> {
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |result| {
         let _ = sender.send(result);
     });
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
-    receiver.recv().map_err(|e| RenderError::Gpu(e.to_string()))?.map_err(|e| RenderError::Gpu(e.to_string()))?;
-    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+    receiver.recv().map_err(|e| RenderError::Gpu(e.to_string()))?.map_err(|e| RenderError::Gpu(e.to_string()))
+}
+
+/// The first `width * 4` bytes of each of `height` rows of a mapped `buffer`; unmaps it.
+fn rows(buffer: &wgpu::Buffer, bytes_per_row: u32, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
+    let mut out = Vec::with_capacity((width * height * 4) as usize);
     {
         let view = buffer.get_mapped_range(..).map_err(|e| RenderError::Gpu(e.to_string()))?;
         for row in view.chunks(bytes_per_row as usize).take(height as usize) {
-            rgba.extend_from_slice(&row[..(width * 4) as usize]);
+            out.extend_from_slice(&row[..(width * 4) as usize]);
         }
     }
     buffer.unmap();
-    Ok(rgba)
+    Ok(out)
+}
+
+/// A submitted offscreen frame on its way back ([`Renderer::submit_render`]).
+#[derive(Debug)]
+pub struct Readback {
+    buffer: wgpu::Buffer,
+    bytes_per_row: u32,
+    size: (u32, u32),
+    swap_red_blue: bool,
+    supersample: u32,
+}
+
+impl Readback {
+    /// The buffer to map for reading.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// The frame, down-sampled to the options' size, once the buffer is mapped.
+    pub fn image(self) -> Result<Image, RenderError> {
+        let (width, height) = self.size;
+        let mut rgba = rows(&self.buffer, self.bytes_per_row, width, height)?;
+        if self.swap_red_blue {
+            rgba.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
+        Ok(Image { width, height, rgba }.downsample(self.supersample))
+    }
 }
 
 /// The part drawn at each pixel of a frame ([`Renderer::part_map`]).
@@ -587,21 +619,38 @@ impl ErrorScopes {
 }
 
 /// The error a popped scope reports. Natively it blocks until the device answers. In the browser
-/// nothing may block: WebGL2 (wgpu-core) answers at once, and a WebGPU answer still pending after
-/// one poll is left to the device's uncaptured-error handler, which the page reports.
+/// nothing may block: WebGL2 (wgpu-core) answers at once; a WebGPU answer still pending after one
+/// poll is awaited on the page's event loop and, if it is an error, written to the console (which
+/// the page and its tests watch), since the frame that caused it has already returned.
 #[cfg(feature = "native")]
 fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>>) -> Option<wgpu::Error> {
     pollster::block_on(pop)
 }
 
 #[cfg(not(feature = "native"))]
-fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>>) -> Option<wgpu::Error> {
-    let mut pop = std::pin::pin!(pop);
+fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>> + 'static) -> Option<wgpu::Error> {
+    let mut pop = Box::pin(pop);
     match pop.as_mut().poll(&mut std::task::Context::from_waker(std::task::Waker::noop())) {
         std::task::Poll::Ready(error) => error,
-        std::task::Poll::Pending => None,
+        std::task::Poll::Pending => {
+            report_later(pop);
+            None
+        }
     }
 }
+
+#[cfg(all(not(feature = "native"), target_arch = "wasm32"))]
+fn report_later(pop: std::pin::Pin<Box<dyn std::future::Future<Output = Option<wgpu::Error>>>>) {
+    wasm_bindgen_futures::spawn_local(async move {
+        if let Some(error) = pop.await {
+            web_sys::console::error_1(&format!("drafter: GPU error: {error}").into());
+        }
+    });
+}
+
+/// Off the web without `native` (a check build) nothing answers later.
+#[cfg(all(not(feature = "native"), not(target_arch = "wasm32")))]
+fn report_later(_pop: std::pin::Pin<Box<dyn std::future::Future<Output = Option<wgpu::Error>>>>) {}
 
 /// Runs `f` inside error scopes.
 fn scoped<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, RenderError> {

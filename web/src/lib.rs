@@ -43,6 +43,18 @@ pub struct Viewer {
     backend: String,
 }
 
+/// Resolves on a later task of the page's event loop (`setTimeout(…, 0)`).
+async fn next_task() -> Result<(), JsError> {
+    let window = web_sys::window().ok_or_else(|| js_error("no window"))?;
+    let mut scheduled = Ok(0);
+    let promise = js_sys::Promise::new(&mut |resolve, _| {
+        scheduled = window.set_timeout_with_callback(&resolve);
+    });
+    scheduled.map_err(|_| js_error("setTimeout failed"))?;
+    wasm_bindgen_futures::JsFuture::from(promise).await.map_err(|_| js_error("the page's timer failed"))?;
+    Ok(())
+}
+
 fn js_error(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
 }
@@ -82,6 +94,10 @@ impl Viewer {
             .or_else(|| capabilities.formats.first().copied())
             .ok_or_else(|| js_error("the canvas supports no texture format"))?;
         let gpu = Gpu::request(instance, adapter).await.map_err(js_error)?;
+        // A lost device draws nothing and fails every read: say so where the page looks.
+        gpu.device.set_device_lost_callback(|reason, message| {
+            web_sys::console::error_1(&format!("drafter: the GPU device was lost ({reason:?}): {message}").into());
+        });
         let backend = gpu.description();
         let interactive_scale = gpu.interactive_scale();
         let config = wgpu::SurfaceConfiguration {
@@ -231,6 +247,35 @@ impl Viewer {
     /// Orthographic projection on or off.
     pub fn set_orthographic(&mut self, on: bool) {
         self.options.orthographic = on;
+    }
+
+    /// Renders the view offscreen, into the renderer's own target as `drafter render` does, and
+    /// returns its RGBA bytes row by row (width × height × 4, the canvas's size). For a canvas
+    /// that cannot be read back: a WebGPU canvas's texture is gone once presented, and headless
+    /// Chromium's SwiftShader WebGPU gives empty pixels even in the frame's own task.
+    pub async fn capture(&mut self) -> Result<Vec<u8>, JsError> {
+        if self.model.is_none() {
+            return Err(js_error("no model loaded"));
+        }
+        self.orbit.apply(&mut self.options);
+        self.options.interactive = false;
+        let readback = self.renderer.submit_render(&self.options).map_err(js_error)?;
+        let mapped = std::rc::Rc::new(std::cell::RefCell::new(None));
+        let answer = mapped.clone();
+        readback.buffer().map_async(wgpu::MapMode::Read, .., move |result| {
+            *answer.borrow_mut() = Some(result);
+        });
+        let device = self.renderer.gpu().device.clone();
+        // WebGL2 maps when polled; WebGPU when the browser's promise resolves, on a later task.
+        loop {
+            let _ = device.poll(wgpu::PollType::Poll);
+            if let Some(result) = mapped.borrow_mut().take() {
+                result.map_err(js_error)?;
+                break;
+            }
+            next_task().await?;
+        }
+        Ok(readback.image().map_err(js_error)?.rgba)
     }
 
     /// The frame's settings as JSON: style, edges, lines, shadow, orthographic, view and zoom.

@@ -42,11 +42,11 @@ export function killBrowser() {
  * Starts headless Chromium with the flags above (software WebGL 2) and registers it for
  * killBrowser(). `timeoutMs` bounds any single DevTools call.
  */
-export async function launchBrowser(timeoutMs) {
+export async function launchBrowser(timeoutMs, extraArgs = []) {
   const browser = await puppeteer.launch({
     executablePath: CHROMIUM,
     headless: true,
-    args: ARGS,
+    args: [...ARGS, ...extraArgs],
     timeout: 30_000, // to start the browser
     protocolTimeout: timeoutMs + 10_000,
   });
