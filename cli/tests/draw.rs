@@ -35,6 +35,17 @@ fn the_sample_draws_as_a_valid_svg_with_hidden_lines() {
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains(r#"<g id="hidden""#) && text.contains(r#"<g id="visible""#));
     assert_eq!(text.matches("<path").count() as u64, figures["strokes"].as_u64().unwrap());
+
+    // With the gradient bands under the lines: still valid, the fills first, a group per part.
+    let banded = dir.join("sample-bands.svg");
+    let run = common::run(&["draw", baked.to_str().unwrap(), "-o", banded.to_str().unwrap(), "--fill", "bands"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let lint = Command::new("xmllint").arg("--noout").arg(&banded).output().expect("xmllint");
+    assert!(lint.status.success(), "xmllint: {}", String::from_utf8_lossy(&lint.stderr));
+    let text = std::fs::read_to_string(&banded).unwrap();
+    let (fills, visible) = (text.find(r#"<g id="fills""#).unwrap(), text.find(r#"<g id="visible""#).unwrap());
+    assert!(fills < visible, "fills are painted under the lines");
+    assert!(text.matches(r#"<g class="fill part-"#).count() >= 10 && text.contains(r#"class="band-1""#));
 }
 
 /// The same drawing as a PDF: one page of 600 × 450 pt for 800 × 600 px, which poppler reads.

@@ -38,6 +38,7 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::edges::LineClass;
+pub use crate::fills::{Fill, PartFill};
 use crate::model::Model;
 use crate::style::{DEFAULT_FOV_Y_DEG, View};
 
@@ -63,6 +64,8 @@ pub struct DrawOptions {
     pub hidden: Hidden,
     /// Pieces shorter than this (pixels) are dropped, and end points closer than it are joined.
     pub tolerance_px: f64,
+    /// Part fills under the lines ([`crate::fills`]).
+    pub fill: Fill,
 }
 
 impl Default for DrawOptions {
@@ -74,6 +77,7 @@ impl Default for DrawOptions {
             fov_y_deg: DEFAULT_FOV_Y_DEG,
             hidden: Hidden::None,
             tolerance_px: 0.05,
+            fill: Fill::None,
         }
     }
 }
@@ -112,6 +116,8 @@ pub struct DrawStats {
 pub struct Drawing {
     pub width: u32,
     pub height: u32,
+    /// Part fills, farthest part first ([`crate::fills`]); empty without `--fill`.
+    pub fills: Vec<PartFill>,
     pub strokes: Vec<Stroke>,
     pub stats: DrawStats,
 }
@@ -160,6 +166,20 @@ impl Projection {
     /// Pixels (x right, y down) of a world point; `None` behind the eye.
     pub fn to_screen(&self, world: DVec3) -> Option<DVec2> {
         self.project(world).map(|p| DVec2::new(p.x, p.y))
+    }
+
+    /// The view's width and height in pixels.
+    pub(crate) fn size(&self) -> (f64, f64) {
+        (self.width, self.height)
+    }
+
+    /// The mean closeness of the corners (`None` if one is behind the eye).
+    pub(crate) fn closeness_of(&self, corners: &[DVec3]) -> Option<f64> {
+        let mut sum = 0.0;
+        for &c in corners {
+            sum += self.project(c)?.c;
+        }
+        Some(sum / corners.len().max(1) as f64)
     }
 
     /// Pixels (x right, y down) and closeness of a world point; `None` behind the eye.
@@ -285,7 +305,7 @@ fn batch_of(model: &Model, instance: u32) -> Option<&crate::model::Batch> {
 }
 
 /// The part of mesh triangle `t` drawn by `instance` through `batch`.
-fn part_of(model: &Model, batch: Option<&crate::model::Batch>, instance: u32, t: usize) -> Option<u32> {
+pub(crate) fn part_of(model: &Model, batch: Option<&crate::model::Batch>, instance: u32, t: usize) -> Option<u32> {
     let batch = batch?;
     let v = *batch.indices.get(3 * t)? as usize;
     let label = batch.vertices.get(v)?.label;
@@ -619,7 +639,8 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
 /// Draws `model` as `options` say.
 pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
     let start = Instant::now();
-    let Visibility { edges, mut stats, .. } = visibility(model, options);
+    let Visibility { edges, mut stats, projection } = visibility(model, options);
+    let fills = crate::fills::fills(model, &projection, options.fill);
     let tolerance = options.tolerance_px.max(0.0);
     let mut pieces = Vec::new();
     for edge in &edges {
@@ -654,7 +675,7 @@ pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
     }
     let strokes = chain(&pieces, tolerance);
     stats.elapsed = start.elapsed();
-    Drawing { width: options.size.0, height: options.size.1, strokes, stats }
+    Drawing { width: options.size.0, height: options.size.1, fills, strokes, stats }
 }
 
 /// Joins pieces of one class and visibility that meet end to end (within `tolerance`) into
@@ -739,6 +760,32 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
     );
     let _ = writeln!(s, "<desc>drafter draw: {} strokes</desc>", drawing.strokes.len());
+    if !drawing.fills.is_empty() {
+        // Farthest part first (painter's order); the nonzero rule fills each region's loops.
+        let _ = writeln!(s, r#"<g id="fills" stroke="none">"#);
+        for fill in &drawing.fills {
+            let part = fill.part.map(|p| format!(" part-{p}")).unwrap_or_default();
+            let _ = writeln!(s, r#"<g class="fill{part}">"#);
+            for region in &fill.regions {
+                let g = (region.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
+                let _ = write!(s, r##"<path class="band-{}" fill="#{g:02x}{g:02x}{g:02x}" d=""##, region.band);
+                for (k, ring) in region.loops.iter().enumerate() {
+                    for (i, p) in ring.iter().enumerate() {
+                        let sep = match (k, i) {
+                            (0, 0) => "M",
+                            (_, 0) => " M",
+                            _ => " L",
+                        };
+                        let _ = write!(s, "{sep}{} {}", coordinate(p.x), coordinate(p.y));
+                    }
+                    let _ = write!(s, "Z");
+                }
+                let _ = writeln!(s, r#""/>"#);
+            }
+            let _ = writeln!(s, "</g>");
+        }
+        let _ = writeln!(s, "</g>");
+    }
     let classes =
         [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
     for visible in [false, true] {
@@ -791,6 +838,21 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden) -> Vec<u8> {
     p.resources();
     p.finish();
     let mut content = Content::new();
+    for region in drawing.fills.iter().flat_map(|f| &f.regions) {
+        content.set_fill_gray(region.grey as f32);
+        for ring in &region.loops {
+            for (i, q) in ring.iter().enumerate() {
+                let (x, y) = (q.x as f32 * POINTS_PER_PIXEL, h - q.y as f32 * POINTS_PER_PIXEL);
+                if i == 0 {
+                    content.move_to(x, y);
+                } else {
+                    content.line_to(x, y);
+                }
+            }
+            content.close_path();
+        }
+        content.fill_nonzero();
+    }
     content.set_line_cap(pdf_writer::types::LineCapStyle::RoundCap);
     content.set_line_join(pdf_writer::types::LineJoinStyle::RoundJoin);
     let classes =

@@ -58,6 +58,8 @@ pub mod controls;
 pub mod drawing;
 pub mod edges;
 pub mod edit;
+#[cfg(feature = "native")]
+pub mod fills;
 pub mod gpu_types;
 pub mod image;
 pub mod lookups;

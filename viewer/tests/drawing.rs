@@ -247,3 +247,89 @@ fn a_cylinder_with_faces_edge_on_keeps_its_outline() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The parts' fills rasterised in painter's order (scanlines through pixel centres, nonzero
+/// winding), as the part id of each pixel.
+fn rasterise_fills(drawing: &drawing::Drawing, (w, h): (usize, usize)) -> Vec<Option<u32>> {
+    let mut ids = vec![None; w * h];
+    for fill in &drawing.fills {
+        // Per row: (x of the crossing, +1 or −1) of every edge of every region of the part.
+        let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); h];
+        for ring in fill.regions.iter().flat_map(|r| &r.loops) {
+            for (i, &a) in ring.iter().enumerate() {
+                let b = ring[(i + 1) % ring.len()];
+                if a.y == b.y {
+                    continue;
+                }
+                let (lo, hi, dir) = if a.y < b.y { (a, b, 1) } else { (b, a, -1) };
+                let first = (lo.y - 0.5).ceil().max(0.0) as usize;
+                let mut y = first;
+                while y < h && (y as f64 + 0.5) < hi.y {
+                    let yc = y as f64 + 0.5;
+                    rows[y].push((lo.x + (hi.x - lo.x) * (yc - lo.y) / (hi.y - lo.y), dir));
+                    y += 1;
+                }
+            }
+        }
+        for (y, row) in rows.iter_mut().enumerate() {
+            row.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut winding = 0;
+            for k in 0..row.len() {
+                winding += row[k].1;
+                if winding != 0 && k + 1 < row.len() {
+                    let from = (row[k].0 - 0.5).ceil().max(0.0) as usize;
+                    let to = ((row[k + 1].0 - 0.5).ceil().max(0.0) as usize).min(w);
+                    for x in from..to {
+                        ids[y * w + x] = fill.part;
+                    }
+                }
+            }
+        }
+    }
+    ids
+}
+
+/// `--fill flat` and `--fill bands` against the renderer's part ids at the same view: the regions
+/// are exact, painter's order of whole parts is the approximation (fills.rs); the share of pixels
+/// it paints with another part than the renderer shows is printed and bounded.
+#[test]
+fn the_fills_match_the_renderers_parts() {
+    for (name, model) in
+        [("sample", common::sample()), ("RodAssembly", common::baked(&common::corpus_path("gltf/RodAssembly/rod.glb")))]
+    {
+        let size = (800u32, 600u32);
+        let mut renderer = common::renderer();
+        renderer.set_model(&model).expect("upload");
+        let render = drafter_viewer::RenderOptions {
+            size,
+            supersample: 1,
+            view: DrawOptions::default().view,
+            ..drafter_viewer::RenderOptions::default()
+        };
+        renderer.render(&render).expect("frame");
+        let parts = renderer.part_map().expect("part ids").expect("a frame");
+        for fill in [drawing::Fill::Flat, drawing::Fill::Bands] {
+            let options = DrawOptions { size, fill, ..DrawOptions::default() };
+            let drawing = drawing::draw(&model, &options);
+            let ids = rasterise_fills(&drawing, (size.0 as usize, size.1 as usize));
+            let covered = ids.iter().zip(&parts.ids).filter(|(a, b)| a.is_some() || b.is_some()).count();
+            let wrong = ids.iter().zip(&parts.ids).filter(|(a, b)| a != b).count();
+            let share = wrong as f64 / covered.max(1) as f64;
+            let loops: usize = drawing.fills.iter().flat_map(|f| &f.regions).map(|r| r.loops.len()).sum();
+            let svg = drawing::to_svg(&drawing, Hidden::None);
+            eprintln!(
+                "{name} {fill:?}: {} parts, {loops} loops, {} SVG bytes; {wrong} of {covered} covered pixels ({:.3}%) differ from the renderer's part",
+                drawing.fills.len(),
+                svg.len(),
+                100.0 * share
+            );
+            assert!(covered > 20_000, "{name}: the view shows the model");
+            // Measured 2026-11-29: sample 7.29%, RodAssembly 17.69% (rods through housings: a part
+            // in front of another in some pixels and behind it in others, which no order of
+            // whole parts paints right); a regression guard above those figures.
+            let bound = if name == "sample" { 0.08 } else { 0.19 };
+            assert!(share <= bound, "{name} {fill:?}: {:.3}% of pixels disagree", 100.0 * share);
+            assert!(svg.contains(r#"<g id="fills""#) && svg.contains("class=\"fill part-"));
+        }
+    }
+}

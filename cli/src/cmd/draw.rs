@@ -1,5 +1,5 @@
 //! `drafter draw FILE -o view.svg|view.pdf [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
-//! [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
+//! [--fill none|flat|bands] [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
 //! (`drafter_viewer::drawing`): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
 
@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use drafter_viewer::View;
-use drafter_viewer::drawing::{self, DrawOptions, Hidden};
+use drafter_viewer::drawing::{self, DrawOptions, Fill, Hidden};
 
 use crate::cmd::out;
 use crate::cmd::render::{parse_size, parse_view};
@@ -33,6 +33,10 @@ pub struct Args {
     /// Lines hidden by surfaces: left out, dashed or thin solid, in a group of their own.
     #[arg(long, value_enum, default_value_t = HiddenArg::None)]
     pub hidden: HiddenArg,
+    /// Part fills under the lines, painted farthest part first: none, each part's area in a flat
+    /// grey, or its gradient bands (Lux et al. 2013) as grey regions.
+    #[arg(long, value_enum, default_value_t = FillArg::None)]
+    pub fill: FillArg,
     /// Pieces shorter than this many pixels are dropped and end points closer than it joined.
     #[arg(long, value_name = "PX", default_value_t = 0.05)]
     pub tolerance: f64,
@@ -52,6 +56,23 @@ pub enum HiddenArg {
     None,
     Dashed,
     Solid,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum FillArg {
+    None,
+    Flat,
+    Bands,
+}
+
+impl From<FillArg> for Fill {
+    fn from(f: FillArg) -> Fill {
+        match f {
+            FillArg::None => Fill::None,
+            FillArg::Flat => Fill::Flat,
+            FillArg::Bands => Fill::Bands,
+        }
+    }
 }
 
 impl From<HiddenArg> for Hidden {
@@ -91,6 +112,7 @@ pub fn run(args: Args) -> Result<()> {
         orthographic: args.ortho,
         hidden: args.hidden.into(),
         tolerance_px: args.tolerance,
+        fill: args.fill.into(),
         ..DrawOptions::default()
     };
     let drawing = drawing::draw(&model, &options);
