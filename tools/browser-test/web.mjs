@@ -84,6 +84,9 @@ async function main() {
     if (options.edges) params.set('edges', '1');
     if (options.lines) params.set('lines', '1');
     if (options['max-triangles']) params.set('max-triangles', options['max-triangles']);
+    // WebGPU here: present nothing (presenting a WebGPU canvas loses the device in this headless
+    // Chromium); the shots are viewer.capture()'s.
+    if (options.backend === 'webgpu') params.set('offscreen', '1');
     const started = Date.now();
     await page.goto(`${server.url}/index.html?${params}`, { waitUntil: 'domcontentloaded', timeout: timeoutMs });
     const settled = await page

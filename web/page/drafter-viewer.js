@@ -9,7 +9,8 @@
 // edges, lines (present: on), shadow (none, hard, penumbra, soft), view ("AZ,EL" degrees, as
 // `drafter render --view`), size ("WxH": a fixed canvas size in pixels instead of the element's),
 // backend ("webgpu", "webgl2"; default: either), max-triangles (default 5,000,000), controls
-// ("none" hides the toolbar). A file dropped on the element replaces the model.
+// ("none" hides the toolbar), offscreen (present: nothing is drawn into the canvas, frames come
+// from viewer.capture(); for tests). A file dropped on the element replaces the model.
 //
 // Mouse and keys as in `drafter view`: left drag turns the object, right or middle drag pans, the
 // wheel zooms; 1-7 styles, S next style, E edges, L lines, H next shadow, O orthographic, R reset,
@@ -225,6 +226,9 @@ export class DrafterViewer extends HTMLElement {
   /** Draws now (`interactive`: the reduced frame of a drag). */
   draw(interactive) {
     this.sizeCanvas();
+    // `offscreen`: nothing is presented; frames come from viewer.capture() alone (headless
+    // Chromium on SwiftShader loses its WebGPU device when a WebGPU canvas is presented).
+    if (this.hasAttribute('offscreen')) return 0;
     return this.viewer.render(interactive);
   }
 

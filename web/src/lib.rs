@@ -251,8 +251,9 @@ impl Viewer {
 
     /// Renders the view offscreen, into the renderer's own target as `drafter render` does, and
     /// returns its RGBA bytes row by row (width × height × 4, the canvas's size). For a canvas
-    /// that cannot be read back: a WebGPU canvas's texture is gone once presented, and headless
-    /// Chromium's SwiftShader WebGPU gives empty pixels even in the frame's own task.
+    /// that cannot be read back (a WebGPU canvas's texture is gone once presented) or must not be
+    /// presented (headless Chromium on SwiftShader loses its WebGPU device when one is: the
+    /// page's `offscreen` attribute, docs/web.md).
     pub async fn capture(&mut self) -> Result<Vec<u8>, JsError> {
         if self.model.is_none() {
             return Err(js_error("no model loaded"));
