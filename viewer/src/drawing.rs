@@ -489,7 +489,7 @@ impl Occluders {
             .filter_map(|t| Some([projection.project(t[0])?, projection.project(t[1])?, projection.project(t[2])?]))
             .collect();
         let boxes: Vec<Aabb> = projected.iter().map(padded_box).collect();
-        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::fast_build() };
+        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::very_fast_build() };
         let bvh = build_bvh2(&boxes, params, &mut Duration::default());
         Occluders { projected, bvh }
     }
