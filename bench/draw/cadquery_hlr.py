@@ -1,6 +1,6 @@
 """`drafter draw` against OpenCascade's hidden-line removal (CadQuery's SVG export), issue 45.
 
-For each CAD model built here with CadQuery (plate, bushing, bracket, gear, assemblies):
+For each CAD model built here with CadQuery (plate, bushing, bracket, gear, six assemblies):
 
 1. The solid is built z-up as CadQuery does, then turned so that its up is +y (drafter's world is
    y-up, as glTF's), and everything below uses these turned coordinates.
@@ -179,6 +179,86 @@ def tower_assembly():
     return cq.Compound.makeCompound([base.val(), post.val(), cap.val()])
 
 
+def flange_assembly():
+    """Five parts: a square flange plate with four holes and a centre bore, and four hexagon-head
+    bolts through the holes (shank 8 in a 10 hole, so the shanks touch nothing; heads on the plate)."""
+    plate = (
+        cq.Workplane("XY")
+        .box(90, 90, 12)
+        .translate((0, 0, 6))
+        .faces(">Z")
+        .workplane()
+        .rarray(60, 60, 2, 2)
+        .hole(10)
+        .faces(">Z")
+        .workplane()
+        .hole(30)
+    )
+    parts = [plate.val()]
+    for x in (-30, 30):
+        for y in (-30, 30):
+            head = cq.Workplane("XY").polygon(6, 16).extrude(6).translate((x, y, 12))
+            shank = cq.Workplane("XY").circle(4).extrude(24).translate((x, y, -12))
+            parts.append(head.union(shank).val())
+    return cq.Compound.makeCompound(parts)
+
+
+def gear_pair_assembly():
+    """Five parts: a base plate, two spur gears apart from each other (teeth not in mesh), each on
+    its own shaft standing in a hole of the plate (shaft 12 in the gears' 14 bores)."""
+    base = cq.Workplane("XY").box(150, 80, 10).translate((20, 0, 5))
+    parts = [base.val()]
+    for x in (-15, 55):
+        g = gear()
+        parts.append(g.translate(cq.Vector(x, 0, 30)))
+        parts.append(cq.Workplane("XY").circle(6).extrude(50).translate((x, 0, 10)).val())
+    return cq.Compound.makeCompound(parts)
+
+
+def clevis_assembly():
+    """Three parts: a clevis (a block with a slot and a cross hole), a link plate in the slot (thinner
+    than the slot) and a pin through both (pin 8 in 10 holes)."""
+    clevis = (
+        cq.Workplane("XY")
+        .box(40, 30, 40)
+        .translate((0, 0, 20))
+        .cut(cq.Workplane("XY").box(40, 14, 30).translate((0, 0, 25)))
+        .faces(">Y")
+        .workplane(centerOption="CenterOfBoundBox")
+        .center(0, 5)
+        .hole(10)
+    )
+    link = (
+        cq.Workplane("XZ")
+        .center(20, 25)
+        .rect(70, 16)
+        .extrude(5)
+        .translate((0, 2.5, 0))
+        .faces(">Y")
+        .workplane(centerOption="CenterOfBoundBox")
+        .center(-15, 0)
+        .hole(10)
+    )
+    pin = cq.Workplane("XZ").circle(4).extrude(50).translate((0, 25, 25))
+    return cq.Compound.makeCompound([clevis.val(), link.val(), pin.val()])
+
+
+def bushing_assembly():
+    """Three parts: a mounting plate with a bore, the flanged bushing on it (its sleeve up, the
+    flange on the plate, centred over the bore) and a shaft through both (shaft 24 in the
+    bushing's 28 bore and the plate's 30 bore: no contact)."""
+    plate = (
+        cq.Workplane("XY")
+        .box(120, 100, 10)
+        .translate((0, 0, -5))
+        .faces(">Z")
+        .workplane()
+        .hole(30)
+    )
+    shaft = cq.Workplane("XY").circle(12).extrude(90).translate((0, 0, -25))
+    return cq.Compound.makeCompound([plate.val(), bushing(), shaft.val()])
+
+
 MODELS = {
     "plate": (plate, (35, 30)),
     "bushing": (bushing, (20, 35)),
@@ -186,6 +266,10 @@ MODELS = {
     "gear": (gear, (30, 50)),
     "pillow-assembly": (pillow_assembly, (35, 25)),
     "tower-assembly": (tower_assembly, (25, 20)),
+    "flange-assembly": (flange_assembly, (35, 40)),
+    "gear-pair-assembly": (gear_pair_assembly, (25, 35)),
+    "clevis-assembly": (clevis_assembly, (40, 25)),
+    "bushing-assembly": (bushing_assembly, (25, 30)),
 }
 
 # ---------------------------------------------------------------------------------------------
