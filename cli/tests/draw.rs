@@ -47,6 +47,22 @@ fn the_sample_draws_as_a_valid_svg_with_hidden_lines() {
     let (fills, visible) = (text.find(r#"<g id="fills""#).unwrap(), text.find(r#"<g id="visible""#).unwrap());
     assert!(fills < visible, "fills are painted under the lines");
     assert!(text.matches(r#"<g class="fill part-"#).count() >= 10 && text.contains(r#"class="band-1""#));
+
+    // The largest size allowed: fills never allocate per output pixel (their order is counted on a
+    // grid of at most 2048 cells a side).
+    let huge = dir.join("huge.svg");
+    let run = common::run(&[
+        "draw",
+        baked.to_str().unwrap(),
+        "-o",
+        huge.to_str().unwrap(),
+        "--fill",
+        "flat",
+        "--size",
+        "65536x65536",
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(std::fs::read_to_string(&huge).unwrap().contains(r#"<g id="fills""#));
 }
 
 /// The same drawing as a PDF: one page of 600 × 450 pt for 800 × 600 px, which poppler reads.
@@ -80,6 +96,15 @@ fn a_model_without_baked_edges_draws_its_outline_or_nothing() {
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let lint = Command::new("xmllint").arg("--noout").arg(&svg).output().expect("xmllint");
     assert!(lint.status.success());
+    // Filled from both sides: `flat` fills a sheet whichever face the eye sees, `bands` its front
+    // face only.
+    for (view, fill) in [("35,25", "flat"), ("215,-25", "flat"), ("35,25", "bands")] {
+        let run =
+            common::run(&["draw", stl.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--fill", fill, "--view", view]);
+        assert!(run.status.success(), "{view} {fill}: {}", String::from_utf8_lossy(&run.stderr));
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains(r#"<g id="fills""#) || fill == "bands", "{view} {fill}: {text}");
+    }
 }
 
 #[test]

@@ -66,6 +66,9 @@ pub struct PartFill {
     pub regions: Vec<Region>,
 }
 
+/// The longest side, in cells, of the grid the painter's order is counted on.
+const ORDER_GRID: f64 = 2048.0;
+
 /// The grey of a flat fill.
 pub const FLAT_GREY: f64 = 0.93;
 
@@ -373,8 +376,17 @@ pub fn fills(model: &Model, projection: &Projection, mode: Fill) -> Vec<PartFill
             }
         }
     }
+    // The count needs pixels, not the output's resolution: at most ORDER_GRID on the longer side
+    // (a 65536-pixel drawing must not allocate a buffer per output pixel).
     let (w, h) = projection.size();
-    let order = painter_order(&patches, &fronts, (w as usize, h as usize));
+    let scale = (ORDER_GRID / w.max(h).max(1.0)).min(1.0);
+    if scale < 1.0 {
+        for (_, screen, _) in &mut fronts {
+            *screen = screen.map(|p| p * scale);
+        }
+    }
+    let grid = ((w * scale).ceil().max(1.0) as usize, (h * scale).ceil().max(1.0) as usize);
+    let order = painter_order(&patches, &fronts, grid);
     group_runs(order, patches, &gradients)
 }
 
