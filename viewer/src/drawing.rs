@@ -762,13 +762,19 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
     let _ = writeln!(s, "<desc>drafter draw: {} strokes</desc>", drawing.strokes.len());
     if !drawing.fills.is_empty() {
         // Farthest part first (painter's order); the nonzero rule fills each region's loops.
-        let _ = writeln!(s, r#"<g id="fills" stroke="none">"#);
+        let _ = writeln!(s, r#"<g id="fills" stroke-width="0.5">"#);
         for fill in &drawing.fills {
             let part = fill.part.map(|p| format!(" part-{p}")).unwrap_or_default();
             let _ = writeln!(s, r#"<g class="fill{part}">"#);
             for region in &fill.regions {
                 let g = (region.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
-                let _ = write!(s, r##"<path class="band-{}" fill="#{g:02x}{g:02x}{g:02x}" d=""##, region.band);
+                // Stroked with its own grey, half a pixel wide: pieces of one surface painted apart
+                // leave no hairline seam under anti-aliasing (the region grows by a quarter pixel).
+                let _ = write!(
+                    s,
+                    r##"<path class="band-{}" fill="#{g:02x}{g:02x}{g:02x}" stroke="#{g:02x}{g:02x}{g:02x}" d=""##,
+                    region.band
+                );
                 for (k, ring) in region.loops.iter().enumerate() {
                     for (i, p) in ring.iter().enumerate() {
                         let sep = match (k, i) {
@@ -838,8 +844,12 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden) -> Vec<u8> {
     p.resources();
     p.finish();
     let mut content = Content::new();
+    // Fills as in the SVG: each region filled and stroked with its grey, half a pixel wide.
+    content.set_line_width(0.5 * POINTS_PER_PIXEL);
+    content.set_line_join(pdf_writer::types::LineJoinStyle::RoundJoin);
     for region in drawing.fills.iter().flat_map(|f| &f.regions) {
         content.set_fill_gray(region.grey as f32);
+        content.set_stroke_gray(region.grey as f32);
         for ring in &region.loops {
             for (i, q) in ring.iter().enumerate() {
                 let (x, y) = (q.x as f32 * POINTS_PER_PIXEL, h - q.y as f32 * POINTS_PER_PIXEL);
@@ -851,7 +861,7 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden) -> Vec<u8> {
             }
             content.close_path();
         }
-        content.fill_nonzero();
+        content.fill_nonzero_and_stroke();
     }
     content.set_line_cap(pdf_writer::types::LineCapStyle::RoundCap);
     content.set_line_join(pdf_writer::types::LineJoinStyle::RoundJoin);
