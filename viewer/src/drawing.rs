@@ -173,13 +173,9 @@ impl Projection {
         (self.width, self.height)
     }
 
-    /// The mean closeness of the corners (`None` if one is behind the eye).
-    pub(crate) fn closeness_of(&self, corners: &[DVec3]) -> Option<f64> {
-        let mut sum = 0.0;
-        for &c in corners {
-            sum += self.project(c)?.c;
-        }
-        Some(sum / corners.len().max(1) as f64)
+    /// Pixels (x right, y down) and closeness of a world point; `None` behind the eye.
+    pub(crate) fn screen_and_closeness(&self, world: DVec3) -> Option<(DVec2, f64)> {
+        self.project(world).map(|p| (DVec2::new(p.x, p.y), p.c))
     }
 
     /// Pixels (x right, y down) and closeness of a world point; `None` behind the eye.

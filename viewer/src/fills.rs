@@ -258,6 +258,8 @@ struct Drawn {
     part: Option<u32>,
     front: bool,
     screen: [DVec2; 3],
+    /// The corners' closeness (module docs of `drawing`), for the order.
+    closeness: [f64; 3],
     corners: [DVec3; 3],
 }
 
@@ -282,7 +284,12 @@ fn drawn_triangles(
         .map(|(t, tri)| {
             let corners = [0, 1, 2].map(|k| points.get(tri[k] as usize).copied());
             let [Some(a), Some(b), Some(c)] = corners else { return None };
-            let screen = [projection.to_screen(a)?, projection.to_screen(b)?, projection.to_screen(c)?];
+            let projected = [
+                projection.screen_and_closeness(a)?,
+                projection.screen_and_closeness(b)?,
+                projection.screen_and_closeness(c)?,
+            ];
+            let (screen, closeness) = (projected.map(|p| p.0), projected.map(|p| p.1));
             // Twice the signed area with y up: positive is counter-clockwise on the screen.
             let area_up = -(screen[1] - screen[0]).perp_dot(screen[2] - screen[0]);
             if area_up == 0.0 {
@@ -290,7 +297,7 @@ fn drawn_triangles(
             }
             let front = (area_up > 0.0) != mirrored;
             let part = crate::drawing::part_of(model, Some(batch), instance, t);
-            Some(Drawn { part, front, screen, corners: [a, b, c] })
+            Some(Drawn { part, front, screen, closeness, corners: [a, b, c] })
         })
         .collect()
 }
@@ -364,7 +371,6 @@ struct Instance<'a> {
 fn number_patches(
     instances: &mut [Instance],
     mode: Fill,
-    projection: &Projection,
     split: &dyn Fn(usize, usize) -> bool,
 ) -> (Vec<Option<u32>>, Vec<f64>, Vec<Front>) {
     let (mut parts, mut sums, mut fronts) = (Vec::new(), Vec::<(f64, f64)>::new(), Vec::new());
@@ -385,7 +391,7 @@ fn number_patches(
             instance.patch[t] = p;
             if d.front {
                 let area = (d.screen[1] - d.screen[0]).perp_dot(d.screen[2] - d.screen[0]).abs();
-                let cs = d.corners.map(|c| projection.closeness_of(&[c]).unwrap_or(0.0));
+                let cs = d.closeness;
                 sums[p].0 += area * (cs[0] + cs[1] + cs[2]) / 3.0;
                 sums[p].1 += area;
                 fronts.push((p, d.screen, cs));
@@ -421,14 +427,14 @@ pub fn fills(model: &Model, projection: &Projection, mode: Fill) -> Vec<PartFill
         }
         painter_order(means, &fronts, grid)
     };
-    let (mut parts, mut means, fronts) = number_patches(&mut instances, mode, projection, &|_, _| false);
+    let (mut parts, mut means, fronts) = number_patches(&mut instances, mode, &|_, _| false);
     let (mut order, conflicted) = order_of(&means, fronts);
     // Patches in front of each other both ways are cut into screen tiles and ordered again.
     if conflicted.iter().any(|&c| c) {
         let marks: Vec<Vec<bool>> =
             instances.iter().map(|i| i.patch.iter().map(|&p| p != usize::MAX && conflicted[p]).collect()).collect();
         let fronts;
-        (parts, means, fronts) = number_patches(&mut instances, mode, projection, &|k, t| marks[k][t]);
+        (parts, means, fronts) = number_patches(&mut instances, mode, &|k, t| marks[k][t]);
         order = order_of(&means, fronts).0;
     }
     // The outlines of the patches, then the runs of one part.
