@@ -1,9 +1,12 @@
 //! ARCHITECTURE.md against the code: the code map names every workspace member and only paths that
 //! exist, the viewer's pass order is the order the renderer encodes its passes, and the bake's
 //! stage order is `drafter_bake::STAGE_NAMES`. Each test reads the document and the code as they
-//! are, so a change to either that makes the document untrue fails here.
+//! are, so a change to either that makes the document untrue fails here. And the crate graph's
+//! arrows, read from every member's Cargo.toml: stage crates depend on drafter-core only, the CPU
+//! scene and the drawings reach no GPU or window crate, and only the viewer and the CLI name a
+//! window crate.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use drafter_viewer::renderer::PASS_ORDER;
@@ -185,4 +188,162 @@ fn architecture_states_the_bakes_stage_order() {
     named.sort();
     let named: Vec<String> = named.into_iter().map(|(_, w)| w).collect();
     assert_eq!(named, stages, "the stage order of ARCHITECTURE.md's \"Stage order of a bake\"");
+}
+
+/// A workspace member's manifest: its package name and the crates it names, by kind.
+#[derive(Debug)]
+struct Manifest {
+    path: String,
+    /// `[dependencies]` and `[build-dependencies]`, target-specific ones included: name → optional.
+    normal: BTreeMap<String, bool>,
+    /// `[dev-dependencies]`, target-specific ones included.
+    dev: BTreeSet<String>,
+    /// `[features]`: feature → what it enables.
+    features: BTreeMap<String, Vec<String>>,
+}
+
+/// The names of a dependency table, each with whether it is optional.
+fn dependency_names(table: Option<&toml::Value>) -> Vec<(String, bool)> {
+    let Some(table) = table.and_then(toml::Value::as_table) else { return Vec::new() };
+    table
+        .iter()
+        .map(|(key, spec)| {
+            // `foo = { package = "bar" }` depends on bar.
+            let name = spec.get("package").and_then(toml::Value::as_str).unwrap_or(key).to_string();
+            let optional = spec.get("optional").and_then(toml::Value::as_bool).unwrap_or(false);
+            (name, optional)
+        })
+        .collect()
+}
+
+/// Every workspace member's manifest, by package name.
+fn manifests() -> BTreeMap<String, Manifest> {
+    let mut out = BTreeMap::new();
+    for member in workspace_members() {
+        let text = read(&format!("{member}/Cargo.toml"));
+        let doc: toml::Value = toml::from_str(&text).unwrap_or_else(|e| panic!("{member}/Cargo.toml: {e}"));
+        let name = doc
+            .get("package")
+            .and_then(|p| p.get("name"))
+            .and_then(toml::Value::as_str)
+            .unwrap_or_else(|| panic!("{member}/Cargo.toml has no package name"))
+            .to_string();
+        let mut tables = vec![doc.clone()];
+        if let Some(targets) = doc.get("target").and_then(toml::Value::as_table) {
+            tables.extend(targets.values().cloned());
+        }
+        let mut normal = BTreeMap::new();
+        let mut dev = BTreeSet::new();
+        for table in &tables {
+            for kind in ["dependencies", "build-dependencies"] {
+                for (dep, optional) in dependency_names(table.get(kind)) {
+                    normal.insert(dep, optional);
+                }
+            }
+            dev.extend(dependency_names(table.get("dev-dependencies")).into_iter().map(|(d, _)| d));
+        }
+        let features = doc
+            .get("features")
+            .and_then(toml::Value::as_table)
+            .map(|f| {
+                f.iter()
+                    .map(|(k, v)| {
+                        let list =
+                            v.as_array().map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_string)).collect());
+                        (k.clone(), list.unwrap_or_default())
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        out.insert(name, Manifest { path: member, normal, dev, features });
+    }
+    out
+}
+
+/// The stage crates: each a function of plain data over drafter-core's scene.
+const STAGE_CRATES: [&str; 5] =
+    ["drafter-segment", "drafter-bounds", "drafter-normals", "drafter-lines", "drafter-textures"];
+
+/// The GPU crates, and the window side of the viewer (the event loop and the egui panel).
+const GPU_CRATES: [&str; 1] = ["wgpu"];
+const WINDOW_CRATES: [&str; 4] = ["winit", "egui", "egui-winit", "egui-wgpu"];
+
+/// Every crate `root` depends on through workspace crates' normal dependencies (its own
+/// dev-dependencies included: `cargo tree` shows them too), with the workspace crate that names
+/// each first.
+fn reached(root: &str, manifests: &BTreeMap<String, Manifest>) -> BTreeMap<String, String> {
+    let mut seen: BTreeMap<String, String> = BTreeMap::new();
+    let first = &manifests[root];
+    let mut stack: Vec<(String, String)> =
+        first.normal.keys().chain(&first.dev).map(|d| (d.clone(), root.to_string())).collect();
+    while let Some((name, via)) = stack.pop() {
+        if seen.contains_key(&name) {
+            continue;
+        }
+        seen.insert(name.clone(), via);
+        if let Some(m) = manifests.get(&name) {
+            stack.extend(m.normal.keys().map(|d| (d.clone(), name.clone())));
+        }
+    }
+    seen
+}
+
+#[test]
+fn stage_crates_depend_on_drafter_core_only() {
+    let manifests = manifests();
+    for stage in STAGE_CRATES {
+        let manifest = manifests.get(stage).unwrap_or_else(|| panic!("stage crate {stage} is not a workspace member"));
+        let workspace: Vec<&String> =
+            manifest.normal.keys().filter(|d| manifests.contains_key(d.as_str()) && *d != "drafter-core").collect();
+        assert!(
+            workspace.is_empty(),
+            "{} depends on workspace crates {workspace:?}: a stage crate depends on drafter-core only",
+            manifest.path
+        );
+    }
+}
+
+#[test]
+fn the_scene_and_the_drawings_reach_no_gpu_or_window_crate() {
+    let manifests = manifests();
+    for root in ["drafter-scene", "drafter-draw"] {
+        assert!(manifests.contains_key(root), "{root} is not a workspace member");
+        let reached = reached(root, &manifests);
+        for forbidden in GPU_CRATES.iter().chain(&WINDOW_CRATES) {
+            if let Some(via) = reached.get(*forbidden) {
+                panic!("{root} depends on {forbidden} (named by {via}): it must build without GPU or window code");
+            }
+        }
+    }
+}
+
+#[test]
+fn only_the_viewer_and_the_cli_name_window_crates() {
+    let manifests = manifests();
+    for (name, manifest) in &manifests {
+        for window in WINDOW_CRATES {
+            let Some(&optional) = manifest.normal.get(window) else { continue };
+            match name.as_str() {
+                "drafter-cli" => {}
+                // The viewer's window side is behind its `native` feature, which the browser build
+                // leaves out.
+                "drafter-viewer" => {
+                    let native = manifest.features.get("native").cloned().unwrap_or_default();
+                    assert!(
+                        optional && native.contains(&format!("dep:{window}")),
+                        "viewer/Cargo.toml: {window} must be optional and enabled by the `native` feature only"
+                    );
+                }
+                _ => panic!("{} depends on {window}: only the viewer's window side and the CLI may", manifest.path),
+            }
+        }
+        assert!(
+            !manifest
+                .dev
+                .iter()
+                .any(|d| WINDOW_CRATES.contains(&d.as_str()) && name != "drafter-viewer" && name != "drafter-cli"),
+            "{} names a window crate",
+            manifest.path
+        );
+    }
 }

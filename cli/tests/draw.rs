@@ -2,7 +2,7 @@
 //! lines) and PDF (pdfinfo) of the baked sample with its hidden lines in a group of
 //! their own; a model without baked edges gives its outline only, never an error; bad input and bad
 //! options end with exit 2, one line, and no output file. The exactness of the hidden lines is
-//! `viewer/tests/drawing.rs` (brute force).
+//! `crates/drafter-draw/tests/visibility.rs` (brute force).
 
 mod common;
 

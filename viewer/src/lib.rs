@@ -42,28 +42,27 @@
 //!
 //! # Platforms
 //! The default feature `native` adds the desktop side: [`window`] and [`panel`] (winit, egui),
-//! blocking device requests ([`Gpu::headless`], [`Renderer::new`]) and [`drawing`] (SVG and PDF).
+//! blocking device requests ([`Gpu::headless`], [`Renderer::new`]).
 //! Without it the crate is the renderer alone and builds for `wasm32-unknown-unknown` (the browser
 //! page in `web/`, WebGPU or WebGL2): the same passes and WGSL, the device requested
 //! asynchronously with [`Gpu::request`], frames recorded with [`Renderer::encode_frame`].
+//!
+//! # The CPU side
+//! What a frame is made of on the CPU (the [`Model`], the [`Camera`] fit, the baked edges and the
+//! silhouette query, the lookup textures, the styles and the view) lives in drafter-scene,
+//! re-exported here as [`model`], [`camera`], [`edges`] and [`lookups`] (the styles and the view
+//! in [`style`], beside the frame's options). The vector drawings (`drafter draw`) are
+//! drafter-draw, which reads the same model without wgpu.
 //!
 //! Invariant: the viewer renders what drafter-io and drafter-format read; it never runs a bake
 //! stage. A file without `DRAFTER_illustration` data renders with one part per instance and a
 //! bounding-box projector, and [`Model::notices`] says so.
 
-pub mod camera;
 pub mod context;
 pub mod controls;
-#[cfg(feature = "native")]
-pub mod drawing;
-pub mod edges;
 pub mod edit;
-#[cfg(feature = "native")]
-pub mod fills;
 pub mod gpu_types;
 pub mod image;
-pub mod lookups;
-pub mod model;
 #[cfg(feature = "native")]
 pub mod panel;
 pub mod passes;
@@ -74,6 +73,8 @@ pub mod table;
 pub mod targets;
 #[cfg(feature = "native")]
 pub mod window;
+
+pub use drafter_scene::{camera, edges, lookups, model};
 
 pub use camera::Camera;
 pub use context::{Gpu, RenderError};

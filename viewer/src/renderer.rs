@@ -23,6 +23,8 @@ use crate::passes::upscale::UpscalePass;
 use crate::scene::SceneGpu;
 use crate::style::{HATCH_SHARPNESS, RenderOptions, SPLASH_BACK_ALPHA, SPLASH_BACK_BETA, ShadowMode};
 use crate::targets::{SHADOW_REDUCTION, Target, Targets};
+/// Where a camera looks from, in world space (drafter-scene's, re-exported for the renderer's users).
+pub use drafter_scene::camera::world_view;
 
 /// A model on the GPU with what the camera fit needs.
 #[derive(Debug)]
@@ -521,16 +523,6 @@ impl Renderer {
         self.gpu.queue.submit([encoder.finish()]);
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Gpu(e.to_string()))?;
         Ok(start.elapsed())
-    }
-}
-
-/// Where `camera` looks from, in world space (the render space's `origin` added back in f64).
-pub fn world_view(camera: &Camera, origin: glam::DVec3) -> crate::edges::WorldView {
-    if camera.orthographic {
-        let direction = camera.view_from_render.inverse().transform_vector3(Vec3::NEG_Z);
-        crate::edges::WorldView::Orthographic { direction: direction.as_dvec3() }
-    } else {
-        crate::edges::WorldView::Perspective { eye: camera.position_in_render.as_dvec3() + origin }
     }
 }
 

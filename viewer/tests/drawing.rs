@@ -1,123 +1,11 @@
-//! Line drawings (`drafter_viewer::drawing`, issue 45): the hidden parts of every edge against brute
-//! force. Each sampled point of an edge is ray-cast from the eye (or along the view direction)
-//! against every triangle of the scene in world space (Möller–Trumbore in f64, an independent
-//! formulation: no projection, no BVH, no interval clipping); the drawing must say the same thing
-//! wherever the point lies farther than the tolerance from one of its change points. On the sample
-//! assembly, fandisk and RodAssembly (29 instances), in perspective and orthographic views.
+//! Line drawings (drafter-draw) against the renderer: the visible black lines against the raster
+//! lines pass, and the part fills against the renderer's part ids, at the same view and size. The
+//! drawing's own tests (brute-force visibility, SVG) are in `crates/drafter-draw/tests/`.
 
 mod common;
 
-use drafter_viewer::Model;
-use drafter_viewer::View;
-use drafter_viewer::drawing::brute::{blocked, world_triangles};
-use drafter_viewer::drawing::{self, DrawOptions, Hidden};
-use drafter_viewer::edges::{LineClass, WorldView};
-use glam::DVec2;
-
-/// Samples `per_edge` points on every `stride`-th edge and counts disagreements with brute force
-/// beyond `tolerance_px` of a change point. Returns (samples compared, disagreements, hidden
-/// samples).
-fn check(model: &Model, options: &DrawOptions, stride: usize, per_edge: usize) -> (usize, usize, usize) {
-    let triangles = world_triangles(model);
-    let vis = drawing::visibility(model, options);
-    let viewer = vis.projection.view();
-    let diagonal = model.bounds.max.distance(model.bounds.min).max(1e-9);
-    let (mut compared, mut wrong, mut hidden_count) = (0, 0, 0);
-    let mut first_wrong = None;
-    for edge in vis.edges.iter().step_by(stride) {
-        let [a2, b2] = edge.screen;
-        let length = a2.distance(b2);
-        if length < 1.0 {
-            continue;
-        }
-        for k in 0..per_edge {
-            // A point of the 3D edge, and where it falls on the projected one.
-            let s = (k as f64 + 0.5) / per_edge as f64;
-            let point = edge.a + (edge.b - edge.a) * s;
-            let screen: DVec2 = vis.projection.to_screen(point).expect("in front of the eye");
-            let u = (screen - a2).dot(b2 - a2) / (length * length);
-            let near_change = edge.hidden.iter().any(|&(lo, hi)| {
-                ((u - lo).abs() * length) < options.tolerance_px || ((u - hi).abs() * length) < options.tolerance_px
-            });
-            if near_change || u * length < options.tolerance_px || (1.0 - u) * length < options.tolerance_px {
-                continue;
-            }
-            let drawn_hidden = edge.hidden.iter().any(|&(lo, hi)| u > lo && u < hi);
-            let towards = match viewer {
-                WorldView::Perspective { eye } => eye,
-                // The direction the camera looks along (`renderer::world_view`): the viewer is
-                // behind it.
-                WorldView::Orthographic { direction } => point - direction.normalize() * (10.0 * diagonal),
-            };
-            let brute_hidden = blocked(point, towards, &triangles);
-            compared += 1;
-            hidden_count += usize::from(brute_hidden);
-            if brute_hidden != drawn_hidden {
-                wrong += 1;
-                first_wrong.get_or_insert((edge.class, u, length, brute_hidden, edge.hidden.clone()));
-            }
-        }
-    }
-    if let Some(w) = first_wrong {
-        eprintln!("first disagreement: {w:?}");
-    }
-    (compared, wrong, hidden_count)
-}
-
-fn options(view: (f32, f32), orthographic: bool) -> DrawOptions {
-    DrawOptions {
-        size: (800, 600),
-        view: View { azimuth_deg: view.0, elevation_deg: view.1 },
-        orthographic,
-        hidden: Hidden::Dashed,
-        ..DrawOptions::default()
-    }
-}
-
-fn check_model(name: &str, model: &Model, stride: usize) {
-    for (view, orthographic) in [((35.0, 25.0), false), ((-120.0, 40.0), true), ((200.0, -20.0), false)] {
-        let (compared, wrong, hidden) = check(model, &options(view, orthographic), stride, 7);
-        eprintln!("{name} view {view:?} ortho {orthographic}: {compared} samples, {hidden} hidden, {wrong} wrong");
-        assert!(compared > 500, "{name}: enough samples ({compared})");
-        assert!(hidden > compared / 20, "{name}: the view hides something ({hidden} of {compared})");
-        assert_eq!(wrong, 0, "{name} {view:?} ortho {orthographic}: {wrong} of {compared} samples misclassified");
-    }
-}
-
-#[test]
-fn hidden_lines_match_brute_force_on_the_sample() {
-    check_model("sample", &common::sample(), 4);
-}
-
-#[test]
-fn hidden_lines_match_brute_force_on_fandisk() {
-    check_model("fandisk", &common::baked(&common::corpus_path("obj/common-3d-test-models/fandisk.obj")), 2);
-}
-
-#[test]
-fn hidden_lines_match_brute_force_on_a_cad_assembly() {
-    check_model("RodAssembly", &common::baked(&common::corpus_path("gltf/RodAssembly/rod.glb")), 40);
-}
-
-/// The drawing is made of chained polylines, grouped by visibility and class, and deterministic.
-#[test]
-fn the_svg_groups_classes_and_chains_pieces() {
-    let model = common::sample();
-    let options = options((35.0, 25.0), false);
-    let drawing = drawing::draw(&model, &options);
-    let pieces: usize = drawing.strokes.iter().map(|s| s.points.len() - 1).sum();
-    assert!(drawing.strokes.len() * 3 < pieces * 2, "chained: {} strokes for {pieces} pieces", drawing.strokes.len());
-    let svg = drawing::to_svg(&drawing, options.hidden);
-    for needle in
-        [r#"<g id="visible""#, r#"<g id="hidden""#, r#"class="silhouette""#, r#"class="crease""#, "stroke-dasharray"]
-    {
-        assert!(svg.contains(needle), "{needle}");
-    }
-    assert!(svg.contains(r#"class="part-"#), "paths name their parts");
-    assert_eq!(svg, drawing::to_svg(&drawing::draw(&model, &options), options.hidden), "deterministic");
-    let none = drawing::to_svg(&drawing::draw(&model, &DrawOptions { hidden: Hidden::None, ..options }), Hidden::None);
-    assert!(!none.contains(r#"<g id="hidden""#));
-}
+use drafter_draw::{self as drawing, DrawOptions, Hidden};
+use drafter_viewer::edges::LineClass;
 
 /// The drawing's visible black lines (silhouettes, boundaries, part borders) against the raster
 /// lines pass of `drafter render --lines` in the Gooch style (black lines over cool-to-warm shading,
@@ -202,50 +90,6 @@ fn rasterise(drawing: &drawing::Drawing, (w, h): (usize, usize), keep: impl Fn(L
         }
     }
     mask
-}
-
-/// A 126-sided cylinder seen so that two of its faces are exactly edge-on (found against
-/// OpenCascade's hidden-line removal, docs/drawing.md): the outline is still drawn, on both sides,
-/// and from a view a hair away the same.
-#[test]
-fn a_cylinder_with_faces_edge_on_keeps_its_outline() {
-    let dir = std::env::temp_dir().join(format!("drafter-drawing-cylinder-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("scratch folder");
-    let n = 126;
-    let mut obj = String::new();
-    for k in 0..n {
-        // Columns half a step off the axes: the faces' normals fall on them, two exactly along x.
-        let angle = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
-        let (x, z) = (angle.cos(), angle.sin());
-        obj += &format!("v {x} 0 {z}\nv {x} 3 {z}\n");
-    }
-    obj += "v 0 0 0\nv 0 3 0\n";
-    for k in 0..n {
-        let (a, b) = (2 * k + 1, 2 * ((k + 1) % n) + 1);
-        obj += &format!("f {a} {b} {}\nf {a} {} {}\n", b + 1, b + 1, a + 1);
-        obj += &format!("f {} {b} {a}\nf {} {} {}\n", 2 * n + 1, 2 * n + 2, a + 1, b + 1);
-    }
-    let path = dir.join("cylinder.obj");
-    std::fs::write(&path, obj).expect("write");
-    let model = common::baked(&path);
-    for azimuth in [0.0, 0.001] {
-        let options = DrawOptions {
-            view: View { azimuth_deg: azimuth, elevation_deg: 30.0 },
-            orthographic: true,
-            ..DrawOptions::default()
-        };
-        let drawing = drawing::draw(&model, &options);
-        let outline: f64 = drawing
-            .strokes
-            .iter()
-            .filter(|s| s.visible && s.class == LineClass::Silhouette)
-            .flat_map(|s| s.points.windows(2).map(|p| p[0].distance(p[1])))
-            .sum();
-        assert!(drawing.stats.silhouettes >= 2, "azimuth {azimuth}: {} silhouettes", drawing.stats.silhouettes);
-        // Two sides of the cylinder's height, each several hundred pixels long on an 800 x 600 view.
-        assert!(outline > 600.0, "azimuth {azimuth}: {outline:.0} px of visible outline");
-    }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The parts' fills rasterised in painter's order (scanlines through pixel centres, nonzero

@@ -9,7 +9,7 @@
 //! size is reported per tolerance.
 //!
 //! Brute force, side by side: points on the view's edges ray-cast from the eye against every
-//! triangle of the scene in world space (Möller–Trumbore in f64, as `viewer/tests/drawing.rs`
+//! triangle of the scene in world space (Möller–Trumbore in f64, as `crates/drafter-draw/tests/visibility.rs`
 //! checks the drawing). Timing every pixel of every edge that way would take minutes to hours on a
 //! large model, so `--brute-samples` points spread over the edges are timed and the time per point
 //! is multiplied by the drawing's edge length in pixels (one point per pixel): the printed brute
@@ -18,10 +18,10 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use drafter_viewer::View;
-use drafter_viewer::drawing::brute::{blocked, world_triangles};
-use drafter_viewer::drawing::{self, DrawOptions, Drawing, Hidden};
-use drafter_viewer::edges::WorldView;
+use drafter_draw::brute::{blocked, world_triangles};
+use drafter_draw::{self as drawing, DrawOptions, Drawing, Hidden};
+use drafter_scene::View;
+use drafter_scene::edges::WorldView;
 use glam::DVec2;
 use serde::Serialize;
 

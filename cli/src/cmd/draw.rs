@@ -1,13 +1,13 @@
 //! `drafter draw FILE -o view.svg|view.pdf [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
 //! [--fill none|flat|bands] [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
-//! (`drafter_viewer::drawing`): the baked hard edges and the view's silhouettes, split where they
+//! (drafter-draw, which reads drafter-scene's model and links no GPU code): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
-use drafter_viewer::View;
-use drafter_viewer::drawing::{self, DrawOptions, Fill, Hidden};
+use drafter_draw::{self as drawing, DrawOptions, Fill, Hidden};
+use drafter_scene::{LoadError, Model, View};
 
 use crate::cmd::out;
 use crate::cmd::render::{parse_size, parse_view};
@@ -85,6 +85,15 @@ impl From<HiddenArg> for Hidden {
     }
 }
 
+/// Reads the model to draw (import errors keep their exit code; a file that loads but cannot be
+/// drawn is bad input).
+fn load(path: &std::path::Path, max_triangles: u64) -> Result<Model> {
+    Model::load_within(path, &drafter_io::Limits { max_triangles }).map_err(|e| match e {
+        LoadError::Import(e) => anyhow::Error::from(e),
+        other => anyhow::Error::from(BadInput(other.to_string())),
+    })
+}
+
 pub fn run(args: Args) -> Result<()> {
     let extension = args.output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let pdf = match extension.as_deref() {
@@ -105,7 +114,7 @@ pub fn run(args: Args) -> Result<()> {
     if !(view.elevation_deg > -90.0 && view.elevation_deg < 90.0 && view.azimuth_deg.is_finite()) {
         return Err(BadInput(format!("--view {},{}: elevation must be in (-90, 90)", args.view.0, args.view.1)).into());
     }
-    let model = crate::cmd::render::load(&args.file, args.max_triangles)?;
+    let model = load(&args.file, args.max_triangles)?;
     let options = DrawOptions {
         size: args.size,
         view,

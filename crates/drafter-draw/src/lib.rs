@@ -1,7 +1,10 @@
-//! Vector line drawings with exact hidden lines (`drafter draw`, issue 45).
+//! drafter-draw: vector line drawings with exact hidden lines (`drafter draw`), as SVG or PDF.
+//!
+//! It reads drafter-scene's CPU model (the same [`Model`], camera fit and baked edges the wgpu
+//! viewer draws) and links no GPU code.
 //!
 //! # What is drawn
-//! The lines the raster lines pass draws ([`crate::edges`]): every hard edge of the file (crease,
+//! The lines the raster lines pass draws ([`drafter_scene::edges`]): every hard edge of the file (crease,
 //! boundary, part border, non-manifold) and this view's silhouettes among the file's candidates,
 //! decided from face normals computed in f64 from the positions (the stored normals are rounded),
 //! under the camera `drafter render --lines` uses ([`Camera::fit`] on
@@ -30,17 +33,21 @@
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
+use drafter_core::{EDGE_NONE, Topology, Weld};
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
 use rayon::prelude::*;
 
-use crate::camera::Camera;
-use crate::edges::LineClass;
+use drafter_scene::camera::Camera;
+use drafter_scene::edges::LineClass;
+use drafter_scene::model::Model;
+use drafter_scene::style::{DEFAULT_FOV_Y_DEG, View};
+
+pub mod fills;
+
 pub use crate::fills::{Fill, PartFill};
-use crate::model::Model;
-use crate::style::{DEFAULT_FOV_Y_DEG, View};
 
 /// What a drawing shows of the lines hidden by surfaces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,7 +142,7 @@ struct Projected {
 pub struct Projection {
     clip_from_render: DMat4,
     /// Where the camera looks from, as the raster lines pass queries silhouettes.
-    view: crate::edges::WorldView,
+    view: drafter_scene::edges::WorldView,
     origin: DVec3,
     orthographic: bool,
     width: f64,
@@ -150,7 +157,7 @@ impl Projection {
         let camera = Camera::fit(&model.frame_points, options.view, aspect, options.orthographic, options.fov_y_deg);
         Projection {
             clip_from_render: camera.clip_from_render().as_dmat4(),
-            view: crate::renderer::world_view(&camera, model.origin),
+            view: drafter_scene::camera::world_view(&camera, model.origin),
             origin: model.origin,
             orthographic: options.orthographic,
             width: f64::from(w),
@@ -159,7 +166,7 @@ impl Projection {
     }
 
     /// Where the camera looks from, as the silhouette query takes it.
-    pub fn view(&self) -> crate::edges::WorldView {
+    pub fn view(&self) -> drafter_scene::edges::WorldView {
         self.view
     }
 
@@ -225,83 +232,58 @@ fn world_triangles(model: &Model) -> Triangles {
     Triangles { corners }
 }
 
-/// An edge by the bits of its two end points, in either order.
-type EdgeKey = ([u32; 3], [u32; 3]);
-
-fn edge_key(a: Vec3, b: Vec3) -> EdgeKey {
-    let (ka, kb) = (a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits));
-    if ka <= kb { (ka, kb) } else { (kb, ka) }
+/// The welded connectivity of the mesh an instance draws ([`Topology`], welded exactly: the hard
+/// edges' and candidates' end points are the file's `f32`s) and the normal of each of its faces.
+struct MeshFaces {
+    topology: Topology,
+    /// Per triangle, its normal (f64, unnormalised) from the file's positions.
+    normals: Vec<DVec3>,
 }
 
-/// The normals (f64, unnormalised) of the first two faces met at an edge, and how many faces meet
-/// there.
-#[derive(Clone, Copy, Debug, Default)]
-struct EdgeFaces {
-    normals: [DVec3; 2],
-    count: u32,
-}
-
-impl EdgeFaces {
-    /// The two faces of a manifold edge.
-    fn pair(&self) -> Option<[DVec3; 2]> {
-        (self.count == 2).then_some(self.normals)
-    }
-}
-
-/// A multiplicative hash of the position bits (FxHash's step): the map below is built over every
-/// edge of a mesh, where SipHash cost several times the rest of a drawing of the dragon.
-#[derive(Default)]
-struct EdgeHasher(u64);
-
-impl std::hash::Hasher for EdgeHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u32(u32::from(b));
-        }
-    }
-    fn write_u32(&mut self, x: u32) {
-        self.0 = (self.0.rotate_left(5) ^ u64::from(x)).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-}
-
-type EdgeMap = HashMap<EdgeKey, EdgeFaces, std::hash::BuildHasherDefault<EdgeHasher>>;
-
-/// The object-space normals of the faces at each edge of the mesh drawn by `instance` (the batch's
-/// triangles, whose positions are the file's: the hard edges' and candidates' end points are the
-/// same `f32`s).
-fn mesh_edge_faces(model: &Model, instance: u32) -> EdgeMap {
-    let mut faces = EdgeMap::default();
-    let Some(batch) = batch_of(model, instance) else { return faces };
-    faces.reserve(batch.indices.len() / 2 + 16);
-    for t in batch.indices.chunks_exact(3) {
-        let (Some(p0), Some(p1), Some(p2)) =
-            (batch.vertices.get(t[0] as usize), batch.vertices.get(t[1] as usize), batch.vertices.get(t[2] as usize))
-        else {
-            continue;
+impl MeshFaces {
+    /// The faces of the batch that draws `instance` (the mesh's triangles in its order).
+    fn of_instance(model: &Model, instance: u32) -> MeshFaces {
+        let Some(batch) = batch_of(model, instance) else {
+            return MeshFaces { topology: Topology::default(), normals: Vec::new() };
         };
-        let p = [p0, p1, p2].map(|v| Vec3::from_array(v.position_in_object));
-        let normal = (p[1].as_dvec3() - p[0].as_dvec3()).cross(p[2].as_dvec3() - p[0].as_dvec3());
-        for k in 0..3 {
-            let entry = faces.entry(edge_key(p[k], p[(k + 1) % 3])).or_default();
-            if entry.count < 2 {
-                entry.normals[entry.count as usize] = normal;
-            }
-            entry.count += 1;
+        let positions: Vec<Vec3> = batch.vertices.iter().map(|v| Vec3::from_array(v.position_in_object)).collect();
+        let triangles: Vec<[u32; 3]> = batch.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let normals = triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| positions[v as usize].as_dvec3());
+                (p[1] - p[0]).cross(p[2] - p[0])
+            })
+            .collect();
+        MeshFaces { topology: Topology::from_triangles(&positions, &triangles, Weld::Exact), normals }
+    }
+
+    /// The normals of the two faces at the edge of corner `3·t + k` (v_k → v_(k+1) of triangle t),
+    /// when exactly two faces meet there, in triangle order.
+    fn pair(&self, corner: u32) -> Option<[DVec3; 2]> {
+        let edge = *self.topology.face_edges.get(corner as usize / 3)?.get(corner as usize % 3)?;
+        if edge == EDGE_NONE {
+            return None;
+        }
+        match *self.topology.faces_of_edge(edge as usize) {
+            [f, g] => Some([*self.normals.get(f as usize)?, *self.normals.get(g as usize)?]),
+            _ => None,
         }
     }
-    faces
 }
 
 /// The batch that draws `instance` (looked up once per instance, not per edge).
-fn batch_of(model: &Model, instance: u32) -> Option<&crate::model::Batch> {
+fn batch_of(model: &Model, instance: u32) -> Option<&drafter_scene::model::Batch> {
     model.batches.iter().find(|b| b.instances.contains(&instance))
 }
 
 /// The part of mesh triangle `t` drawn by `instance` through `batch`.
-pub(crate) fn part_of(model: &Model, batch: Option<&crate::model::Batch>, instance: u32, t: usize) -> Option<u32> {
+pub(crate) fn part_of(
+    model: &Model,
+    batch: Option<&drafter_scene::model::Batch>,
+    instance: u32,
+    t: usize,
+) -> Option<u32> {
     let batch = batch?;
     let v = *batch.indices.get(3 * t)? as usize;
     let label = batch.vertices.get(v)?.label;
@@ -316,8 +298,8 @@ pub(crate) fn part_of(model: &Model, batch: Option<&crate::model::Batch>, instan
 /// view's silhouettes, in world space.
 fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
     let mut edges = Vec::new();
-    let faces_of: Vec<EdgeMap> =
-        model.lines.meshes.par_iter().map(|mesh| mesh_edge_faces(model, mesh.instances.start)).collect();
+    let faces_of: Vec<MeshFaces> =
+        model.lines.meshes.par_iter().map(|mesh| MeshFaces::of_instance(model, mesh.instances.start)).collect();
     for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
@@ -325,18 +307,19 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
             let object_from_world =
                 model.lines.object_from_world.get(instance as usize).copied().unwrap_or(DMat4::IDENTITY);
             for (k, &([a, b], class)) in mesh.hard.iter().enumerate() {
-                let part = mesh.hard_triangles.get(k).and_then(|&t| part_of(model, batch, instance, t as usize));
+                let corner = mesh.hard_corners.get(k).copied();
+                let part = corner.and_then(|c| part_of(model, batch, instance, (c / 3) as usize));
                 // A crease whose faces turn opposite ways to the viewer lies on the contour: drawn
                 // as a silhouette, as the raster lines pass draws a crease across which the depth
                 // jumps (Gooch et al. 1999 draw every silhouette black and heavy).
-                let class = match (class, faces.get(&edge_key(a, b)).and_then(EdgeFaces::pair)) {
+                let class = match (class, corner.and_then(|c| faces.pair(c))) {
                     (LineClass::Crease, Some(normals)) => {
                         let middle = (a.as_dvec3() + b.as_dvec3()) * 0.5;
                         let towards = match projection.view {
-                            crate::edges::WorldView::Perspective { eye } => {
+                            drafter_scene::edges::WorldView::Perspective { eye } => {
                                 object_from_world.transform_point3(eye) - middle
                             }
-                            crate::edges::WorldView::Orthographic { direction } => {
+                            drafter_scene::edges::WorldView::Orthographic { direction } => {
                                 object_from_world.transform_vector3(direction)
                             }
                         };
@@ -366,8 +349,7 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
     let mut silhouettes = 0;
     for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
         let Some(candidates) = &mesh.silhouettes else { continue };
-        let normals: Vec<Option<[DVec3; 2]>> =
-            candidates.segments.iter().map(|&[a, b]| faces.get(&edge_key(a, b)).and_then(EdgeFaces::pair)).collect();
+        let normals: Vec<Option<[DVec3; 2]>> = candidates.corners.iter().map(|&c| faces.pair(c)).collect();
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
             let batch = batch_of(model, instance);
@@ -376,10 +358,10 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
             for (k, (&[a, b], n)) in candidates.segments.iter().zip(&normals).enumerate() {
                 let Some([n1, n2]) = n else { continue };
                 let towards = match projection.view {
-                    crate::edges::WorldView::Perspective { eye } => {
+                    drafter_scene::edges::WorldView::Perspective { eye } => {
                         object_from_world.transform_point3(eye) - a.as_dvec3()
                     }
-                    crate::edges::WorldView::Orthographic { direction } => {
+                    drafter_scene::edges::WorldView::Orthographic { direction } => {
                         object_from_world.transform_vector3(direction)
                     }
                 };
@@ -902,14 +884,14 @@ fn coordinate(v: f64) -> String {
     if text == "-0" { "0".to_string() } else { text.to_string() }
 }
 
-/// Brute force, the reference the drawing is checked and timed against (`viewer/tests/drawing.rs`,
+/// Brute force, the reference the drawing is checked and timed against (`tests/visibility.rs`,
 /// `drafter bench draw`): a point is hidden when any triangle of the scene crosses the segment from
 /// it to the eye, tested triangle by triangle in world space (Möller–Trumbore in f64). Independent
 /// of the drawing's method: no projection, no BVH, no interval clipping.
 pub mod brute {
     use glam::{DVec3, Vec3};
 
-    use crate::model::Model;
+    use drafter_scene::model::Model;
 
     /// Every triangle of `model` in world space.
     pub fn world_triangles(model: &Model) -> Vec<[DVec3; 3]> {

@@ -296,6 +296,16 @@ pub fn hull_sample(points: &[Vec3]) -> Vec<usize> {
     support_points(points, &sphere_directions(SUPPORT_DIRECTIONS))
 }
 
+/// Where `camera` looks from, in world space (the render space's `origin` added back in f64).
+pub fn world_view(camera: &Camera, origin: glam::DVec3) -> crate::edges::WorldView {
+    if camera.orthographic {
+        let direction = camera.view_from_render.inverse().transform_vector3(Vec3::NEG_Z);
+        crate::edges::WorldView::Orthographic { direction: direction.as_dvec3() }
+    } else {
+        crate::edges::WorldView::Perspective { eye: camera.position_in_render.as_dvec3() + origin }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

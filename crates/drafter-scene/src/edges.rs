@@ -38,7 +38,7 @@ use drafter_lines::{
 };
 use glam::{DMat4, DVec3, Vec3};
 
-use crate::gpu_types::LineSegmentGpu;
+use crate::layout::LineSegmentGpu;
 
 /// Class of a drawn line (`lines.wgsl`: `CLASS_*`). Codes 1–4 are the file's `hardEdgeClasses`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -83,8 +83,9 @@ pub struct MeshLines {
     pub instances: Range<u32>,
     /// Hard edges: object-space endpoints and class.
     pub hard: Vec<([Vec3; 2], LineClass)>,
-    /// The mesh triangle each hard edge was read from (its part, for drawings).
-    pub hard_triangles: Vec<u32>,
+    /// The corner `3·t + k` each hard edge was read from (edge v_k → v_(k+1) of mesh triangle t):
+    /// for drawings, its triangle's part and, through the mesh's topology, its two faces.
+    pub hard_corners: Vec<u32>,
     pub silhouettes: Option<MeshSilhouetteLines>,
 }
 
@@ -160,7 +161,7 @@ impl ModelLines {
                 mesh.positions.get(tri[k % 3] as usize).copied()
             };
             let mut hard = Vec::new();
-            let mut hard_triangles = Vec::new();
+            let mut hard_corners = Vec::new();
             for (_, p, edges) in baked.primitive_edges.iter().filter(|(mm, _, _)| *mm as usize == m) {
                 let Some(group) = mesh.groups.iter().find(|g| g.primitive == Some(*p)) else {
                     bad_slots += 1;
@@ -176,7 +177,7 @@ impl ModelLines {
                     match (position(t, k), position(t, k + 1)) {
                         (Some(a), Some(b)) => {
                             hard.push(([a, b], LineClass::from_hard_code(class)));
-                            hard_triangles.push(t as u32);
+                            hard_corners.push((3 * t + k) as u32);
                         }
                         _ => bad_slots += 1,
                     }
@@ -190,7 +191,7 @@ impl ModelLines {
             if hard.is_empty() && silhouettes.is_none() {
                 continue;
             }
-            meshes.push(MeshLines { mesh: m as u32, instances, hard, hard_triangles, silhouettes });
+            meshes.push(MeshLines { mesh: m as u32, instances, hard, hard_corners, silhouettes });
         }
         if bad_slots > 0 {
             notices.push(format!("{bad_slots} baked edges do not match the file's triangles: not drawn"));

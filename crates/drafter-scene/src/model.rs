@@ -19,7 +19,7 @@
 //! A baked file carries two normal sets per primitive: the crease-aware `NORMAL` and the enhanced
 //! normals of Cignoni et al. 2005 (`_ENHANCED_NORMAL`; swapped when the bake put the enhanced ones in
 //! `NORMAL`). Both are read ([`drafter_format::read_normal_sets`]) and split with the vertices, so a
-//! batch can be drawn with either ([`crate::RenderOptions::enhanced_normals`]); other files keep their
+//! batch can be drawn with either (the viewer's `RenderOptions::enhanced_normals`); other files keep their
 //! imported normals.
 //!
 //! # Lookup textures
@@ -40,7 +40,7 @@ use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
-use crate::gpu_types::{InstanceGpu, MaterialGpu, NO_STYLE, NOT_FLAT, PartGpu, Vertex};
+use crate::layout::{InstanceGpu, MaterialGpu, NO_STYLE, NOT_FLAT, PartGpu, Vertex};
 use crate::lookups::BakedLookups;
 use crate::style::{Style, transfer_index};
 
@@ -68,7 +68,7 @@ pub struct Batch {
     pub vertices: Vec<Vertex>,
     pub indices: Vec<u32>,
     /// The enhanced normals (Cignoni et al. 2005) of `vertices`, one each, when the file carries them
-    /// (`_ENHANCED_NORMAL`): what [`crate::RenderOptions::enhanced_normals`] draws instead of
+    /// (`_ENHANCED_NORMAL`): what the viewer's `RenderOptions::enhanced_normals` draws instead of
     /// `Vertex::normal_in_object`.
     pub enhanced_normals: Option<Vec<[f32; 3]>>,
     /// Range of [`Model::instances`] that draws this batch.
@@ -377,18 +377,18 @@ impl Model {
     }
 
     /// Marks the selected parts and the reference part for the G-buffer's highlight (see
-    /// [`crate::gpu_types::PART_SELECTED`]).
+    /// [`crate::layout::PART_SELECTED`]).
     pub fn set_selection(&mut self, selected: &[u32], reference: Option<u32>) {
         for part in &mut self.parts {
             part.gpu.flags = 0;
         }
         for &id in selected {
             if let Some(part) = self.parts.get_mut(id as usize) {
-                part.gpu.flags |= crate::gpu_types::PART_SELECTED;
+                part.gpu.flags |= crate::layout::PART_SELECTED;
             }
         }
         if let Some(part) = reference.and_then(|id| self.parts.get_mut(id as usize)) {
-            part.gpu.flags |= crate::gpu_types::PART_SELECTED | crate::gpu_types::PART_REFERENCE;
+            part.gpu.flags |= crate::layout::PART_SELECTED | crate::layout::PART_REFERENCE;
         }
     }
 

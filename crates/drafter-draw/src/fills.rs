@@ -34,8 +34,8 @@ use std::collections::HashMap;
 use drafter_core::gradient::{GradientParams, IntensityTransfer, TransferCurve};
 use glam::{DVec2, DVec3, DVec4, Vec3};
 
-use crate::drawing::Projection;
-use crate::model::Model;
+use crate::Projection;
+use drafter_scene::model::Model;
 
 /// Which fills a drawing has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -59,7 +59,7 @@ pub struct Region {
     pub loops: Vec<Vec<DVec2>>,
 }
 
-/// A part's fill, in painter's order within [`crate::drawing::Drawing::fills`].
+/// A part's fill, in painter's order within [`crate::Drawing::fills`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartFill {
     /// The part (`None`: triangles of no part).
@@ -266,7 +266,7 @@ struct Drawn {
 /// Every triangle of `batch` drawn by `instance` (`None`: behind the eye, or of no screen area).
 fn drawn_triangles(
     model: &Model,
-    batch: &crate::model::Batch,
+    batch: &drafter_scene::model::Batch,
     instance: u32,
     projection: &Projection,
 ) -> Vec<Option<Drawn>> {
@@ -296,7 +296,7 @@ fn drawn_triangles(
                 return None;
             }
             let front = (area_up > 0.0) != mirrored;
-            let part = crate::drawing::part_of(model, Some(batch), instance, t);
+            let part = crate::part_of(model, Some(batch), instance, t);
             Some(Drawn { part, front, screen, closeness, corners: [a, b, c] })
         })
         .collect()
@@ -360,7 +360,7 @@ fn add_to_patch(patch: &mut Patch, d: &Drawn, model: &Model, projection: &Projec
 
 /// One mesh instance's triangles as drawn, and the patch of each (`usize::MAX`: none).
 struct Instance<'a> {
-    batch: &'a crate::model::Batch,
+    batch: &'a drafter_scene::model::Batch,
     drawn: Vec<Option<Drawn>>,
     patch: Vec<usize>,
 }
