@@ -146,6 +146,10 @@ pub struct RenderOptions {
     /// [`INTERACTIVE_SCALE`]; the window and `drafter bench render` take
     /// [`crate::Gpu::interactive_scale`], which is larger on a CPU rasteriser.
     pub interactive_scale: u32,
+    /// Drawn pixels per logical pixel of the widths of lines and image-space edges: the
+    /// browser's `devicePixelRatio`, so that the page's lines keep their width in CSS pixels on a
+    /// high-density screen. Default 1; range [0.25, 8].
+    pub line_scale: f32,
 }
 
 /// Divisor of the resolution of an [`RenderOptions::interactive`] frame on a GPU, in each direction.
@@ -181,6 +185,7 @@ impl Default for RenderOptions {
             enhanced_normals: false,
             interactive: false,
             interactive_scale: INTERACTIVE_SCALE,
+            line_scale: 1.0,
         }
     }
 }
@@ -229,6 +234,9 @@ impl RenderOptions {
         if !self.pan.iter().all(|p| p.is_finite() && p.abs() <= 100.0) {
             return Err(format!("pan {:?}: each component must be finite and within ±100", self.pan));
         }
+        if !(self.line_scale >= 0.25 && self.line_scale <= 8.0) {
+            return Err(format!("line scale {} is out of range [0.25, 8]", self.line_scale));
+        }
         if !(self.hatch_period_px >= 1.0 && self.hatch_period_px <= 256.0) {
             return Err(format!("hatch period {} is out of range [1, 256] pixels", self.hatch_period_px));
         }
@@ -259,6 +267,11 @@ impl RenderOptions {
     pub fn pixel_scale(&self) -> f32 {
         let scale = self.supersample.max(1) as f32;
         if self.interactive { scale / self.interactive_scale.clamp(1, 4) as f32 } else { scale }
+    }
+
+    /// Drawn pixels per pixel of a line's width: [`Self::pixel_scale`] times [`Self::line_scale`].
+    pub fn line_pixel_scale(&self) -> f32 {
+        self.pixel_scale() * self.line_scale.clamp(0.25, 8.0)
     }
 }
 

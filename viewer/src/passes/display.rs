@@ -53,7 +53,7 @@ pub fn uniforms(options: &RenderOptions, scene_radius: f32, orthographic: bool) 
         _pad: [0; 2],
         depth_threshold: DEPTH_EDGE_THRESHOLD,
         crease_cos: CREASE_ANGLE_DEG.to_radians().cos(),
-        line_radius: options.pixel_scale().max(1.0),
+        line_radius: options.line_pixel_scale().max(1.0),
         unsharp_strength: UNSHARP_STRENGTH,
         ortho: if orthographic { 1.0 } else { 0.0 },
         scene_radius: scene_radius.max(1e-12),

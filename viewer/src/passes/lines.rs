@@ -31,7 +31,7 @@
 //!    drawn as one; the outer outline heavier by [`OUTER_EXTRA_PX`] — added only where the line
 //!    covers background, so it grows outwards.
 //!
-//! Widths are in output pixels and scale with supersampling. Silhouettes are queried on the CPU:
+//! Widths are in output pixels and scale with supersampling (and `RenderOptions::line_scale`). Silhouettes are queried on the CPU:
 //! the hierarchy answers in microseconds to a few milliseconds (see `drafter bench render`'s
 //! `silhouette_query_ms`), well under a lavapipe frame, so no compute pass is used.
 
@@ -74,7 +74,7 @@ pub fn notice(lines: &ModelLines) -> Option<&'static str> {
 
 /// The uniforms for a frame of `options` seen through `camera` on targets `target_height` high.
 pub fn uniforms(options: &RenderOptions, camera: &crate::Camera, target_height: u32) -> LinesUniforms {
-    let scale = options.pixel_scale();
+    let scale = options.line_pixel_scale();
     let gooch = matches!(options.style, Style::Gooch | Style::Goochel | Style::Metal);
     // Pixel footprint: 2 / (P[1][1] · height), times the depth for a perspective camera.
     let footprint = 2.0 / (camera.clip_from_view.y_axis.y * target_height.max(1) as f32);
