@@ -246,3 +246,186 @@ fn drafter_web_writes_a_folder_for_a_static_host() {
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("scripts/web"), "{stderr}");
 }
+
+// The page as a product (issue 60): each test below failed before its fix.
+
+/// `node web.mjs probe` on the built page: the page's state after the actions in `args`.
+fn probe(file: &Path, args: &[&str]) -> Value {
+    let json = web("probe", file, args);
+    assert!(json["ok"] == true, "the page did not settle: {json}");
+    json
+}
+
+/// The unbaked sample assembly (a .glb with no DRAFTER_illustration data).
+fn unbaked_sample() -> PathBuf {
+    root().join("samples/assembly.glb")
+}
+
+/// Defect 1: a value the page does not know is shown on the page, with state `error`, and nothing
+/// is thrown uncaught.
+#[test]
+fn a_bad_attribute_shows_a_message_and_sets_state_error() {
+    for param in ["style=bogus", "shadow=bogus", "edges=bogus", "view=bogus"] {
+        let json = web("bad", &sample(), &["--param", param]);
+        assert!(json["ok"] == true && json["state"] == "error", "{param}: no error on the page: {json}");
+        let message = json["message"].as_str().unwrap_or_default();
+        assert!(message.contains("bogus"), "{param}: {message}");
+        assert_eq!(json["consoleErrors"], serde_json::json!([]), "{param}: {json}");
+        eprintln!("{param}: {message}");
+    }
+}
+
+/// Defect 2: edges and lines take true/false, 1/0 and on/off.
+#[test]
+fn boolean_attributes_accept_true_false_1_0_on_off() {
+    for (edges, lines) in [("true", "off"), ("0", "on"), ("1", "false")] {
+        let json = probe(&sample(), &["--param", &format!("edges={edges}"), "--param", &format!("lines={lines}")]);
+        let on = |v: &str| ["true", "1", "on"].contains(&v);
+        assert_eq!(json["viewerState"]["edges"], on(edges), "edges={edges}: {json}");
+        assert_eq!(json["viewerState"]["lines"], on(lines), "lines={lines}: {json}");
+    }
+}
+
+/// Defect 3: an unbaked file is shown with a visible note (and "lines", which has nothing to draw,
+/// is off and disabled), and `drafter web` notes it too.
+#[test]
+fn an_unbaked_file_shows_a_notice_and_drafter_web_notes_it() {
+    let file = unbaked_sample();
+    let json = probe(&file, &["--controls", "--param", "edges", "--param", "lines"]);
+    assert_eq!(json["state"], "ready", "{json}");
+    let notice = json["notice"].as_str().unwrap_or_default();
+    assert!(notice.contains("not baked") && json["layout"]["notice"].is_object(), "no visible notice: {json}");
+    assert_eq!(json["viewerState"]["lines"], false, "{json}");
+    let lines = json["labels"].as_array().expect("labels").iter().find(|c| c["name"] == "lines").cloned();
+    assert!(lines.is_some_and(|c| c["disabled"] == true), "the lines box is not disabled: {json}");
+
+    let dir = common::scratch("web-unbaked");
+    let run = common::drafter()
+        .arg("web")
+        .arg(&file)
+        .arg("-o")
+        .arg(dir.join("site"))
+        .env("DRAFTER_WEB_PAGE", page())
+        .output()
+        .expect("drafter runs");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(stderr.contains("note:") && stderr.contains("not baked"), "drafter web says nothing: {stderr}");
+}
+
+/// Defect 4: style, edges, lines and shadow chosen by the user stay when another file loads.
+#[test]
+fn settings_persist_when_another_file_loads() {
+    // Gooch (3), edges on (E), the next shadow (H: hard), then the element's src set anew.
+    let json = probe(&sample(), &["--keys", "3eh", "--reload"]);
+    assert_eq!(json["state"], "ready", "{json}");
+    let state = &json["viewerState"];
+    assert_eq!(state["style"], "gooch", "{json}");
+    assert_eq!(state["edges"], true, "{json}");
+    assert_eq!(state["lines"], false, "{json}");
+    assert_eq!(state["shadow"], "hard", "{json}");
+}
+
+/// Defect 5: a .gltf dropped with its .bin (and images) loads; a .gltf alone says what to drop with it.
+#[test]
+fn a_gltf_dropped_with_its_files_loads_and_a_lone_gltf_says_what_to_drop() {
+    let folder = common::shared_models().join("gltf/GearboxAssy");
+    let gltf = folder.join("GearboxAssy.gltf");
+    let both = format!("{},{}", gltf.display(), folder.join("GearboxAssy.bin").display());
+    let json = probe(&sample(), &["--drop", &both]);
+    assert_eq!(json["state"], "ready", "{json}");
+    assert_eq!(json["summary"]["name"], "GearboxAssy.gltf", "{json}");
+    assert!(json["summary"]["triangles"].as_u64().is_some_and(|t| t > 600_000), "{json}");
+
+    // The same with an image beside it (a texture the file lists): dropped with the rest, it loads;
+    // left out, the page names it.
+    let dir = common::scratch("web-drop-textured");
+    let mut json: Value = serde_json::from_slice(&std::fs::read(&gltf).expect("gltf")).expect("JSON");
+    json["images"] = serde_json::json!([{ "uri": "grid%20texture.png" }]);
+    json["samplers"] = serde_json::json!([{}]);
+    json["textures"] = serde_json::json!([{ "source": 0, "sampler": 0 }]);
+    let textured = dir.join("Textured.gltf");
+    std::fs::write(&textured, serde_json::to_vec(&json).expect("JSON")).expect("write");
+    std::fs::copy(folder.join("GearboxAssy.bin"), dir.join("GearboxAssy.bin")).expect("copy");
+    std::fs::copy(root().join("docs/img/clients/gearbox-cesium-edge-cull.png"), dir.join("grid texture.png"))
+        .expect("copy");
+    let files = |names: &[&str]| names.iter().map(|n| dir.join(n).display().to_string()).collect::<Vec<_>>().join(",");
+    let all = probe(&sample(), &["--drop", &files(&["Textured.gltf", "GearboxAssy.bin", "grid texture.png"])]);
+    assert_eq!(all["state"], "ready", "{all}");
+    let no_image = probe(&sample(), &["--drop", &files(&["Textured.gltf", "GearboxAssy.bin"])]);
+    assert_eq!(no_image["state"], "error", "{no_image}");
+    assert!(no_image["message"].as_str().is_some_and(|m| m.contains("grid texture.png")), "{no_image}");
+
+    let alone = probe(&sample(), &["--drop", gltf.to_str().expect("utf-8")]);
+    assert_eq!(alone["state"], "error", "{alone}");
+    let message = alone["message"].as_str().unwrap_or_default();
+    assert!(message.contains("GearboxAssy.bin") && message.contains("drop"), "{message}");
+}
+
+/// Defect 6: a lost WebGPU device is replaced by WebGL2, which shows the same model, and the page
+/// says so.
+#[test]
+fn a_lost_webgpu_device_falls_back_to_webgl2() {
+    let json = probe(&sample(), &["--backend", "webgpu", "--keys", "3", "--lose-device"]);
+    assert_eq!(json["state"], "ready", "{json}");
+    assert!(json["backend"].as_str().is_some_and(|b| b.contains("Gl")), "not on WebGL2: {json}");
+    let notice = json["notice"].as_str().unwrap_or_default();
+    assert!(notice.contains("lost") && notice.contains("WebGL2"), "the page does not say so: {json}");
+    assert_eq!(json["viewerState"]["style"], "gooch", "the settings were not kept: {json}");
+}
+
+/// Pixels darker than a line's grey in every channel.
+fn dark_pixels(image: &Image) -> usize {
+    image.rgba.chunks_exact(4).filter(|p| p[0].max(p[1]).max(p[2]) < 96).count()
+}
+
+/// Defect 7: at devicePixelRatio 2 the lines are twice as many canvas pixels wide (the same CSS
+/// width): on an 800×600 canvas they cover about twice the dark pixels that `drafter render` of
+/// 800×600 adds with its lines, not the same.
+#[test]
+fn line_widths_are_in_css_pixels() {
+    let file = sample();
+    let dir = common::scratch("web-dpr");
+    let native_lines = dark_pixels(&render(&file, "gradient", &["--lines"], &dir.join("lines.png")));
+    let native_plain = dark_pixels(&render(&file, "gradient", &[], &dir.join("plain.png")));
+    let shots = dir.join("page");
+    let args = ["--out", shots.to_str().expect("utf-8"), "--styles", "gradient", "--lines", "--dpr", "2", "--no-size"];
+    let json = web("shots", &file, &args);
+    assert!(json["ok"] == true, "{json}");
+    let page = Image::from_png(&std::fs::read(shots.join("gradient.png")).expect("shot")).expect("PNG");
+    assert_eq!((page.width, page.height), (800, 600), "the canvas is not in device pixels");
+    let line_pixels = native_lines.saturating_sub(native_plain) as f64;
+    let extra = dark_pixels(&page).saturating_sub(native_lines) as f64;
+    eprintln!("lines at 1x: {line_pixels} dark pixels; at devicePixelRatio 2: {extra} more");
+    assert!(line_pixels > 1000.0, "the sample has lines: {line_pixels}");
+    assert!(extra > 0.5 * line_pixels, "lines at devicePixelRatio 2 are not wider: {extra} more of {line_pixels}");
+}
+
+/// Defect 8: a help overlay (? or its button) lists mouse and keys; every control has a label; the
+/// toolbar is above the canvas, clear of the model; a baked file shows its lines and edges.
+#[test]
+fn help_labels_framing_and_lines_by_default_for_a_newcomer() {
+    let json = probe(&sample(), &["--controls", "--no-size", "--param", "edges", "--param", "lines", "--help-key"]);
+    assert_eq!(json["state"], "ready", "{json}");
+    let help = json["help"]["text"].as_str().unwrap_or_default();
+    assert!(json["help"]["shown"] == true, "? shows no help: {json}");
+    for words in ["left drag", "wheel", "right or middle drag", "next style", "png", "desktop window"] {
+        assert!(help.to_lowercase().contains(words), "the help lacks {words:?}: {help}");
+    }
+    for control in json["labels"].as_array().expect("labels") {
+        let label = control["label"].as_str().unwrap_or_default();
+        assert!(!label.is_empty(), "a control without a label: {json}");
+        if control["name"] == "style" || control["name"] == "shadow" {
+            assert!(label.contains(control["name"].as_str().unwrap_or_default()), "{control}");
+        }
+    }
+    let layout = &json["layout"];
+    let toolbar_bottom = layout["toolbar"]["bottom"].as_f64().expect("a toolbar");
+    assert!(
+        layout["canvas"]["top"].as_f64().expect("a canvas") >= toolbar_bottom,
+        "the toolbar covers the canvas: {json}"
+    );
+    assert!(layout["modelTop"].as_f64().expect("a model") > toolbar_bottom, "the toolbar covers the model: {json}");
+    assert_eq!(json["viewerState"]["lines"], true, "a baked file's lines are off: {json}");
+    assert_eq!(json["viewerState"]["edges"], true, "a baked file's edges are off: {json}");
+}

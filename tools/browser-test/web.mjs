@@ -18,13 +18,26 @@
 //       A scripted left drag over the canvas, then the key 3 (gooch). Prints {ok, before, after,
 //       keyStyle, pixelsChanged, consoleErrors}.
 //   bad [--max-triangles N]
-//       Loads FILE, which should be refused. Prints {ok, state, message, ms, canvasBlank,
-//       consoleErrors}; ok when the page shows an error message within the timeout.
+//       Loads FILE, which should be refused (or the page's parameters, --param). Prints {ok, state,
+//       message, ms, consoleErrors}; ok when the page shows an error message within the timeout.
+//   probe [--controls] [--keys K] [--reload] [--drop F1,F2,...] [--lose-device] [--help-key]
+//       Loads FILE, then, in this order: types the keys K (one character each); sets the element's
+//       src again (a new load of FILE); drops the files F1,F2,... on the element at once (as a user
+//       selecting them); destroys the GPU device (viewer.lose_device()); presses ?. Waits for the
+//       page to settle after each. Prints {ok, state, message, notice, backend, viewerState,
+//       summary, layout, labels, help, consoleErrors}: layout holds the toolbar's, the canvas's and
+//       the notice's rectangles (CSS pixels) and modelTop, the first canvas row that is not
+//       background in CSS pixels from the page's top; labels the accessible name of each control;
+//       help whether the help is shown and its text. ok when the page settled (ready or error).
 // Common: --backend webgpu|webgl2 (default webgl2; webgpu starts Chromium with WebGPU on SwiftShader's
-// Vulkan, or with DRAFTER_WEBGPU_ARGS), --timeout S (default 120).
+// Vulkan, or with DRAFTER_WEBGPU_ARGS), --timeout S (default 120), --param NAME=VALUE (a page
+// parameter, repeatable; replaces the one this script sets; --param NAME alone removes it), --dpr N (devicePixelRatio, default 1),
+// --no-size (no size parameter: the canvas fills the page, in device pixels), --controls (show the
+// toolbar). Without --edges / --lines the page is told edges=0 / lines=0 (its default is on for a
+// file that carries baked lines).
 // Every command prints one JSON line and exits 0 when ok, 1 otherwise, 2 on wrong usage.
 
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import process from 'node:process';
 
@@ -36,14 +49,126 @@ import { startServer } from './lib/server.mjs';
 
 function parse(argv) {
   const [command, pageDir, file, ...rest] = argv;
-  const options = { backend: 'webgl2', timeout: '120', size: '800x600', view: '35,25', shadow: 'none' };
+  const options = { backend: 'webgl2', timeout: '120', size: '800x600', view: '35,25', shadow: 'none', param: [] };
+  const flags = ['edges', 'lines', 'no-src', 'capture', 'no-size', 'controls', 'reload', 'lose-device', 'help-key'];
   for (let i = 0; i < rest.length; i++) {
     const name = rest[i].replace(/^--/, '');
-    if (['edges', 'lines', 'no-src', 'capture'].includes(name)) options[name] = true;
+    if (flags.includes(name)) options[name] = true;
+    else if (name === 'param') options.param.push(rest[++i]);
     else options[name] = rest[++i];
   }
-  if (!command || !pageDir || !file) throw new Error('usage: web.mjs shots|interact|bad PAGE_DIR FILE [options]');
+  if (!command || !pageDir || !file) throw new Error('usage: web.mjs shots|interact|bad|probe PAGE_DIR FILE [options]');
   return { command, pageDir: path.resolve(pageDir), file: path.resolve(file), options };
+}
+
+/** Waits until the viewer settles (ready, error or empty) after an action started at load `loads`. */
+async function settle(page, timeoutMs, loads) {
+  return page
+    .waitForFunction(
+      (loads) => {
+        const v = document.getElementById('viewer');
+        return ['ready', 'error', 'empty'].includes(v?.state) && (loads === undefined || v.loads > loads || v.state === 'error');
+      },
+      { timeout: timeoutMs, polling: 100 },
+      loads,
+    )
+    .then(() => true)
+    .catch(() => false);
+}
+
+/** The probe command: actions, then what the page shows. */
+async function probe(page, options, file, settled, timeoutMs) {
+  const loads = () => page.evaluate(() => document.getElementById('viewer').loads);
+  if (settled && options.keys) {
+    await page.focus('#viewer');
+    for (const key of options.keys) await page.keyboard.press(key);
+  }
+  if (settled && options.reload) {
+    const before = await loads();
+    await page.evaluate((name) => {
+      document.getElementById('viewer').setAttribute('src', `/model/${encodeURIComponent(name)}?again`);
+    }, path.basename(file));
+    settled = await settle(page, timeoutMs, before);
+  }
+  if (settled && options.drop) {
+    const files = options.drop.split(',').map((f) => ({ name: path.basename(f), data: readFileSync(f).toString('base64') }));
+    const before = await loads();
+    await page.evaluate((files) => {
+      const transfer = new DataTransfer();
+      for (const f of files) {
+        const bytes = Uint8Array.from(atob(f.data), (c) => c.charCodeAt(0));
+        transfer.items.add(new File([bytes], f.name));
+      }
+      const v = document.getElementById('viewer');
+      v.dispatchEvent(new DragEvent('drop', { dataTransfer: transfer, bubbles: true, cancelable: true }));
+    }, files);
+    settled = await settle(page, timeoutMs, before);
+  }
+  if (settled && options['lose-device']) {
+    const before = await loads();
+    await page.evaluate(() => document.getElementById('viewer').viewer.lose_device());
+    settled = await settle(page, timeoutMs, before);
+  }
+  if (settled && options['help-key']) {
+    await page.focus('#viewer');
+    await page.keyboard.press('?');
+  }
+  const report = await page.evaluate(async () => {
+    const v = document.getElementById('viewer');
+    const root = v.shadowRoot;
+    const rect = (e) => {
+      if (!e || e.hidden || e.offsetParent === null) return null;
+      const r = e.getBoundingClientRect();
+      return { left: r.left, top: r.top, right: r.right, bottom: r.bottom };
+    };
+    let modelTop = null;
+    if (v.state === 'ready' && !v.hasAttribute('offscreen')) {
+      // The canvas as drawn, read in the task of its draw, then the first row that is not background.
+      v.draw(false);
+      const url = v.canvas.toDataURL('image/png');
+      const img = new Image();
+      img.src = url;
+      await img.decode();
+      const c = document.createElement('canvas');
+      [c.width, c.height] = [img.width, img.height];
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      const { data } = g.getImageData(0, 0, c.width, c.height);
+      const [r0, g0, b0] = [data[0], data[1], data[2]];
+      find: for (let y = 0; y < c.height; y++) {
+        for (let x = 0; x < c.width; x++) {
+          const i = 4 * (y * c.width + x);
+          if (Math.abs(data[i] - r0) + Math.abs(data[i + 1] - g0) + Math.abs(data[i + 2] - b0) > 30) {
+            modelTop = v.canvas.getBoundingClientRect().top + y * (v.canvas.clientHeight / c.height);
+            break find;
+          }
+        }
+      }
+    }
+    const labels = [...root.querySelectorAll('.bar select, .bar input, .bar button')].map((e) => ({
+      name: e.name,
+      label: e.getAttribute('aria-label') || [...(e.labels ?? [])].map((l) => l.textContent.trim()).join(' ') || e.textContent.trim(),
+      disabled: e.disabled,
+    }));
+    const help = root.querySelector('.help');
+    return {
+      state: v.state,
+      message: v.message,
+      notice: root.querySelector('.notice').hidden ? '' : v.notice,
+      backend: v.viewer?.backend() ?? null,
+      viewerState: v.viewer ? JSON.parse(v.viewer.state()) : null,
+      summary: v.summary,
+      layout: {
+        toolbar: rect(root.querySelector('.bar')),
+        canvas: rect(v.canvas),
+        notice: rect(root.querySelector('.notice')),
+        modelTop,
+      },
+      labels,
+      help: { shown: !help.hidden, text: help.hidden ? '' : help.textContent },
+    };
+  });
+  return { ok: settled, ...report };
 }
 
 async function main() {
@@ -66,9 +191,11 @@ async function main() {
   const consoleErrors = [];
   let result;
   try {
-    const [w, h] = options.size.split('x').map(Number);
+    const dpr = Number(options.dpr ?? 1);
+    // The page's size in CSS pixels: with --no-size and --dpr N, the canvas is N times larger.
+    const [w, h] = options.size.split('x').map((n) => Math.round(Number(n) / (options['no-size'] ? dpr : 1)));
     const page = await browser.newPage();
-    await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
+    await page.setViewport({ width: w, height: h, deviceScaleFactor: dpr });
     page.on('console', (msg) => msg.type() === 'error' && consoleErrors.push(msg.text()));
     page.on('pageerror', (err) => consoleErrors.push(`page error: ${err.message ?? err}`));
     const params = new URLSearchParams({
@@ -78,12 +205,19 @@ async function main() {
       shadow: options.shadow,
       backend: options.backend,
       controls: 'none',
+      edges: options.edges ? '1' : '0',
+      lines: options.lines ? '1' : '0',
     });
     // --no-src: the page's own model (what `drafter web` wrote beside it), served from PAGE_DIR.
     if (options['no-src']) params.delete('src');
-    if (options.edges) params.set('edges', '1');
-    if (options.lines) params.set('lines', '1');
+    if (options['no-size']) params.delete('size');
+    if (options.controls) params.delete('controls');
     if (options['max-triangles']) params.set('max-triangles', options['max-triangles']);
+    for (const p of options.param) {
+      const [name, ...value] = p.split('=');
+      if (value.length === 0) params.delete(name);
+      else params.set(name, value.join('='));
+    }
     // WebGPU here: present nothing (presenting a WebGPU canvas loses the device in this headless
     // Chromium); the shots are viewer.capture()'s.
     if (options.backend === 'webgpu') params.set('offscreen', '1');
@@ -91,7 +225,7 @@ async function main() {
     await page.goto(`${server.url}/index.html?${params}`, { waitUntil: 'domcontentloaded', timeout: timeoutMs });
     const settled = await page
       .waitForFunction(
-        () => ['ready', 'error'].includes(document.getElementById('viewer')?.state),
+        () => ['ready', 'error', 'empty'].includes(document.getElementById('viewer')?.state),
         { timeout: timeoutMs, polling: 100 },
       )
       .then(() => true)
@@ -114,6 +248,8 @@ async function main() {
         return !box.hidden && box.textContent.length > 0 ? box.textContent : '';
       });
       result = { ok: settled && status.state === 'error' && shown !== '', state: status.state, message: shown, ms };
+    } else if (command === 'probe') {
+      result = await probe(page, options, file, settled, timeoutMs);
     } else if (!settled || status.state !== 'ready') {
       result = { ok: false, state: status.state, message: status.message || 'page did not finish loading', ms };
     } else if (command === 'shots') {
@@ -208,8 +344,8 @@ async function main() {
     clearTimeout(watchdog);
   }
   result.consoleErrors = consoleErrors;
-  // A refused file may log the refusal; any other console error fails the run.
-  if (command !== 'bad' && consoleErrors.length > 0) result.ok = false;
+  // A refused file may log the refusal; any other console error fails the run (the probe reports them).
+  if (!['bad', 'probe'].includes(command) && consoleErrors.length > 0) result.ok = false;
   console.log(JSON.stringify(result));
   process.exit(result.ok ? 0 : 1);
 }

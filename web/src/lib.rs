@@ -30,10 +30,33 @@ pub fn start() {
     }));
 }
 
+/// The event a lost device fires on the window: `detail` is the JSON `{"id", "reason", "message"}`,
+/// `id` the lost viewer's [`Viewer::id`] (the page re-creates that viewer on WebGL2).
+pub const DEVICE_LOST_EVENT: &str = "drafter-device-lost";
+
+/// The next [`Viewer::id`].
+static NEXT_ID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(1);
+
+/// Tells the page that viewer `id` lost its GPU device: a [`DEVICE_LOST_EVENT`] on the window,
+/// and a warning on the console.
+fn announce_device_loss(id: u32, reason: wgpu::DeviceLostReason, message: &str) {
+    let reason = format!("{reason:?}");
+    web_sys::console::warn_1(&format!("drafter: the GPU device was lost ({reason}): {message}").into());
+    let detail = serde_json::json!({ "id": id, "reason": reason, "message": message }).to_string();
+    let init = web_sys::CustomEventInit::new();
+    init.set_detail(&JsValue::from_str(&detail));
+    if let (Some(window), Ok(event)) =
+        (web_sys::window(), web_sys::CustomEvent::new_with_event_init_dict(DEVICE_LOST_EVENT, &init))
+    {
+        let _ = window.dispatch_event(&event);
+    }
+}
+
 /// A renderer on one canvas, with at most one model.
 #[wasm_bindgen]
 #[derive(Debug)]
 pub struct Viewer {
+    id: u32,
     renderer: Renderer,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
@@ -94,10 +117,10 @@ impl Viewer {
             .or_else(|| capabilities.formats.first().copied())
             .ok_or_else(|| js_error("the canvas supports no texture format"))?;
         let gpu = Gpu::request(instance, adapter).await.map_err(js_error)?;
-        // A lost device draws nothing and fails every read: say so where the page looks.
-        gpu.device.set_device_lost_callback(|reason, message| {
-            web_sys::console::error_1(&format!("drafter: the GPU device was lost ({reason:?}): {message}").into());
-        });
+        // A lost device draws nothing and fails every read: the page hears of it (and re-creates
+        // the viewer on WebGL2) through an event on the window.
+        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        gpu.device.set_device_lost_callback(move |reason, message| announce_device_loss(id, reason, &message));
         let backend = gpu.description();
         let interactive_scale = gpu.interactive_scale();
         let config = wgpu::SurfaceConfiguration {
@@ -114,7 +137,24 @@ impl Viewer {
         surface.configure(&gpu.device, &config);
         let renderer = Renderer::with_gpu(gpu, format).map_err(js_error)?;
         let options = RenderOptions { size: (width, height), interactive_scale, ..RenderOptions::default() };
-        Ok(Viewer { renderer, surface, config, options, orbit: Orbit::default(), model: None, backend })
+        Ok(Viewer { id, renderer, surface, config, options, orbit: Orbit::default(), model: None, backend })
+    }
+
+    /// This viewer's number on the page: the `id` of its [`DEVICE_LOST_EVENT`].
+    pub fn id(&self) -> u32 {
+        self.id
+    }
+
+    /// Destroys the GPU device, as a browser that loses it does (for tests of the page's
+    /// fallback): the device-lost event follows.
+    pub fn lose_device(&self) {
+        self.renderer.gpu().device.destroy();
+    }
+
+    /// Line widths in CSS pixels: `ratio` is the canvas's pixels per CSS pixel (the browser's
+    /// `devicePixelRatio` when the canvas fills its box), clamped to 0.25–8.
+    pub fn set_line_scale(&mut self, ratio: f32) {
+        self.options.line_scale = if ratio.is_finite() { ratio.clamp(0.25, 8.0) } else { 1.0 };
     }
 
     /// The adapter: "name (backend, device type)".
@@ -124,7 +164,9 @@ impl Viewer {
 
     /// Loads a model from its bytes (`name` for messages and to tell the format); refuses one that
     /// lists more than `max_triangles` triangles. Returns a JSON summary (triangles, parts,
-    /// notices, hard edges). The view is reset.
+    /// notices, hard edges; `baked`: the file carries `DRAFTER_illustration` data; `lines`: it
+    /// carries baked lines for the lines pass). The view is reset; the style and the other
+    /// settings are kept.
     pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<String, JsError> {
         let limits = drafter_io::Limits { max_triangles: max_triangles.max(0.0) as u64 };
         let model = Model::load_bytes_within(Path::new(name), bytes, &limits).map_err(js_error)?;
@@ -135,6 +177,8 @@ impl Viewer {
             "triangles": model.triangle_count(),
             "parts": model.parts.len(),
             "hardEdges": self.renderer.hard_edge_count(),
+            "baked": model.baked,
+            "lines": !model.lines.is_empty(),
             "notices": model.notices,
         });
         self.model = Some(model);

@@ -9,7 +9,8 @@
 //! fails with one line and exit code 5 ([`crate::exit::MISSING_PAGE`]).
 //!
 //! The model is checked first as the page will load it (the viewer's reader, the page's default
-//! triangle limit), so a file the page would refuse is refused here (exit code 2). The files are
+//! triangle limit), so a file the page would refuse is refused here (exit code 2); an unbaked
+//! file is written with a note, as the page shows it with one. The files are
 //! staged beside their targets and renamed into place together.
 
 use std::path::{Path, PathBuf};
@@ -81,6 +82,14 @@ pub fn run(args: Args) -> Result<()> {
         .into());
     }
     let model = crate::cmd::render::load(&args.file, PAGE_MAX_TRIANGLES)?;
+    if !model.baked && !args.quiet {
+        eprintln!(
+            "note: {} is not baked (no DRAFTER_illustration data): the page draws each object as one part, with no \
+             baked lines or gradients, and says so; bake it first (drafter bake {} -o OUT.glb)",
+            args.file.display(),
+            args.file.display()
+        );
+    }
     let bytes = std::fs::read(&args.file).map_err(|e| BadInput(format!("{}: {e}", args.file.display())))?;
     let name = model_name(&args.file);
 
