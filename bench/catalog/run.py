@@ -152,10 +152,13 @@ print(f"    runs in turn {' '.join(f'{x:.3f}' for x in seq)}; at once {' '.join(
 
 PY_RAY = r"""
 import json, os, shutil, statistics, sys, tempfile, time, logging
+# Every Ray process on the loopback address only (read when ray is imported): its node address is
+# then 127.0.0.1, and its servers listen there rather than on the machine's network address.
+os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
 import ray, drafter, drafter.ray
 models, scratch = sys.argv[1], sys.argv[2]
 t = time.perf_counter()
-ray.init(num_cpus=2, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
+ray.init(num_cpus=2, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False, _node_ip_address="127.0.0.1")
 start = time.perf_counter() - t
 first = None
 local, remote = [], []

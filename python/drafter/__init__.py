@@ -8,20 +8,30 @@ drafter-catalog). Every call releases the GIL while it works, so Python threads 
     glb = drafter.bake(stl_bytes, name="part.stl", config={"gradient": {"q": 12}})
     info = drafter.inspect(glb)                              # what ``drafter inspect --json`` prints
     record = drafter.bake_file("a.obj", "out/a.glb", cache="~/.cache/drafter")
-    report = drafter.bake_many(["models/"], "baked/", cache="/shared/drafter-cache")
+    report = drafter.bake_many("models/", "baked/", cache="/shared/drafter-cache")
 
 Errors raise :class:`InputError` (bad input or options: the CLI's exit code 2), :class:`IoError`
-(a file could not be read or written: 3) or :class:`InternalError` (a bug: 1), all subclasses of
-:class:`DrafterError`. ``bake_file`` and ``bake_many`` report a failed file in their records instead.
+(a file could not be read or written: 3; also an :class:`OSError`) or :class:`InternalError` (a
+bug: 1), all subclasses of :class:`DrafterError`. A number out of range (``threads=-1``) raises
+:class:`ValueError` before anything runs. ``bake_file`` and ``bake_many`` report a failed file in
+their records instead of raising.
 
-``drafter.ray`` bakes catalogs across a Ray cluster.
+**Paths.** Wherever a list of paths is asked for (``bake_many``'s inputs and manifests,
+``discover``), one ``str`` or ``os.PathLike`` is one path, never a sequence of characters.
+
+**Configurations** (``config=``): ``None`` (the defaults), a mapping of the TOML file's tables
+(``{"gradient": {"q": 12}}``), an ``os.PathLike`` naming a TOML file, or a ``str``. A ``str`` is a
+file's path when it has no line break and no ``=`` and either names an existing file or ends in
+``.toml`` (a missing ``c.toml`` raises :class:`FileNotFoundError`); any other ``str`` is TOML text
+(``"[gradient]\\nq = 12"``).
+
+``drafter.ray`` bakes catalogs across a Ray cluster (``pip install drafter[ray]``).
 """
 
-from __future__ import annotations
-
-import json
-import os
-from typing import Any, Iterable, List, Mapping, Optional, Tuple, Union
+import json as _json
+import numbers as _numbers
+import os as _os
+import typing as _t
 
 from . import _drafter
 from ._drafter import BUILD_ID, DrafterError, InputError, InternalError, IoError, __version__
@@ -43,140 +53,223 @@ __all__ = [
     "inspect",
 ]
 
-PathLike = Union[str, "os.PathLike[str]"]
-#: A bake configuration: TOML text (a ``str``), a path to a TOML file (``os.PathLike``), or a
-#: mapping of the same tables (``{"gradient": {"q": 12}, "part": [{"name": "gear", ...}]}``).
-Config = Union[None, str, "os.PathLike[str]", Mapping[str, Any]]
-Source = Union[bytes, bytearray, memoryview, PathLike]
+_PathLike = _t.Union[str, "_os.PathLike[str]"]
+#: A bake configuration: a mapping of the TOML file's tables, a TOML file's path, or TOML text
+#: (the module's docs give the rule that tells a path from text).
+_Config = _t.Union[None, str, "_os.PathLike[str]", _t.Mapping[str, _t.Any]]
+_Source = _t.Union[bytes, bytearray, memoryview, _PathLike]
+#: ``progress(record, done, total)`` of ``bake_many``.
+_Progress = _t.Callable[[dict, int, int], _t.Any]
 
 
-def _config(config: Config) -> dict:
-    if config is None:
-        return {}
-    if isinstance(config, os.PathLike):
-        with open(config, encoding="utf-8") as f:
-            return {"config_toml": f.read()}
-    if isinstance(config, str):
-        return {"config_toml": config}
-    if isinstance(config, Mapping):
-        return {"config_json": json.dumps(config)}
+def _is_config_path(text: str) -> bool:
+    """The rule of the module's docs: a ``str`` is a path when it has no line break and no ``=``
+    and names an existing file or ends in ``.toml``."""
+    if not text or "\n" in text or "\r" in text or "=" in text:
+        return False
+    return text.lower().endswith(".toml") or _os.path.isfile(_os.path.expanduser(text))
+
+
+def _config_value(config: _Config) -> _t.Union[None, str, _t.Mapping[str, _t.Any]]:
+    """``config`` with a path read: ``None``, TOML text or a mapping (what ``drafter.ray`` sends
+    to its workers, whose working folder is not the caller's)."""
+    if config is None or isinstance(config, _t.Mapping):
+        return config
+    if isinstance(config, str) and not _is_config_path(config):
+        return config
+    if isinstance(config, (str, _os.PathLike)):
+        with open(_os.path.expanduser(_os.fspath(config)), encoding="utf-8") as f:
+            return f.read()
     raise TypeError(f"config must be TOML text, a path or a mapping, not {type(config).__name__}")
 
 
-def _source(data_or_path: Source, name: Optional[str]) -> dict:
+def _config(config: _Config) -> dict:
+    value = _config_value(config)
+    if value is None:
+        return {}
+    if isinstance(value, str):
+        return {"config_toml": value}
+    return {"config_json": _json.dumps(value)}
+
+
+def _paths(paths: _t.Union[_PathLike, _t.Iterable[_PathLike]], what: str) -> _t.List[str]:
+    """A list of paths: one ``str`` or ``os.PathLike`` is one path."""
+    if isinstance(paths, (str, _os.PathLike)):
+        return [_os.fspath(paths)]
+    if isinstance(paths, (bytes, bytearray)):
+        raise TypeError(f"{what}: give paths as str or os.PathLike, not bytes")
+    return [_os.fspath(p) for p in paths]
+
+
+def _count(name: str, value: _t.Optional[int], low: int = 1, high: int = (1 << 64) - 1) -> _t.Optional[int]:
+    """``value`` checked to be a whole number in ``low..=high`` (``None`` passes)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, _numbers.Integral):
+        raise TypeError(f"{name} must be a whole number, not {type(value).__name__}")
+    value = int(value)
+    if not low <= value <= high:
+        raise ValueError(f"{name} must be between {low} and {high}, not {value}")
+    return value
+
+
+def _cache_path(cache: _t.Optional[_PathLike]) -> _t.Optional[str]:
+    return None if cache is None else _os.path.expanduser(_os.fspath(cache))
+
+
+def _source(data_or_path: _Source, name: _t.Optional[str]) -> dict:
     if isinstance(data_or_path, (bytes, bytearray, memoryview)):
         return {"data": bytes(data_or_path), "name": name}
-    if isinstance(data_or_path, (str, os.PathLike)):
-        return {"path": os.fspath(data_or_path)}
+    if isinstance(data_or_path, (str, _os.PathLike)):
+        return {"path": _os.fspath(data_or_path)}
     raise TypeError(f"expected bytes or a path, not {type(data_or_path).__name__}")
 
 
 def bake(
-    data_or_path: Source,
-    config: Config = None,
+    data_or_path: _Source,
+    config: _Config = None,
     *,
-    name: Optional[str] = None,
-    threads: Optional[int] = None,
-    max_triangles: Optional[int] = None,
+    name: _t.Optional[str] = None,
+    threads: _t.Optional[int] = None,
+    max_triangles: _t.Optional[int] = None,
 ) -> bytes:
     """Bakes a model (a path, or its bytes) and returns the baked GLB's bytes.
 
     ``name`` names in-memory bytes (``"part.stl"``): it breaks ties in format detection and is
     recorded in the output as the CLI records the input's file name. A glTF given as bytes can only
-    use data URIs; give its path to resolve buffers beside it. ``threads`` runs the bake on a pool
-    of its own (the output is the same bytes at any thread count).
+    use data URIs; give its path to resolve buffers beside it. ``threads`` (1 to 1024) runs the
+    bake on a pool of its own (the output is the same bytes at any thread count).
     """
     return _drafter.bake(
-        **_source(data_or_path, name), **_config(config), threads=threads, max_triangles=max_triangles
+        **_source(data_or_path, name),
+        **_config(config),
+        threads=_count("threads", threads, 1, 1024),
+        max_triangles=_count("max_triangles", max_triangles),
     )
 
 
-def inspect(data_or_path: Source, *, name: Optional[str] = None, max_triangles: Optional[int] = None) -> dict:
+def inspect(data_or_path: _Source, *, name: _t.Optional[str] = None, max_triangles: _t.Optional[int] = None) -> dict:
     """What ``drafter inspect --json`` reports: format, instances, totals, bounds, welded topology,
     and for a baked file its parts, boxes, projectors and byte sections."""
-    return json.loads(_drafter.inspect(**_source(data_or_path, name), max_triangles=max_triangles))
+    return _json.loads(
+        _drafter.inspect(**_source(data_or_path, name), max_triangles=_count("max_triangles", max_triangles))
+    )
 
 
 def bake_file(
-    input: PathLike,
-    output: PathLike,
+    input: _PathLike,
+    output: _PathLike,
     *,
-    config: Config = None,
-    cache: Optional[PathLike] = None,
-    cache_max: Optional[int] = None,
-    threads: Optional[int] = None,
-    max_triangles: Optional[int] = None,
+    config: _Config = None,
+    cache: _t.Optional[_PathLike] = None,
+    cache_max: _t.Optional[int] = None,
+    threads: _t.Optional[int] = None,
+    max_triangles: _t.Optional[int] = None,
 ) -> dict:
     """Bakes ``input`` into ``output`` (.glb, or .gltf with its .bin) atomically, through the cache
     folder ``cache`` when given, and returns the file's record as in a batch report:
     ``{"input", "output", "status": "baked"|"cached"|"failed", "cache", "ms", "bytes_in",
     "bytes_out", "error", "exit_code", ...}``. A failure is reported in the record, not raised."""
     record = _drafter.bake_file(
-        os.fspath(input),
-        os.fspath(output),
+        _os.fspath(input),
+        _os.fspath(output),
         **_config(config),
-        cache=None if cache is None else os.path.expanduser(os.fspath(cache)),
-        cache_max=cache_max,
-        threads=threads,
-        max_triangles=max_triangles,
+        cache=_cache_path(cache),
+        cache_max=_count("cache_max", cache_max, 0),
+        threads=_count("threads", threads, 1, 1024),
+        max_triangles=_count("max_triangles", max_triangles),
     )
-    return json.loads(record)
+    return _json.loads(record)
 
 
 def bake_many(
-    inputs: Iterable[PathLike],
-    out_dir: PathLike,
+    inputs: _t.Union[_PathLike, _t.Iterable[_PathLike]],
+    out_dir: _PathLike,
     *,
-    manifests: Iterable[PathLike] = (),
-    config: Config = None,
-    cache: Optional[PathLike] = None,
-    cache_max: Optional[int] = None,
-    memory: Optional[int] = None,
-    jobs: Optional[int] = None,
-    max_triangles: Optional[int] = None,
+    manifests: _t.Union[_PathLike, _t.Iterable[_PathLike]] = (),
+    config: _Config = None,
+    cache: _t.Optional[_PathLike] = None,
+    cache_max: _t.Optional[int] = None,
+    memory: _t.Optional[int] = None,
+    jobs: _t.Optional[int] = None,
+    max_triangles: _t.Optional[int] = None,
+    progress: _t.Optional[_Progress] = None,
 ) -> dict:
     """``drafter bake INPUTS... -o OUT_DIR`` in this process: files and folders (recursively) and
-    manifests, baked side by side under a memory budget (``memory`` bytes; default half the
-    available memory), ``jobs`` files at once. Returns the batch report (``files``, counts,
-    ``wall_ms``)."""
-    report = _drafter.bake_many(
-        [os.fspath(p) for p in inputs],
-        os.fspath(out_dir),
-        manifests=[os.fspath(p) for p in manifests],
+    manifests (``inputs`` and ``manifests``: a path or a list of paths), baked side by side under a
+    memory budget (``memory`` bytes; default half the available memory), ``jobs`` files at once.
+    Returns the batch report (``files``, counts, ``wall_ms``, ...). No file is written outside
+    ``out_dir`` (and the cache folder).
+
+    ``progress(record, done, total)`` is called once for each file baked, written from the cache
+    or failed, as it finishes, with its record (as in the report), how many have finished and how
+    many the batch holds. It runs on a baking thread with the GIL held: keep it short. If it
+    raises, the batch stops as on Ctrl-C and the exception is raised with ``.report`` set.
+
+    **Ctrl-C** (SIGINT, while Python's default handler is installed and ``bake_many`` runs on the
+    main thread) stops the batch as the CLI's first Ctrl-C does: no file is started after it, the
+    files being baked finish and are written, and ``KeyboardInterrupt`` is raised with the partial
+    report as its ``.report`` attribute (the files not started have status ``"skipped"``)::
+
+        try:
+            report = drafter.bake_many("models/", "baked/")
+        except KeyboardInterrupt as stopped:
+            report = stopped.report
+    """
+    on_finished = None
+    if progress is not None:
+        if not callable(progress):
+            raise TypeError(f"progress must be callable, not {type(progress).__name__}")
+
+        def on_finished(record: str, done: int, total: int) -> None:
+            progress(_json.loads(record), done, total)
+
+    report, error = _drafter.bake_many(
+        _paths(inputs, "inputs"),
+        _os.fspath(out_dir),
+        manifests=_paths(manifests, "manifests"),
         **_config(config),
-        cache=None if cache is None else os.path.expanduser(os.fspath(cache)),
-        cache_max=cache_max,
-        memory=memory,
-        jobs=jobs,
-        max_triangles=max_triangles,
+        cache=_cache_path(cache),
+        cache_max=_count("cache_max", cache_max, 0),
+        memory=_count("memory", memory),
+        jobs=_count("jobs", jobs, 1, 1 << 16),
+        max_triangles=_count("max_triangles", max_triangles),
+        progress=on_finished,
     )
-    return json.loads(report)
+    report = _json.loads(report)
+    if error is not None:
+        error.report = report
+        raise error
+    return report
 
 
 def discover(
-    inputs: Iterable[PathLike], manifests: Iterable[PathLike] = (), skip: Optional[PathLike] = None
-) -> List[Tuple[str, str]]:
+    inputs: _t.Union[_PathLike, _t.Iterable[_PathLike]],
+    manifests: _t.Union[_PathLike, _t.Iterable[_PathLike]] = (),
+    skip: _t.Optional[_PathLike] = None,
+) -> _t.List[_t.Tuple[str, str]]:
     """The files a batch of ``inputs`` (files, folders) and ``manifests`` bakes, as
     ``(input, output path relative to the output folder)`` pairs; ``skip`` is a folder never
     entered (the output folder)."""
     pairs = _drafter.discover(
-        [os.fspath(p) for p in inputs],
-        [os.fspath(p) for p in manifests],
-        None if skip is None else os.fspath(skip),
+        _paths(inputs, "inputs"),
+        _paths(manifests, "manifests"),
+        None if skip is None else _os.fspath(skip),
     )
-    return [(os.fspath(i), os.fspath(o)) for i, o in pairs]
+    return [(_os.fspath(i), _os.fspath(o)) for i, o in pairs]
 
 
-def cache_stats(cache: PathLike) -> dict:
-    """Entries, bytes and temporary files of a cache folder (``drafter cache stats``)."""
-    return json.loads(_drafter.cache(os.fspath(cache), "stats"))
+def cache_stats(cache: _PathLike) -> dict:
+    """Entries, bytes and temporary files of a cache folder (``drafter cache stats``). A folder
+    that is not a cache raises :class:`InputError` and is left as it was (not created)."""
+    return _json.loads(_drafter.cache(_cache_path(cache), "stats"))
 
 
-def cache_evict(cache: PathLike, max_bytes: int) -> dict:
+def cache_evict(cache: _PathLike, max_bytes: int) -> dict:
     """Removes the least recently used entries until the cache holds at most ``max_bytes``."""
-    return json.loads(_drafter.cache(os.fspath(cache), "evict", max_bytes))
+    return _json.loads(_drafter.cache(_cache_path(cache), "evict", _count("max_bytes", max_bytes, 0)))
 
 
-def cache_clear(cache: PathLike) -> int:
+def cache_clear(cache: _PathLike) -> int:
     """Removes every entry; returns how many there were."""
-    return int(_drafter.cache(os.fspath(cache), "clear"))
+    return int(_drafter.cache(_cache_path(cache), "clear"))

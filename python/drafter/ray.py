@@ -7,17 +7,17 @@ report as ``drafter bake DIR -o OUT --report``.
     ray.init(address="auto")                     # a cluster started with `ray start --head` / `--address`
     report = drafter.ray.bake_catalog(["/data/catalog"], "/data/baked", cache="/data/drafter-cache")
 
-Every write is atomic (a temporary file renamed into place), so a task that Ray retries after a
-worker or node is lost leaves no partial file and bakes the same bytes again; with a cache, a retry
-of a file already baked is a hit. A file drafter refuses is a ``"failed"`` record (not retried).
+Every path (inputs, manifests, ``out_dir``, ``cache``, ``report``, a config file) is resolved on
+the driver, against its working folder, before any task is sent: the workers' working folder is
+``/``. Every write is atomic (a temporary file renamed into place), so a task that Ray retries
+after a worker or node is lost leaves no partial file and bakes the same bytes again; with a
+cache, a retry of a file already baked is a hit. A file drafter refuses is a ``"failed"`` record (not retried).
 Inputs, outputs and the cache must be on storage every node sees (NFS or another shared folder).
 """
 
-from __future__ import annotations
-
-import json
-import os
-import time
+import json as _json
+import os as _os
+import time as _time
 from typing import Any, Iterable, List, Optional, Sequence, Tuple
 
 import drafter
@@ -34,13 +34,20 @@ def _bake_chunk(pairs: Sequence[Tuple[str, str]], options: dict, cpus: int) -> L
     return [dict(drafter.bake_file(i, o, threads=cpus, **options), node=node) for i, o in pairs]
 
 
+def _absolute(path: Any) -> str:
+    """``path`` against the driver's working folder (the workers' is ``/``)."""
+    return _os.path.abspath(_os.path.expanduser(_os.fspath(path)))
+
+
 def _options(config, cache, max_triangles) -> dict:
-    """The per-file options of the tasks. The cache's size bound is not among them: eviction lists
-    the whole cache, so the driver runs it once at the end instead of every task after every file."""
-    if isinstance(config, os.PathLike):
-        with open(config, encoding="utf-8") as f:
-            config = f.read()
-    return {"config": config, "cache": None if cache is None else os.fspath(cache), "max_triangles": max_triangles}
+    """The per-file options of the tasks, every path made absolute and a config file read here.
+    The cache's size bound is not among them: eviction lists the whole cache, so the driver runs it
+    once at the end instead of every task after every file."""
+    return {
+        "config": drafter._config_value(config),
+        "cache": None if cache is None else _absolute(cache),
+        "max_triangles": max_triangles,
+    }
 
 
 def bake_catalog(
@@ -69,13 +76,16 @@ def bake_catalog(
 
     if not ray.is_initialized():
         ray.init()
-    started = time.perf_counter()
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
+    started = _time.perf_counter()
+    out_dir = _absolute(out_dir)
+    inputs = [_absolute(p) for p in drafter._paths(inputs, "inputs")]
+    manifests = [_absolute(p) for p in drafter._paths(manifests, "manifests")]
+    options = _options(config, cache, max_triangles)
+    _os.makedirs(out_dir, exist_ok=True)
     items = drafter.discover(inputs, manifests, skip=out_dir)
-    pairs = [(i, os.path.join(out_dir, o)) for i, o in items]
+    pairs = [(i, _os.path.join(out_dir, o)) for i, o in items]
     for _, output in pairs:
-        os.makedirs(os.path.dirname(output) or ".", exist_ok=True)
+        _os.makedirs(_os.path.dirname(output) or ".", exist_ok=True)
     # Largest first, as the local batch orders its files: a big file started last would keep the
     # cluster waiting on one task.
     order = sorted(range(len(pairs)), key=lambda k: (-_size(pairs[k][0]), k))
@@ -87,21 +97,20 @@ def bake_catalog(
         retry_exceptions=False,
         runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}},
     )
-    options = _options(config, cache, max_triangles)
     refs = [task.remote([pairs[k] for k in chunk], options, cpus) for chunk in chunks]
     records: List[Optional[dict]] = [None] * len(pairs)
     for chunk, ref in zip(chunks, refs):
         try:
             results = ray.get(ref)
         except Exception as e:  # a task that failed past its retries: its files fail, the rest go on
-            results = [_lost(pairs[k], e) for k in chunk]
+            results = [_lost(*pairs[k], e) for k in chunk]
         for k, record in zip(chunk, results):
             records[k] = record
-    if cache is not None and cache_max is not None:
-        drafter.cache_evict(cache, cache_max)
+    if options["cache"] is not None and cache_max is not None:
+        drafter.cache_evict(options["cache"], cache_max)
     summary = _summary(records, started, len(chunks))
     if report is not None:
-        _write_atomically(os.fspath(report), json.dumps(summary, indent=2).encode())
+        _write_atomically(_absolute(report), _json.dumps(summary, indent=2).encode())
     return summary
 
 
@@ -109,40 +118,42 @@ def bake_dataset(dataset: Any, out_dir: Any, *, column: str = "path", cpus_per_t
     """Bakes the files named by ``column`` of a Ray Dataset into ``out_dir`` (their file names under
     it), returning a Dataset of the per-file records (as JSON text in column ``record``). The
     options are ``bake_catalog``'s: ``config``, ``cache``, ``max_triangles`` (bound the cache with
-    ``drafter.cache_evict`` once the dataset is consumed)."""
+    ``drafter.cache_evict`` once the dataset is consumed). Relative paths in the column are taken
+    against the driver's working folder, as every other path."""
     options = _options(kwargs.pop("config", None), kwargs.pop("cache", None), kwargs.pop("max_triangles", None))
     if kwargs:
         raise TypeError(f"unknown options: {sorted(kwargs)}")
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
+    out_dir = _absolute(out_dir)
+    _os.makedirs(out_dir, exist_ok=True)
     cpus = max(1, int(cpus_per_task))
+    base = _os.getcwd()
 
     def one(row: dict) -> dict:
-        source = row[column]
-        output = os.path.join(out_dir, os.path.splitext(os.path.basename(source))[0] + ".glb")
-        return {"record": json.dumps(drafter.bake_file(source, output, threads=cpus, **options))}
+        source = _os.path.join(base, _os.path.expanduser(_os.fspath(row[column])))
+        output = _os.path.join(out_dir, _os.path.splitext(_os.path.basename(source))[0] + ".glb")
+        return {"record": _json.dumps(drafter.bake_file(source, output, threads=cpus, **options))}
 
     return dataset.map(one, num_cpus=cpus, runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}})
 
 
 def _size(path: str) -> int:
     try:
-        return os.path.getsize(path)
+        return _os.path.getsize(path)
     except OSError:
         return 0
 
 
-def _lost(pair: Tuple[str, str], error: BaseException) -> dict:
+def _lost(input: str, output: str, error: BaseException) -> dict:
     return {
-        "input": pair[0],
-        "output": pair[1],
+        "input": input,
+        "output": output,
         "status": "failed",
         "cache": "off",
         "ms": 0.0,
         "bytes_in": 0,
         "bytes_out": 0,
         "estimated_peak_bytes": 0,
-        "error": f"{pair[0]}: the Ray task failed: {type(error).__name__}: {error}".replace("\n", " "),
+        "error": f"{input}: the Ray task failed: {type(error).__name__}: {error}".replace("\n", " "),
         "exit_code": 1,
     }
 
@@ -156,15 +167,15 @@ def _summary(records: List[Optional[dict]], started: float, tasks: int) -> dict:
         "cached": count("cached"),
         "failed": count("failed"),
         "skipped": count("skipped"),
-        "wall_ms": (time.perf_counter() - started) * 1e3,
+        "wall_ms": (_time.perf_counter() - started) * 1e3,
         "tasks": tasks,
     }
 
 
 def _write_atomically(path: str, data: bytes) -> None:
-    temp = f"{path}.{os.getpid()}.tmp"
+    temp = f"{path}.{_os.getpid()}.tmp"
     with open(temp, "wb") as f:
         f.write(data)
         f.flush()
-        os.fsync(f.fileno())
-    os.replace(temp, path)
+        _os.fsync(f.fileno())
+    _os.replace(temp, path)

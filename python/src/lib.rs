@@ -2,26 +2,59 @@
 //! drafter-catalog, the crate `drafter bake` runs, so a bake from Python is the CLI's bake byte for
 //! byte. Every call releases the GIL while it works; `threads=N` runs it on a pool of its own.
 //! The Python-facing API (argument normalisation, docs, type hints) is `drafter/__init__.py`.
+//!
+//! `bake_many` runs the batch on a thread of its own while the calling thread, the GIL released,
+//! looks for Python's signals every [`SIGNAL_POLL`]: a Ctrl-C stops the batch at the next file as
+//! the CLI's first Ctrl-C does, and the caller gets the partial report with the
+//! `KeyboardInterrupt`. The progress callback takes the GIL only while it runs.
 
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
 
 use drafter_bake::BakeConfig;
 use drafter_catalog::batch::{self, Permit};
 use drafter_catalog::cache::Cache;
 use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyOSError};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
 
 create_exception!(_drafter, DrafterError, PyException, "A drafter error (the base class).");
 create_exception!(_drafter, InputError, DrafterError, "Bad input or options (the CLI's exit code 2).");
-create_exception!(_drafter, IoError, DrafterError, "A file could not be read or written (exit code 3).");
 create_exception!(_drafter, InternalError, DrafterError, "A bug in drafter (exit code 1): please report it.");
+
+/// `IoError(DrafterError, OSError)`: made at import by calling `type`, since `create_exception!`
+/// takes one base class.
+static IO_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn io_error_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
+    IO_ERROR
+        .get_or_try_init(py, || {
+            let bases = PyTuple::new(py, [py.get_type::<DrafterError>(), py.get_type::<PyOSError>()])?;
+            let namespace = PyDict::new(py);
+            namespace.set_item("__doc__", "A file could not be read or written (exit code 3); an OSError.")?;
+            namespace.set_item("__module__", "drafter._drafter")?;
+            let made = py.get_type::<PyType>().call1(("IoError", bases, namespace))?;
+            Ok::<_, PyErr>(made.cast_into::<PyType>()?.unbind())
+        })
+        .map(|t| t.bind(py))
+}
+
+fn io_error(message: String) -> PyErr {
+    Python::attach(|py| match io_error_type(py) {
+        Ok(t) => PyErr::from_type(t.clone(), (message,)),
+        Err(e) => e,
+    })
+}
 
 fn to_py(e: &drafter_catalog::Error) -> PyErr {
     let message = e.to_string().replace('\n', " ");
     match e.exit_code() {
         drafter_catalog::exit::BAD_INPUT => InputError::new_err(message),
-        drafter_catalog::exit::IO_FAILURE => IoError::new_err(message),
+        drafter_catalog::exit::IO_FAILURE => io_error(message),
         _ => InternalError::new_err(message),
     }
 }
@@ -142,16 +175,53 @@ fn bake_file(
 }
 
 fn open_cache(dir: Option<&Path>, max: Option<u64>) -> PyResult<Option<Cache>> {
-    dir.map(|d| {
-        Cache::open(d, max).map_err(|e| IoError::new_err(format!("{}: cannot open the cache: {e}", d.display())))
-    })
-    .transpose()
+    dir.map(|d| Cache::open(d, max).map_err(|e| io_error(format!("{}: cannot open the cache: {e}", d.display()))))
+        .transpose()
+}
+
+/// How often `bake_many`'s calling thread looks for Python's signals (a Ctrl-C).
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// `bake_many`'s observer: counts the files finished and calls the Python callback, if any, with
+/// each one's record as JSON text, with how many have finished and how many the batch holds. The
+/// GIL is taken only for the call. A callback that raises stops the batch; its error is kept.
+struct Progress<'a> {
+    callback: Option<Py<PyAny>>,
+    total: AtomicUsize,
+    done: AtomicUsize,
+    stop: &'a AtomicBool,
+    error: Mutex<Option<PyErr>>,
+}
+
+impl batch::Observer for Progress<'_> {
+    fn begin(&self, files: usize, _bytes: u64) {
+        self.total.store(files, Ordering::SeqCst);
+    }
+
+    fn finished(&self, _item: &drafter_catalog::discover::Item, _bytes: u64, record: &batch::Record) {
+        let done = self.done.fetch_add(1, Ordering::SeqCst) + 1;
+        let Some(callback) = &self.callback else { return };
+        let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
+        if error.is_some() {
+            return;
+        }
+        let total = self.total.load(Ordering::SeqCst);
+        let result = serde_json::to_string(record)
+            .map_err(|e| InternalError::new_err(e.to_string()))
+            .and_then(|text| Python::attach(|py| callback.call1(py, (text, done, total)).map(drop)));
+        if let Err(e) = result {
+            *error = Some(e);
+            self.stop.store(true, Ordering::SeqCst);
+        }
+    }
 }
 
 /// Bakes many inputs (files, folders, manifests) into `out_dir` as `drafter bake ... -o DIR` does;
-/// returns the batch report as JSON text.
+/// returns the batch report as JSON text, and the exception that stopped the batch, if one did (a
+/// `KeyboardInterrupt` from Ctrl-C, or what `progress` raised): the caller raises it with the
+/// report.
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, *, manifests=Vec::new(), config_toml=None, config_json=None, cache=None, cache_max=None, memory=None, jobs=None, max_triangles=None))]
+#[pyo3(signature = (inputs, out_dir, *, manifests=Vec::new(), config_toml=None, config_json=None, cache=None, cache_max=None, memory=None, jobs=None, max_triangles=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn bake_many(
     py: Python<'_>,
@@ -165,7 +235,8 @@ fn bake_many(
     memory: Option<u64>,
     jobs: Option<usize>,
     max_triangles: Option<u64>,
-) -> PyResult<String> {
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(String, Option<Py<PyAny>>)> {
     let items = discover(inputs, manifests, Some(out_dir.clone()))?;
     let options = batch::Options {
         config: config(config_toml, config_json)?,
@@ -178,17 +249,48 @@ fn bake_many(
         .into_iter()
         .map(|(input, relative_output)| drafter_catalog::discover::Item { input, relative_output })
         .collect();
-    let summary = py.detach(|| {
+    let stop = AtomicBool::new(false);
+    let observer = Progress {
+        callback: progress,
+        total: AtomicUsize::new(0),
+        done: AtomicUsize::new(0),
+        stop: &stop,
+        error: Mutex::new(None),
+    };
+    let outcome = py.detach(|| {
         std::fs::create_dir_all(&out_dir)
             .map_err(|e| drafter_catalog::Error::Io(format!("{}: cannot create: {e}", out_dir.display())))?;
-        let summary = batch::run(&items, &out_dir, &options, &|| false, &batch::Quiet);
+        let caller = std::thread::current();
+        let (summary, interrupt) = std::thread::scope(|scope| {
+            let batch = scope.spawn(|| {
+                let summary = batch::run(&items, &out_dir, &options, &|| stop.load(Ordering::SeqCst), &observer);
+                caller.unpark();
+                summary
+            });
+            // The signal handlers of Python run on the main thread only when it asks
+            // (`PyErr_CheckSignals`); a worker's own check would never see them.
+            let mut interrupt = None;
+            while !batch.is_finished() {
+                std::thread::park_timeout(SIGNAL_POLL);
+                if interrupt.is_none()
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    stop.store(true, Ordering::SeqCst);
+                    interrupt = Some(e);
+                }
+            }
+            let summary = batch.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (summary, interrupt)
+        });
         if let Some(cache) = &options.cache {
             cache.evict();
         }
-        Ok(summary)
+        Ok((summary, interrupt))
     });
-    let summary = summary.map_err(|e: drafter_catalog::Error| to_py(&e))?;
-    serde_json::to_string(&summary).map_err(|e| InternalError::new_err(e.to_string()))
+    let (summary, interrupt) = outcome.map_err(|e: drafter_catalog::Error| to_py(&e))?;
+    let report = serde_json::to_string(&summary).map_err(|e| InternalError::new_err(e.to_string()))?;
+    let error = interrupt.or_else(|| observer.error.lock().unwrap_or_else(|e| e.into_inner()).take());
+    Ok((report, error.map(|e| e.into_value(py).into_any())))
 }
 
 /// The files a batch of `inputs` and `manifests` holds: (input, output path relative to the output
@@ -224,13 +326,15 @@ fn inspect(
 #[pyfunction]
 #[pyo3(signature = (dir, action, size=None))]
 fn cache(py: Python<'_>, dir: PathBuf, action: &str, size: Option<u64>) -> PyResult<String> {
-    let cache = Cache::open(&dir, size).map_err(|e| IoError::new_err(format!("{}: {e}", dir.display())))?;
+    // As `drafter cache`: a folder that is not a cache is refused, not created.
+    if !dir.join("entries").is_dir() {
+        return Err(InputError::new_err(format!("{}: is not a drafter cache (no entries/ folder)", dir.display())));
+    }
+    let cache = Cache::open(&dir, size).map_err(|e| io_error(format!("{}: {e}", dir.display())))?;
     py.detach(|| match action {
         "stats" => serde_json::to_string(&cache.stats()).map_err(|e| InternalError::new_err(e.to_string())),
         "evict" => serde_json::to_string(&cache.evict()).map_err(|e| InternalError::new_err(e.to_string())),
-        "clear" => {
-            cache.clear().map(|n| n.to_string()).map_err(|e| IoError::new_err(format!("{}: {e}", dir.display())))
-        }
+        "clear" => cache.clear().map(|n| n.to_string()).map_err(|e| io_error(format!("{}: {e}", dir.display()))),
         other => Err(InputError::new_err(format!("unknown cache action {other:?}"))),
     })
 }
@@ -245,7 +349,7 @@ fn _drafter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(cache, m)?)?;
     m.add("DrafterError", m.py().get_type::<DrafterError>())?;
     m.add("InputError", m.py().get_type::<InputError>())?;
-    m.add("IoError", m.py().get_type::<IoError>())?;
+    m.add("IoError", io_error_type(m.py())?)?;
     m.add("InternalError", m.py().get_type::<InternalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("BUILD_ID", drafter_catalog::cache::BUILD_ID)?;
