@@ -30,7 +30,7 @@
 //       background in CSS pixels from the page's top; labels the accessible name of each control;
 //       help whether the help is shown and its text. ok when the page settled (ready or error).
 // Common: --backend webgpu|webgl2 (default webgl2; webgpu starts Chromium with WebGPU on SwiftShader's
-// Vulkan, or with DRAFTER_WEBGPU_ARGS), --timeout S (default 120), --param NAME=VALUE (a page
+// Vulkan, or with DRAFTER_WEBGPU_ARGS), --timeout S (default 120, or DRAFTER_WEB_TIMEOUT), --param NAME=VALUE (a page
 // parameter, repeatable; replaces the one this script sets; --param NAME alone removes it), --dpr N (devicePixelRatio, default 1),
 // --no-size (no size parameter: the canvas fills the page, in device pixels), --controls (show the
 // toolbar). Without --edges / --lines the page is told edges=0 / lines=0 (its default is on for a
@@ -49,7 +49,7 @@ import { startServer } from './lib/server.mjs';
 
 function parse(argv) {
   const [command, pageDir, file, ...rest] = argv;
-  const options = { backend: 'webgl2', timeout: '120', size: '800x600', view: '35,25', shadow: 'none', param: [] };
+  const options = { backend: 'webgl2', timeout: process.env.DRAFTER_WEB_TIMEOUT ?? '120', size: '800x600', view: '35,25', shadow: 'none', param: [] };
   const flags = ['edges', 'lines', 'no-src', 'capture', 'no-size', 'controls', 'reload', 'lose-device', 'help-key'];
   for (let i = 0; i < rest.length; i++) {
     const name = rest[i].replace(/^--/, '');
@@ -67,7 +67,9 @@ async function settle(page, timeoutMs, loads) {
     .waitForFunction(
       (loads) => {
         const v = document.getElementById('viewer');
-        return ['ready', 'error', 'empty'].includes(v?.state) && (loads === undefined || v.loads > loads || v.state === 'error');
+        // (A page without `loads`, as before issue 60, settles on its state alone.)
+        const newer = loads === undefined || v.loads === undefined || v.loads > loads || v.state === 'error';
+        return ['ready', 'error', 'empty'].includes(v?.state) && newer;
       },
       { timeout: timeoutMs, polling: 100 },
       loads,
@@ -154,7 +156,7 @@ async function probe(page, options, file, settled, timeoutMs) {
     return {
       state: v.state,
       message: v.message,
-      notice: root.querySelector('.notice').hidden ? '' : v.notice,
+      notice: !root.querySelector('.notice') || root.querySelector('.notice').hidden ? '' : v.notice,
       backend: v.viewer?.backend() ?? null,
       viewerState: v.viewer ? JSON.parse(v.viewer.state()) : null,
       summary: v.summary,
@@ -165,7 +167,7 @@ async function probe(page, options, file, settled, timeoutMs) {
         modelTop,
       },
       labels,
-      help: { shown: !help.hidden, text: help.hidden ? '' : help.textContent },
+      help: { shown: Boolean(help && !help.hidden), text: help && !help.hidden ? help.textContent : '' },
     };
   });
   return { ok: settled, ...report };
