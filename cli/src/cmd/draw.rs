@@ -140,6 +140,7 @@ pub fn run(args: Args) -> Result<()> {
             "edges": s.edges,
             "silhouettes": s.silhouettes,
             "duplicates": s.duplicates,
+            "merged": s.merged,
             "triangles": s.triangles,
             "pairs_tested": s.pairs_tested,
             "visible_px": s.visible_px,

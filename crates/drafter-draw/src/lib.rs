@@ -23,8 +23,14 @@
 //! is never visited) returns; its visible part is the rest. Change points are therefore found to
 //! rounding, not by sampling; a triangle hides a point only when it is closer by more than a
 //! relative `1e-7` of the closeness, so the faces meeting at an edge never hide it. Pieces shorter
-//! than [`DrawOptions::tolerance_px`] are dropped and edges drawn twice (both parts of a border)
-//! once; pieces sharing end points are chained into polylines.
+//! than [`DrawOptions::tolerance_px`] are dropped.
+//!
+//! # Visibility first, then what shares pixels
+//! Every edge is decided on its own (an edge listed twice in 3D once). Only then are pieces of
+//! different edges that overlap on one screen line merged ([`merge`]): the near and far halves of
+//! a circle seen edge-on, the front and back edges of a face seen edge-on. A visible piece wins
+//! over a hidden one, so which edge comes first never turns a visible line hidden, and a line is
+//! drawn once. Pieces sharing end points are then chained into polylines.
 //!
 //! Limits: edges are the file's edges, so a curved CAD surface's outline is its tessellation's;
 //! lines are not clipped against each other's widths (a line passing just behind another's
@@ -46,8 +52,10 @@ use drafter_scene::model::Model;
 use drafter_scene::style::{DEFAULT_FOV_Y_DEG, View};
 
 pub mod fills;
+pub mod merge;
 
 pub use crate::fills::{Fill, PartFill};
+pub use crate::merge::doubled_visible_length;
 
 /// What a drawing shows of the lines hidden by surfaces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,7 +77,8 @@ pub struct DrawOptions {
     pub orthographic: bool,
     pub fov_y_deg: f32,
     pub hidden: Hidden,
-    /// Pieces shorter than this (pixels) are dropped, and end points closer than it are joined.
+    /// Pieces shorter than this (pixels) are dropped, pieces of one screen line within it of each
+    /// other merged, and end points closer than it joined.
     pub tolerance_px: f64,
     /// Part fills under the lines ([`crate::fills`]).
     pub fill: Fill,
@@ -108,8 +117,10 @@ pub struct DrawStats {
     pub edges: usize,
     /// Of which silhouettes.
     pub silhouettes: usize,
-    /// Edges dropped as drawn twice.
+    /// Edges listed twice in 3D (same class, same end points), decided once.
     pub duplicates: usize,
+    /// Pieces drawn as part of another on the same screen line (see [`merge`]).
+    pub merged: usize,
     /// Triangle-edge pairs tested exactly (after the BVH).
     pub pairs_tested: u64,
     /// Visible and hidden length in pixels.
@@ -556,7 +567,7 @@ pub struct EdgeVisibility {
     pub hidden: Vec<(f64, f64)>,
 }
 
-/// Every edge of a view (drawn twice: once) and what hides it.
+/// Every edge of a view (one listed twice in 3D: once) and what hides it, each decided on its own.
 #[derive(Clone, Debug)]
 pub struct Visibility {
     pub projection: Projection,
@@ -573,15 +584,15 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
     let occluders = Occluders::new(&triangles, &projection);
     let mut stats =
         DrawStats { triangles: triangles.corners.len(), edges: edges.len(), silhouettes, ..Default::default() };
-    // Edges drawn twice (a border of two parts, an instance's edge on another's) once: the same
-    // class between the same pixels, to a hundredth of the tolerance.
-    let quantum = (options.tolerance_px.max(0.0) * 0.01).max(1e-9);
-    let key = |p: &Projected| ((p.x / quantum).round() as i64, (p.y / quantum).round() as i64);
+    // An edge listed twice in 3D (the same class between the same world points: a border of two
+    // parts, coincident instances) is decided once: its copies hide and are hidden alike. Edges
+    // that only meet on the screen are each decided on their own; where their pieces overlap,
+    // `merge` picks what is drawn after visibility is known.
     let mut seen = std::collections::HashSet::new();
     let mut unique = Vec::new();
     for edge in &edges {
         let (Some(a), Some(b)) = (projection.project(edge.a), projection.project(edge.b)) else { continue };
-        let (ka, kb) = (key(&a), key(&b));
+        let (ka, kb) = (edge.a.to_array().map(f64::to_bits), edge.b.to_array().map(f64::to_bits));
         let ordered = if ka <= kb { (ka, kb) } else { (kb, ka) };
         if !seen.insert((ordered, edge.class as u32)) {
             stats.duplicates += 1;
@@ -643,6 +654,9 @@ pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
         }
         push(from, 1.0, true);
     }
+    // Visibility first, then what shares pixels: a visible piece over a hidden one.
+    let (pieces, merged) = merge::merge(&pieces, tolerance);
+    stats.merged = merged;
     for p in &pieces {
         let length = p.a.distance(p.b);
         if p.visible {
