@@ -11,7 +11,8 @@
 //!   file's folder; [`split_container`] frames a .glb through [`glb`].
 //! * [`glb`] is the workspace's one GLB framer (split and write), [`meshopt`] its one
 //!   `EXT_meshopt_compression` codec (`compress_glb` for `bake --compress`, `decompress_glb` in front
-//!   of every reader), [`uri`] its one rule for which buffer URIs may be followed and how they are
+//!   of every reader), [`draco`] its one `KHR_draco_mesh_compression` decoder (`decompress`, which the
+//!   importer calls once the buffers are loaded), [`uri`] its one rule for which buffer URIs may be followed and how they are
 //!   read; the importer (drafter-io), inspect, the viewer and the bake all go through them.
 //!
 //! Invariant: this is the only crate that knows the file format. The extension is listed in
@@ -20,6 +21,7 @@
 
 pub mod accessor;
 mod doc;
+pub mod draco;
 mod edit;
 pub mod ext;
 mod external;

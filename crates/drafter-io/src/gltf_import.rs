@@ -4,7 +4,9 @@
 //! hand, because the crate's `import` follows any URI (absolute paths, `..`) and its accessor reader
 //! assumes float positions, while we must (a) confine URIs to the file's folder, (b) read
 //! KHR_mesh_quantization's integer positions and normals, and (c) check every accessor against its
-//! buffer view and buffer, naming the accessor when it does not fit.
+//! buffer view and buffer, naming the accessor when it does not fit. KHR_draco_mesh_compression
+//! streams are decoded by drafter-format (`draco::decompress`) once the buffers are loaded, and the
+//! rest of the import reads the plain document it returns.
 //!
 //! Scene model: every glTF mesh becomes one [`Mesh`] (its primitives concatenated, one
 //! [`TriangleGroup`] per primitive, so `MeshId` = glTF mesh index); every node of the default scene
@@ -20,8 +22,8 @@ use drafter_core::{
     SourceFormat, TriangleGroup,
 };
 use drafter_format::accessor::{self, ComponentType, Layout};
-use drafter_format::glb;
 use drafter_format::uri::read_buffer_uri;
+use drafter_format::{draco, glb};
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::json::validation::Validate as _;
@@ -31,10 +33,13 @@ use crate::Limits;
 use crate::error::{ImportError, ParseError};
 use crate::raw::drop_nonfinite_faces;
 
-/// Required extensions we can honour: quantized attributes are decoded here; the others change only
-/// appearance or textures, which the bake does not decode.
+/// Required extensions we can honour: quantized attributes are decoded here, Draco streams by
+/// drafter-format before the scene is built; the others change only appearance or textures, which
+/// the bake does not decode.
 const ACCEPTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_mesh_quantization",
+    // Decoded into plain accessors before the scene is built (drafter-format's draco.rs).
+    "KHR_draco_mesh_compression",
     "KHR_texture_transform",
     "KHR_texture_basisu",
     "EXT_texture_webp",
@@ -62,16 +67,33 @@ pub(crate) fn import(
     let root: gltf::json::Root = gltf::json::deserialize::from_slice(json_bytes)
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e)).in_path(path))?;
     let document = gltf::Document::from_json_without_validation(root);
-    let doc = &document;
-    check_required_extensions(doc.as_json()).map_err(|e| e.in_path(path))?;
-    validate(doc.as_json()).map_err(|e| e.in_path(path))?;
-    check_listed_triangles(doc, limits).map_err(|e| e.in_path(path))?;
+    check_required_extensions(document.as_json()).map_err(|e| e.in_path(path))?;
+    validate(document.as_json()).map_err(|e| e.in_path(path))?;
+    check_listed_triangles(&document, limits).map_err(|e| e.in_path(path))?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    let mut buffers = load_buffers(doc, blob, folder).map_err(|e| e.in_path(path))?;
+    let mut buffers = load_buffers(&document, blob, folder).map_err(|e| e.in_path(path))?;
+    // KHR_draco_mesh_compression: the streams are decoded once, by drafter-format, into a document
+    // whose accessors point at the decoded data in one more buffer; everything below, and the
+    // writer's pass-through, reads that plain document. The face counts were held against the
+    // limit above (the decoder refuses a stream that declares other counts than the accessors).
+    let (document, json) = match draco::decompress(json_bytes, &buffers) {
+        Ok(None) => (document, String::from_utf8_lossy(json_bytes).into_owned()),
+        Ok(Some(decoded)) => {
+            buffers.push(decoded.buffer);
+            let root: gltf::json::Root = gltf::json::deserialize::from_str(&decoded.json)
+                .map_err(|e| ParseError::in_file(format!("{}: {e}", draco::EXTENSION)).in_path(path))?;
+            validate(&root).map_err(|e| e.in_path(path))?;
+            (gltf::Document::from_json_without_validation(root), decoded.json)
+        }
+        Err(e) => {
+            return Err(ParseError::at_json(e.place, format!("{}: {}", draco::EXTENSION, e.message)).in_path(path));
+        }
+    };
+    let doc = &document;
     let mut scene = build_scene(doc, &buffers, format, diagnostics).map_err(|e| e.in_path(path))?;
     // Keep the JSON text as written (not re-serialised), so nothing the gltf crate does not model is
-    // lost; only image files beside it are taken in (`embed_image_files`).
-    let json = String::from_utf8_lossy(json_bytes).into_owned();
+    // lost; only image files beside it are taken in (`embed_image_files`). A Draco input's is the
+    // decoded document's.
     let names_files =
         doc.images().any(|i| matches!(i.source(), gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:")));
     let json = if names_files { embed_image_files(json, &mut buffers, folder, diagnostics) } else { json };
