@@ -77,8 +77,7 @@ pub struct DrawOptions {
     pub orthographic: bool,
     pub fov_y_deg: f32,
     pub hidden: Hidden,
-    /// Pieces shorter than this (pixels) are dropped, pieces of one screen line within it of each
-    /// other merged, and end points closer than it joined.
+    /// Pieces shorter than this (pixels) are dropped and end points closer than it joined.
     pub tolerance_px: f64,
     /// Part fills under the lines ([`crate::fills`]).
     pub fill: Fill,

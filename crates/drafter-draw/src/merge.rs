@@ -8,8 +8,8 @@
 //! the same visibility the class the SVG draws last (silhouettes, then boundaries, part borders and
 //! non-manifold edges, then creases); ties go to the longer piece.
 //!
-//! A piece is on a line when both its ends lie within [`SAME_PIXELS_PX`] (or the tolerance, if
-//! larger) of the line's longest piece, extended, running along it, and near one of its pieces: two lines a quarter pixel apart print as one at every width drafter draws (0.6 to
+//! A piece is on a line when both its ends lie within [`SAME_PIXELS_PX`] of the line's longest
+//! piece, extended, running along it, and near one of its pieces: two lines a quarter pixel apart print as one at every width drafter draws (0.6 to
 //! 1.6 px), as the outline of a gear seen from above and the crease of its chamfer a sixth of a
 //! pixel inside do. Nothing is moved: where pieces overlap, the one drawn keeps its own line and
 //! the others are left out there. A piece alone on its line is kept exactly as it is.
@@ -24,7 +24,8 @@ use crate::{Drawing, Piece};
 /// Side of the grid cells candidate pairs are found in, in pixels.
 const CELL_PX: f64 = 16.0;
 
-/// Lines closer than this many pixels (or the tolerance, if larger) are drawn as one.
+/// Lines closer than this many pixels are drawn as one (whatever the tolerance: a coarse tolerance
+/// drops short pieces, it does not move lines).
 pub const SAME_PIXELS_PX: f64 = 0.25;
 
 /// Which piece is drawn where pieces overlap: higher wins.
@@ -90,7 +91,7 @@ impl Line {
 /// near it, that it lies on (they become one), or starts a line of its own. Every piece is tested against the line's own direction (its longest piece's), never
 /// against another member, so a line cannot drift along the short pieces of a curve.
 pub(crate) fn merge(pieces: &[Piece], tolerance: f64) -> (Vec<Piece>, usize) {
-    let eps = tolerance.max(SAME_PIXELS_PX);
+    let eps = SAME_PIXELS_PX;
     let length = |i: usize| pieces[i].a.distance(pieces[i].b);
     let mut order: Vec<usize> = (0..pieces.len()).collect();
     order.sort_by(|&x, &y| length(y).total_cmp(&length(x)).then(x.cmp(&y)));
@@ -191,8 +192,8 @@ pub(crate) fn merge(pieces: &[Piece], tolerance: f64) -> (Vec<Piece>, usize) {
 }
 
 /// The pieces a line's overlapping pieces are drawn as: along the line, each stretch shows its
-/// highest-ranked piece; runs of one class and visibility are joined; end points come from the
-/// line of the piece drawn there (exactly its own end points where it ends).
+/// highest-ranked piece; a piece's neighbouring stretches are joined; end points come from the
+/// piece's own line (exactly its own end points where it ends).
 fn paint(pieces: &[Piece], line: &Line, tolerance: f64) -> Vec<Piece> {
     let cluster = &line.pieces;
     let (origin, u) = (line.origin, line.u);
@@ -226,9 +227,10 @@ fn paint(pieces: &[Piece], line: &Line, tolerance: f64) -> Vec<Piece> {
             .filter(|&k| spans[k].0 <= s && spans[k].1 >= e)
             .max_by(|&x, &y| rank(&pieces[cluster[x]]).cmp(&rank(&pieces[cluster[y]])).then(y.cmp(&x)));
         let Some(k) = winner else { continue };
-        let key = |k: usize| (pieces[cluster[k]].class, pieces[cluster[k]].visible);
         match runs.last_mut() {
-            Some(run) if run.3 == s && key(run.2) == key(k) => {
+            // One piece's stretches only: joining two pieces' would draw a segment across from
+            // one's line to the other's.
+            Some(run) if run.3 == s && run.2 == k => {
                 run.2 = k;
                 run.3 = e;
             }
