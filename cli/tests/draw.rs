@@ -1,7 +1,7 @@
 //! `drafter draw`: a valid SVG (xmllint; Chromium draws it where `drafter render --lines` draws its
 //! lines) and PDF (pdfinfo) of the baked sample with its hidden lines in a group of
-//! their own; a model without baked edges gives its outline only, never an error; bad input and bad
-//! options end with exit 2, one line, and no output file. The exactness of the hidden lines is
+//! their own; a model that is not baked (OBJ, STL, plain glTF) is baked in memory and draws the
+//! lines its bake draws; bad input and bad options end with exit 2, one line, and no output file. The exactness of the hidden lines is
 //! `crates/drafter-draw/tests/visibility.rs` (brute force).
 
 mod common;
@@ -82,9 +82,39 @@ fn the_sample_draws_as_a_pdf() {
     assert!(text.contains("Pages:           1") && text.contains("600 x 450 pts"), "{text}");
 }
 
+/// The `d` attributes of an SVG's paths, in order: its strokes and fills.
+fn path_data(svg: &str) -> Vec<&str> {
+    svg.split(" d=\"").skip(1).map(|rest| &rest[..rest.find('"').expect("attribute closes")]).collect()
+}
+
 #[test]
-fn a_model_without_baked_edges_draws_its_outline_or_nothing() {
+fn an_unbaked_model_is_baked_in_memory_and_draws_the_lines_of_its_bake() {
     let dir = common::scratch("draw-plain");
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples");
+    let obj = common::shared_models().join("obj/common-3d-test-models/fandisk.obj");
+    for (input, args) in [
+        (obj.as_path(), &["--hidden", "dashed"][..]),
+        (sample.join("gear.glb").as_path(), &["--view", "0,89.99999", "--ortho", "--hidden", "dashed"][..]),
+    ] {
+        let name = input.file_stem().unwrap().to_string_lossy().into_owned();
+        let baked = dir.join(format!("{name}.baked.glb"));
+        common::bake(input, &baked, &[]);
+        let (plain_svg, baked_svg) = (dir.join(format!("{name}.svg")), dir.join(format!("{name}.baked.svg")));
+        let plain =
+            common::run(&[&["draw", input.to_str().unwrap(), "-o", plain_svg.to_str().unwrap()][..], args].concat());
+        assert!(plain.status.success(), "{name}: {}", String::from_utf8_lossy(&plain.stderr));
+        assert!(String::from_utf8_lossy(&plain.stderr).contains("baked in memory"), "{name}: says so");
+        let run =
+            common::run(&[&["draw", baked.to_str().unwrap(), "-o", baked_svg.to_str().unwrap()][..], args].concat());
+        assert!(run.status.success(), "{name}: {}", String::from_utf8_lossy(&run.stderr));
+        let (a, b) = (std::fs::read_to_string(&plain_svg).unwrap(), std::fs::read_to_string(&baked_svg).unwrap());
+        let strokes = path_data(&a);
+        assert!(strokes.len() > 20, "{name}: lines drawn ({})", strokes.len());
+        assert_eq!(strokes, path_data(&b), "{name}: the same strokes as its bake's");
+        assert!(a.contains(r#"class="crease""#), "{name}: creases known");
+    }
+    // One triangle of STL: its boundary, and fills from both sides (`flat` fills a sheet whichever
+    // face the eye sees, `bands` its front face only).
     let stl = dir.join("tetra.stl");
     std::fs::write(
         &stl,
@@ -92,18 +122,15 @@ fn a_model_without_baked_edges_draws_its_outline_or_nothing() {
     )
     .unwrap();
     let svg = dir.join("t.svg");
-    let run = common::run(&["draw", stl.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let lint = Command::new("xmllint").arg("--noout").arg(&svg).output().expect("xmllint");
-    assert!(lint.status.success());
-    // Filled from both sides: `flat` fills a sheet whichever face the eye sees, `bands` its front
-    // face only.
-    for (view, fill) in [("35,25", "flat"), ("215,-25", "flat"), ("35,25", "bands")] {
+    for (view, fill) in [("35,25", "none"), ("35,25", "flat"), ("215,-25", "flat"), ("35,25", "bands")] {
         let run =
             common::run(&["draw", stl.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--fill", fill, "--view", view]);
         assert!(run.status.success(), "{view} {fill}: {}", String::from_utf8_lossy(&run.stderr));
+        let lint = Command::new("xmllint").arg("--noout").arg(&svg).output().expect("xmllint");
+        assert!(lint.status.success());
         let text = std::fs::read_to_string(&svg).unwrap();
-        assert!(text.contains(r#"<g id="fills""#) || fill == "bands", "{view} {fill}: {text}");
+        assert!(text.contains(r#"class="boundary""#), "{view} {fill}: the triangle's edges: {text}");
+        assert!(text.contains(r#"<g id="fills""#) || fill == "bands" || fill == "none", "{view} {fill}: {text}");
     }
 }
 
@@ -121,6 +148,7 @@ fn bad_input_and_bad_options_end_with_exit_2_and_no_file() {
         vec!["draw", g, "-o", s],
         vec!["draw", sample, "-o", s, "--size", "0x600"],
         vec!["draw", sample, "-o", s, "--tolerance=-1"],
+        vec!["draw", sample, "-o", s, "--tolerance", "-1"],
         vec!["draw", sample, "-o", s, "--tolerance", "NaN"],
         vec!["draw", sample, "-o", s, "--view", "0,90"],
         vec!["draw", sample, "-o", dir.join("out.png").to_str().unwrap()],
@@ -130,6 +158,19 @@ fn bad_input_and_bad_options_end_with_exit_2_and_no_file() {
         assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: one line: {stderr}");
         assert!(!svg.exists(), "{args:?}: no output");
+    }
+    // What each refusal blames: a negative tolerance parses and is refused by name, an infinite
+    // azimuth is the azimuth's fault, a missing folder is found before the model is even read.
+    for (args, words) in [
+        (vec!["draw", sample, "-o", s, "--tolerance", "-1"], "--tolerance -1"),
+        (vec!["draw", sample, "-o", s, "--view", "inf,0"], "azimuth"),
+        (vec!["draw", g, "-o", dir.join("missing/out.svg").to_str().unwrap(), "--view", "inf,0"], "azimuth"),
+        (vec!["draw", g, "-o", dir.join("missing/out.svg").to_str().unwrap()], "no folder"),
+    ] {
+        let run = common::run(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(words), "{args:?}: {stderr}");
     }
 }
 

@@ -3,7 +3,7 @@
 //! (drafter-draw, which reads drafter-scene's model and links no GPU code): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use drafter_draw::{self as drawing, DrawOptions, Fill, Hidden};
@@ -16,7 +16,8 @@ use crate::exit::BadInput;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The model to draw: a baked .glb/.gltf (its edges and silhouette hierarchies), or any model
-    /// (then only its outline is known: bake it first for creases).
+    /// drafter reads (.glb/.gltf, .obj, .stl, .off, .ply), which is then baked in memory with the
+    /// default settings first, so it draws the lines its bake would.
     pub file: PathBuf,
     /// The drawing to write: .svg, or .pdf (the same strokes on one page, a pixel as 0.75 pt).
     #[arg(short, long)]
@@ -38,7 +39,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = FillArg::None)]
     pub fill: FillArg,
     /// Pieces shorter than this many pixels are dropped and end points closer than it joined.
-    #[arg(long, value_name = "PX", default_value_t = 0.05)]
+    #[arg(long, value_name = "PX", default_value_t = 0.05, allow_negative_numbers = true)]
     pub tolerance: f64,
     /// Print the drawing's figures as JSON on stdout.
     #[arg(long)]
@@ -85,13 +86,33 @@ impl From<HiddenArg> for Hidden {
     }
 }
 
-/// Reads the model to draw (import errors keep their exit code; a file that loads but cannot be
-/// drawn is bad input).
-fn load(path: &std::path::Path, max_triangles: u64) -> Result<Model> {
-    Model::load_within(path, &drafter_io::Limits { max_triangles }).map_err(|e| match e {
+/// Reads the model to draw. A file without `DRAFTER_illustration` data has no baked edges: it is
+/// baked in memory first, through the one path from a file to its bake (drafter-catalog's
+/// `bake_bytes`, as `drafter bake` runs it, with the default settings), so it draws the lines its
+/// bake would. Import errors keep their exit code; a file that loads but cannot be drawn is bad
+/// input.
+fn load(path: &Path, max_triangles: u64) -> Result<(Model, bool)> {
+    let limits = drafter_io::Limits { max_triangles };
+    let bytes = drafter_catalog::job::read_input(path)?;
+    let bad = |e: LoadError| match e {
         LoadError::Import(e) => anyhow::Error::from(e),
         other => anyhow::Error::from(BadInput(other.to_string())),
-    })
+    };
+    if is_baked(path, &bytes) {
+        return Ok((Model::load_bytes_within(path, &bytes, &limits).map_err(bad)?, false));
+    }
+    let config = drafter_bake::BakeConfig::default();
+    let baked = drafter_catalog::job::bake_bytes(path, bytes, &config, &limits, &mut |_| {})?;
+    // The default container is one self-contained .glb, named as `drafter bake` would name it.
+    let name = path.with_extension("baked.glb");
+    Ok((Model::load_bytes_within(&name, &baked.written.main, &limits).map_err(bad)?, true))
+}
+
+/// Whether `bytes` carry `DRAFTER_illustration` data (a compressed GLB decoded first, as the model
+/// loader does). A file whose data does not read counts as baked: loading it reports why.
+fn is_baked(path: &Path, bytes: &[u8]) -> bool {
+    let plain = drafter_format::meshopt::decompress_glb(bytes).ok().flatten();
+    !matches!(drafter_format::read_if_baked(path, plain.as_deref().unwrap_or(bytes)), Ok(None))
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -111,10 +132,25 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     let view = View { azimuth_deg: args.view.0, elevation_deg: args.view.1 };
-    if !(view.elevation_deg > -90.0 && view.elevation_deg < 90.0 && view.azimuth_deg.is_finite()) {
+    if !view.azimuth_deg.is_finite() {
+        return Err(BadInput(format!(
+            "--view {},{}: azimuth must be a finite number of degrees",
+            args.view.0, args.view.1
+        ))
+        .into());
+    }
+    if !(view.elevation_deg > -90.0 && view.elevation_deg < 90.0) {
         return Err(BadInput(format!("--view {},{}: elevation must be in (-90, 90)", args.view.0, args.view.1)).into());
     }
-    let model = load(&args.file, args.max_triangles)?;
+    // The output's folder before any work: a drawing of a large model takes seconds.
+    let folder = args.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        return Err(BadInput(format!("{}: no folder {} to write into", args.output.display(), folder.display())).into());
+    }
+    if args.output.is_dir() {
+        return Err(BadInput(format!("{}: is a folder", args.output.display())).into());
+    }
+    let (model, baked_here) = load(&args.file, args.max_triangles)?;
     let options = DrawOptions {
         size: args.size,
         view,
@@ -163,6 +199,9 @@ pub fn run(args: Args) -> Result<()> {
             s.elapsed.as_secs_f64() * 1e3,
             bytes.len()
         );
+        if baked_here {
+            eprintln!("  note: {} has no baked lines: baked in memory with the default settings", args.file.display());
+        }
         for notice in &model.notices {
             eprintln!("  note: {notice}");
         }
