@@ -22,7 +22,8 @@
 //! triangles a BVH of projected boxes (obvhs, `x`, `y` and `c`; a triangle wholly behind the edge
 //! is never visited) returns; its visible part is the rest. Change points are therefore found to
 //! rounding, not by sampling; a triangle hides a point only when it is closer by more than a
-//! relative `1e-7` of the closeness, so the faces meeting at an edge never hide it. Pieces shorter
+//! relative `1e-6` of the closeness, so the faces meeting at an edge never hide it, nor a surface
+//! touching it within the rounding of the file's `f32` positions. Pieces shorter
 //! than [`DrawOptions::tolerance_px`] are dropped.
 //!
 //! # Visibility first, then what shares pixels
@@ -393,8 +394,10 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
 }
 
 /// Closeness tolerance: a triangle hides a point when closer by more than this share of the
-/// point's closeness.
-const CLOSER_BY: f64 = 1e-7;
+/// point's closeness. 1e-7 let a part's face touching another's silhouette within a few `f32`
+/// roundings (1.9e-7 of the distance to the eye, the sample assembly's axis views in perspective)
+/// hide it; brute force, which ignores hits within 1e-6 of the point, saw it visible.
+const CLOSER_BY: f64 = 1e-6;
 
 /// The interval of `u` in [0, 1] over which the projected triangle `t` hides the projected
 /// segment `a → b`, if any (see the module docs).

@@ -244,18 +244,15 @@ fn visible_drawn_visible(model: &Model, options: &DrawOptions, per_edge: usize) 
 
 /// Exact axis views, where different edges project onto the same pixels (the near and far halves
 /// of an edge-on circle, the top and bottom outlines of a gear seen from above): every point brute
-/// force finds visible is drawn visible, and the visible length drawn twice stays under 2%.
+/// force finds visible is drawn visible, and in orthographic views the visible length drawn twice
+/// stays under 2%.
 #[test]
 fn axis_views_draw_every_visible_line_visible_and_once() {
     let all = [((0.0, 0.0), true), ((0.0, 0.0), false), ((0.0, STEEPEST), true), ((90.0, STEEPEST), false)];
-    // The sample's axis views in perspective are left out: there brute force finds points visible
-    // that the edges' own intervals hide (52 of 1,262 from the front, 105 of 1,471 from the top;
-    // 8 and 12 of them drawn hidden), which the merge does not cause and which is not understood
-    // yet (docs/drawing.md).
     let models = [
         ("cylinder", cylinder("axis"), &all[..]),
         ("gear", common::baked(&common::repo_path("samples/gear.glb")), &all[..]),
-        ("sample", common::sample(), &[all[0], all[2]][..]),
+        ("sample", common::sample(), &all[..]),
     ];
     for (name, model, views) in &models {
         for &(view, orthographic) in *views {
@@ -271,8 +268,10 @@ fn axis_views_draw_every_visible_line_visible_and_once() {
             assert!(visible > 200, "{name} {view:?}: enough samples ({visible})");
             assert_eq!(lost, 0, "{name} {view:?} ortho {orthographic}: visible points not drawn visible");
             assert_eq!(disagree, 0, "{name} {view:?} ortho {orthographic}: intervals against brute force");
+            // In perspective the two edges of a face seen edge-on converge: near the eye's height they
+            // run within half a pixel but more than the merging distance apart, distinct lines.
             assert!(
-                doubled <= 0.02 * length,
+                !orthographic || doubled <= 0.02 * length,
                 "{name} {view:?} ortho {orthographic}: doubled {doubled:.0} of {length:.0} px"
             );
         }
