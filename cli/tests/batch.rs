@@ -455,3 +455,239 @@ fn refusals_are_replayed_from_the_cache_with_the_same_reason() {
     let other = run(&["--max-triangles", "1000000"]);
     assert!(other.iter().all(|f| f.1 == "miss"), "{other:?}");
 }
+
+/// `[k/n] name: ...` lines on a pipe, and the notes a single bake prints (issue 56).
+#[test]
+fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
+    let dir = common::scratch("batch-pipe");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    std::fs::write(input.join("a.off"), tetrahedron(1)).unwrap();
+    // One vertex that is not a number: its face is dropped with a note.
+    std::fs::write(
+        input.join("nan.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv nan 0 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 2 5\n",
+    )
+    .unwrap();
+    let single = common::drafter().arg("bake").arg(input.join("nan.obj")).arg("-o").arg(dir.join("one.glb")).output();
+    let single = String::from_utf8_lossy(&single.unwrap().stderr).into_owned();
+    assert!(single.contains("non-finite positions: 1"), "{single}");
+    let out = common::drafter().arg("bake").arg(&input).arg("-o").arg(dir.join("out")).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains('\r'), "no carriage returns on a pipe: {stderr:?}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with('[')).collect();
+    assert_eq!(lines.len(), 2, "{stderr}");
+    assert!(lines.iter().any(|l| l.starts_with("[1/2] ")) && lines.iter().any(|l| l.starts_with("[2/2] ")), "{stderr}");
+    assert!(lines.iter().all(|l| l.contains(": baked ")), "{stderr}");
+    assert!(stderr.contains("note: non-finite positions: 1"), "{stderr}");
+    // --quiet: nothing but failures.
+    let quiet = common::drafter().arg("bake").arg(&input).arg("-o").arg(dir.join("q")).arg("--quiet").output().unwrap();
+    assert!(quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
+}
+
+/// An output found up to date by its receipt still counts as a use of its cache entry, so
+/// eviction keeps the set in use (issue 56: bake A, bake B, rebake A, evict: A was gone).
+#[test]
+fn eviction_keeps_an_entry_whose_output_was_up_to_date() {
+    let dir = common::scratch("batch-evict-lru");
+    let cache = dir.join("cache");
+    for (name, k) in [("a", 1), ("b", 2)] {
+        std::fs::create_dir_all(dir.join(name)).unwrap();
+        std::fs::write(dir.join(name).join(format!("{name}.off")), tetrahedron(k)).unwrap();
+    }
+    let bake = |name: &str, out: &str| -> serde_json::Value {
+        let output = common::drafter()
+            .arg("bake")
+            .arg(dir.join(name))
+            .arg("-o")
+            .arg(dir.join(out))
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--json")
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        serde_json::from_slice(&output.stdout).unwrap()
+    };
+    bake("a", "out");
+    std::thread::sleep(Duration::from_millis(50));
+    bake("b", "out");
+    std::thread::sleep(Duration::from_millis(50));
+    let again = bake("a", "out");
+    assert_eq!(again["files"][0]["up_to_date"], true, "{again}");
+    let stats = common::run(&["cache", "stats", "--cache", cache.to_str().unwrap(), "--json"]);
+    let stats: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
+    assert_eq!(stats["entries"], 2);
+    // Room for one entry: the least recently used goes, which is b.
+    let one = stats["bytes"].as_u64().unwrap() * 2 / 3;
+    let evicted = common::run(&["cache", "evict", &one.to_string(), "--cache", cache.to_str().unwrap()]);
+    assert!(evicted.status.success(), "{}", String::from_utf8_lossy(&evicted.stderr));
+    // Fresh output folders (no receipts): a is served from the cache, b is baked again.
+    assert_eq!(bake("a", "fresh")["files"][0]["cache"], "hit");
+    assert_eq!(bake("b", "fresh")["files"][0]["cache"], "miss");
+}
+
+/// A file over the whole memory budget runs alone, and the summary and the report say so
+/// (issue 56: the summary said "at most 50 MB estimated at once" of a 579 MB file).
+#[test]
+fn a_file_over_the_memory_budget_runs_alone_and_the_report_says_so() {
+    let dir = common::scratch("batch-over-budget");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb"), input.join("s.glb")).unwrap();
+    std::fs::write(input.join("a.off"), tetrahedron(1)).unwrap();
+    let report_path = dir.join("r.json");
+    let out = common::drafter()
+        .arg("bake")
+        .arg(&input)
+        .arg("-o")
+        .arg(dir.join("out"))
+        .arg("--memory")
+        .arg("1M")
+        .arg("--report")
+        .arg(&report_path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let r = report(&report_path);
+    let over = r["over_budget"].as_u64().unwrap();
+    assert!(over >= 1, "{r}");
+    assert!(r["peak_admitted_bytes"].as_u64().unwrap() > r["memory_budget"].as_u64().unwrap(), "{r}");
+    assert!(stderr.contains("over the budget ran alone"), "{stderr}");
+    assert!(stderr.contains("over the memory budget: ran alone"), "{stderr}");
+    let flagged = r["files"].as_array().unwrap().iter().filter(|f| f["over_budget"] == true).count() as u64;
+    assert_eq!(flagged, over);
+}
+
+/// A refusal replayed from a cache names the input of this run, not the path of the machine (or
+/// folder) that first refused it (issue 56).
+#[test]
+fn a_cached_refusal_names_this_runs_path() {
+    let dir = common::scratch("batch-refusal-path");
+    let cache = dir.join("cache");
+    let sample = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb")).unwrap();
+    let mut errors = Vec::new();
+    for runner in ["runner-one", "runner-two"] {
+        let input = dir.join(runner).join("models");
+        std::fs::create_dir_all(&input).unwrap();
+        std::fs::write(input.join("truncated.glb"), &sample[..sample.len() / 3]).unwrap();
+        let out = common::drafter()
+            .arg("bake")
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.join(runner).join("out"))
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(4));
+        let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        errors.push((r["files"][0]["cache"].clone(), r["files"][0]["error"].as_str().unwrap().to_owned()));
+    }
+    assert_eq!(errors[0].0, "miss");
+    assert_eq!(errors[1].0, "hit");
+    assert!(errors[1].1.contains("runner-two") && !errors[1].1.contains("runner-one"), "{errors:?}");
+    assert_eq!(errors[0].1.replace("runner-one", "runner-two"), errors[1].1);
+}
+
+/// The report counts a .gltf with its buffers, and names the build and the configuration that
+/// made the files (issue 56).
+#[test]
+fn the_report_counts_a_gltfs_buffers_and_names_the_build_and_config() {
+    let dir = common::scratch("batch-report-bytes");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    let mut bin = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(input.join("tri.bin"), &bin).unwrap();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"uri": "tri.bin", "byteLength": 36}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}]
+    });
+    let text = serde_json::to_vec(&json).unwrap();
+    std::fs::write(input.join("tri.gltf"), &text).unwrap();
+    let report_path = dir.join("r.json");
+    let out = common::drafter()
+        .arg("bake")
+        .arg(&input)
+        .arg("-o")
+        .arg(dir.join("out"))
+        .arg("--report")
+        .arg(&report_path)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&report_path);
+    assert_eq!(r["files"][0]["bytes_in"].as_u64().unwrap(), (text.len() + bin.len()) as u64, "{r}");
+    assert_eq!(r["bytes_total"].as_u64().unwrap(), (text.len() + bin.len()) as u64);
+    let build = r["build"].as_str().unwrap();
+    assert!(build.starts_with(env!("CARGO_PKG_VERSION")), "{build}");
+    assert_eq!(r["config"]["lines"]["crease_angle_deg"], 30.0, "{}", r["config"]);
+    assert!(r["config"].get("input").is_none(), "the input is in the file's record, not the config");
+}
+
+/// Checks that run as a user the output folder does not let write, and a subfolder that user
+/// cannot list; as root (CI) through `setpriv` as `nobody`, since root may write anywhere.
+fn as_unprivileged(cmd: &mut std::process::Command) -> std::process::Command {
+    let root = std::process::Command::new("id").arg("-u").output().is_ok_and(|o| o.stdout.trim_ascii() == b"0");
+    if !root {
+        return std::mem::replace(cmd, std::process::Command::new("true"));
+    }
+    let mut wrapped = std::process::Command::new("setpriv");
+    wrapped.args(["--reuid=65534", "--regid=65534", "--clear-groups", "--"]);
+    wrapped.arg(cmd.get_program()).args(cmd.get_args());
+    wrapped
+}
+
+/// A read-only output folder is refused before any bake, with one line and exit 3; a subfolder
+/// that cannot be listed fails alone, by its own path, and the others are baked (issue 56).
+#[test]
+fn a_read_only_output_and_an_unreadable_subfolder_are_named_up_front() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = common::scratch("batch-permissions");
+    let input = dir.join("in");
+    for (name, k) in [("a.off", 1), ("sub/b.off", 2), ("locked/c.off", 3)] {
+        let path = input.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, tetrahedron(k)).unwrap();
+    }
+    let read_only = dir.join("read-only");
+    std::fs::create_dir_all(&read_only).unwrap();
+    std::fs::set_permissions(&read_only, std::fs::Permissions::from_mode(0o555)).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o777)).unwrap();
+    let mut ro = common::drafter();
+    ro.arg("bake").arg(input.join("a.off")).arg(input.join("sub")).arg("-o").arg(&read_only);
+    let started = std::time::Instant::now();
+    let out = as_unprivileged(&mut ro).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("cannot write in the output folder"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(started.elapsed() < Duration::from_secs(60));
+    assert_eq!(std::fs::read_dir(&read_only).unwrap().count(), 0);
+
+    std::fs::set_permissions(input.join("locked"), std::fs::Permissions::from_mode(0o000)).unwrap();
+    let out_dir = dir.join("out");
+    let mut unreadable = common::drafter();
+    unreadable.arg("bake").arg(&input).arg("-o").arg(&out_dir).arg("--json");
+    let out = as_unprivileged(&mut unreadable).output().unwrap();
+    std::fs::set_permissions(input.join("locked"), std::fs::Permissions::from_mode(0o755)).unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{stderr}");
+    assert!(stderr.contains(&format!("{}: cannot list", input.join("locked").display())), "{stderr}");
+    assert!(stderr.contains("1 of 3 inputs failed (listed above); the others were baked"), "{stderr}");
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((r["baked"].as_u64(), r["failed"].as_u64()), (Some(2), Some(1)), "{r}");
+    assert!(out_dir.join("a.glb").is_file() && out_dir.join("sub/b.glb").is_file());
+}

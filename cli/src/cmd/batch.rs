@@ -1,6 +1,7 @@
 //! `drafter bake` of several inputs, folders or manifests into `-o DIR` (`drafter_catalog::batch`
-//! does the work): a progress bar on a terminal, the failures listed at the end, `--report` with
-//! every file's status, and exit code 4 when some inputs failed. The first Ctrl-C stops admitting
+//! does the work): a progress bar on a terminal, one plain line per file elsewhere (a CI log), the
+//! failures listed at the end, `--report` with every file's status, and exit code 4 when some
+//! inputs failed. The first Ctrl-C stops admitting
 //! files and lets the running ones finish (exit 130); a second one exits at once, leaving no
 //! partial file. With `--cache`, a rerun serves the files already baked from the cache.
 
@@ -59,9 +60,12 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
         return Err(BadInput(format!("{}: is both an input folder and the output folder", input.display())).into());
     }
     std::fs::create_dir_all(&out_dir).map_err(|e| IoFailure(format!("{}: cannot create: {e}", out_dir.display())))?;
-    let items = drafter_catalog::discover::discover(&args.inputs, &args.manifest, Some(&out_dir))
+    // A folder nothing can be written in is found now, not after every file was baked.
+    drafter_catalog::output::check_writable(&out_dir).map_err(|e| IoFailure(e.to_string()))?;
+    let found = drafter_catalog::discover::discover_all(&args.inputs, &args.manifest, Some(&out_dir))
         .map_err(|e| BadInput(e.to_string()))?;
-    if items.is_empty() {
+    let items = &found.items;
+    if items.is_empty() && found.unreadable.is_empty() {
         return Err(BadInput("no input of a supported format (.gltf .glb .obj .stl .off .ply) was found".into()).into());
     }
     if let Some(report) = &args.report
@@ -80,8 +84,15 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
 
     drafter_catalog::interrupt::set_graceful(true);
     let stop = || drafter_catalog::interrupt::stop_requested().is_some();
-    let bar = Bar::new(!args.quiet && std::io::stderr().is_terminal(), &items);
-    let summary = batch::run(&items, &out_dir, &options, &stop, &bar);
+    let shown = if args.quiet {
+        Shown::Nothing
+    } else if std::io::stderr().is_terminal() {
+        Shown::Bar
+    } else {
+        Shown::Lines
+    };
+    let bar = Bar::new(shown, items);
+    let summary = batch::run_discovered(&found, &out_dir, &options, &stop, &bar);
     bar.finish();
     if let Some(cache) = &options.cache {
         evict(cache, args.quiet);
@@ -98,10 +109,31 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
         for r in summary.files.iter().filter_map(|r| r.warning.as_ref()) {
             eprintln!("  warning: {r}");
         }
+        if shown != Shown::Lines {
+            // On a terminal the bar is gone: the notes of each file, as a single bake prints them
+            // (on a pipe they followed each file's line).
+            for r in summary.files.iter().filter(|r| !r.notes.is_empty()) {
+                eprintln!("  {}:", r.input);
+                for note in &r.notes {
+                    eprintln!("    note: {note}");
+                }
+            }
+        }
         let hits = summary.files.iter().filter(|r| r.cache == batch::CacheUse::Hit).count();
+        let over = match summary.over_budget {
+            0 => String::new(),
+            n => {
+                let largest = summary.files.iter().map(|r| r.estimated_peak_bytes).max().unwrap_or(0);
+                format!(
+                    "; {n} file{} over the budget ran alone, the largest estimated at {} MB",
+                    if n == 1 { "" } else { "s" },
+                    largest >> 20
+                )
+            }
+        };
         eprintln!(
             "baked {} of {} files into {} in {:.2} s ({} from the cache, {} failed, {} skipped; {} at once, \
-             memory budget {} MB, at most {} MB estimated at once)",
+             memory budget {} MB, at most {} MB estimated at once{over})",
             summary.baked + summary.cached,
             summary.files.len(),
             out_dir.display(),
@@ -122,8 +154,14 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
         return Err(Interrupted(signal).into());
     }
     if !failures.is_empty() {
+        let done = summary.baked + summary.cached;
+        let rest = match done {
+            0 => "none was baked".to_owned(),
+            n if n + failures.len() == summary.files.len() => "the others were baked".to_owned(),
+            n => format!("{n} were baked"),
+        };
         return Err(SomeFailed(format!(
-            "{} of {} inputs failed (listed above); the others were baked",
+            "{} of {} inputs failed (listed above); {rest}",
             failures.len(),
             summary.files.len()
         ))
@@ -132,17 +170,30 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
     Ok(())
 }
 
-/// The batch's progress bar: files done of all, input bytes done of all, the ETA, the files being
-/// baked. Hidden on a pipe and with `--quiet`.
+/// How a batch shows its progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Shown {
+    /// `--quiet`.
+    Nothing,
+    /// A progress bar, on a terminal.
+    Bar,
+    /// One plain line per finished file (`[12/47] name: baked 1.20 s`), no carriage returns: a
+    /// pipe, a CI log.
+    Lines,
+}
+
+/// The batch's progress: on a terminal a bar (files done of all, input bytes done of all, the
+/// ETA, the files being baked); on a pipe a line per file with its notes.
 struct Bar {
     bar: Option<indicatif::ProgressBar>,
+    lines: bool,
     files: usize,
     state: Mutex<(usize, Vec<String>)>,
 }
 
 impl Bar {
-    fn new(enabled: bool, items: &[Item]) -> Self {
-        let bar = enabled.then(|| {
+    fn new(shown: Shown, items: &[Item]) -> Self {
+        let bar = (shown == Shown::Bar).then(|| {
             let bar = indicatif::ProgressBar::new(0);
             let style = indicatif::ProgressStyle::with_template(
                 "{spinner} [{bar:24}] {prefix} {binary_bytes}/{binary_total_bytes} ETA {eta} {wide_msg}",
@@ -153,7 +204,7 @@ impl Bar {
             bar.enable_steady_tick(Duration::from_millis(100));
             bar
         });
-        Bar { bar, files: items.len(), state: Mutex::new((0, Vec::new())) }
+        Bar { bar, lines: shown == Shown::Lines, files: items.len(), state: Mutex::new((0, Vec::new())) }
     }
 
     fn redraw(&self, state: &(usize, Vec<String>)) {
@@ -174,6 +225,24 @@ fn name(item: &Item) -> String {
     item.relative_output.with_extension("").display().to_string()
 }
 
+/// A finished file's line on a pipe: `[3/47] gear: baked 1.20 s`, `cached (up to date)`, or
+/// `FAILED: why`.
+fn line(done: usize, files: usize, item: &Item, record: &Record) -> String {
+    let what = match record.status {
+        Status::Baked => format!("baked {:.2} s", record.ms / 1e3),
+        Status::Cached if record.up_to_date => "cached (up to date)".to_owned(),
+        Status::Cached => format!("cached {:.2} s", record.ms / 1e3),
+        Status::Failed => format!("FAILED: {}", record.error.as_deref().unwrap_or("")),
+        Status::Skipped => "skipped".to_owned(),
+    };
+    let alone = if record.over_budget {
+        format!(" (estimated {} MB, over the memory budget: ran alone)", record.estimated_peak_bytes >> 20)
+    } else {
+        String::new()
+    };
+    format!("[{done}/{files}] {}: {what}{alone}", name(item))
+}
+
 impl Observer for Bar {
     fn begin(&self, _files: usize, bytes: u64) {
         if let Some(bar) = &self.bar {
@@ -187,7 +256,7 @@ impl Observer for Bar {
         self.redraw(&state);
     }
 
-    fn finished(&self, item: &Item, bytes: u64, _record: &Record) {
+    fn finished(&self, item: &Item, bytes: u64, record: &Record) {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         state.0 += 1;
         let n = name(item);
@@ -195,6 +264,14 @@ impl Observer for Bar {
         self.redraw(&state);
         if let Some(bar) = &self.bar {
             bar.inc(bytes);
+        }
+        if self.lines {
+            // Under the lock: one file's lines are not interleaved with another's.
+            let mut text = line(state.0, self.files, item, record);
+            for note in &record.notes {
+                text.push_str(&format!("\n    note: {note}"));
+            }
+            eprintln!("{text}");
         }
     }
 }

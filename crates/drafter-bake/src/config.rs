@@ -77,7 +77,7 @@ use crate::BakeError;
 pub const STYLES: [&str; 7] = ["gradient", "cel", "gooch", "goochel", "phong", "metal", "hatch"];
 
 /// Every option of a bake, one struct per stage.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct BakeConfig {
     pub segment: SegmentOptions,
     pub normals: NormalsStage,
@@ -129,7 +129,7 @@ impl Default for BakeConfig {
 }
 
 /// The normal stage (Cignoni et al. 2005 enhancement + crease-aware vertex normals).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct NormalsStage {
     /// Compute and write normals. Default true.
     pub enabled: bool,
@@ -147,7 +147,7 @@ impl Default for NormalsStage {
 }
 
 /// The line stage (edge classes, EXT_mesh_primitive_edge_visibility, silhouette hierarchies).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct LinesStage {
     /// Classify and write edges. Default true.
     pub enabled: bool,
@@ -204,7 +204,7 @@ pub const DEFAULT_METALLIC_THRESHOLD: f32 = 0.5;
 
 /// The textures stage: which NPR lookup textures (drafter-textures) are baked and embedded as PNG.
 /// What is baked when is documented in `crate::textures`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct TexturesStage {
     /// Bake and embed textures. Default true.
     pub enabled: bool,
@@ -263,7 +263,7 @@ impl TexturesStage {
 }
 
 /// Which parts an override applies to.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub enum PartSelector {
     /// Every part with this name.
     Name(String),
@@ -272,10 +272,10 @@ pub enum PartSelector {
 }
 
 /// Per-part settings from the config file; `None` keeps the computed value.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PartOverride {
-    #[serde(skip, default = "default_selector")]
+    #[serde(skip_deserializing, default = "default_selector")]
     pub selector: PartSelector,
     #[serde(default)]
     name: Option<String>,

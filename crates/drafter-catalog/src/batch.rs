@@ -78,6 +78,13 @@ pub struct Record {
     /// A problem that did not fail the file (the cache could not be written).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warning: Option<String>,
+    /// The bake's notes, one line per kind (`non-finite positions: 1 (first: ...)`), as a single
+    /// bake prints them; a file written from the cache repeats the notes of the bake stored.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// The file's estimated peak was over the whole memory budget: it ran alone.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub over_budget: bool,
 }
 
 impl Record {
@@ -95,6 +102,8 @@ impl Record {
             exit_code: None,
             up_to_date: false,
             warning: None,
+            notes: Vec::new(),
+            over_budget: false,
         }
     }
 
@@ -108,7 +117,10 @@ impl Record {
 /// A reservation of the memory budget, released when dropped.
 pub struct Permit<'a> {
     budget: Option<&'a Budget>,
+    /// What this permit reserves of the budget (at most all of it).
     bytes: u64,
+    /// The estimate asked for, which may be over the budget (such a file runs alone).
+    estimate: u64,
 }
 
 impl std::fmt::Debug for Permit<'_> {
@@ -120,7 +132,12 @@ impl std::fmt::Debug for Permit<'_> {
 impl Permit<'_> {
     /// A permit outside any budget (a single bake).
     pub fn unbounded(bytes: u64) -> Permit<'static> {
-        Permit { budget: None, bytes }
+        Permit { budget: None, bytes, estimate: bytes }
+    }
+
+    /// Whether the estimate asked for was over the whole budget (the file runs alone).
+    pub fn over_budget(&self) -> bool {
+        self.estimate > self.bytes
     }
 }
 
@@ -129,6 +146,7 @@ impl Drop for Permit<'_> {
         if let Some(budget) = self.budget {
             let mut state = budget.state.lock().unwrap_or_else(|e| e.into_inner());
             state.in_use -= self.bytes;
+            state.estimated -= self.estimate;
             state.running -= 1;
             budget.changed.notify_all();
         }
@@ -146,11 +164,13 @@ pub struct Budget {
 #[derive(Debug, Default)]
 struct BudgetState {
     in_use: u64,
+    /// The estimates of the files running, over the budget where one file is.
+    estimated: u64,
     running: usize,
     /// Tickets handed out and the one to be admitted next.
     issued: u64,
     serving: u64,
-    /// The most reserved at once.
+    /// The most estimated at once (over the budget when a file over it ran alone).
     peak: u64,
 }
 
@@ -161,8 +181,8 @@ impl Budget {
 
     /// Waits until `bytes` fit (or nothing else runs) and this caller is next in line; `None` if
     /// `stop()` turns true first. A request over the whole budget reserves the whole budget.
-    pub fn admit(&self, bytes: u64, stop: &dyn Fn() -> bool) -> Option<Permit<'_>> {
-        let bytes = bytes.min(self.total);
+    pub fn admit(&self, estimate: u64, stop: &dyn Fn() -> bool) -> Option<Permit<'_>> {
+        let bytes = estimate.min(self.total);
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         let ticket = state.issued;
         state.issued += 1;
@@ -178,10 +198,11 @@ impl Budget {
             if state.serving >= ticket && (state.in_use + bytes <= self.total || state.running == 0) {
                 state.serving = state.serving.max(ticket + 1);
                 state.in_use += bytes;
+                state.estimated += estimate;
                 state.running += 1;
-                state.peak = state.peak.max(state.in_use);
+                state.peak = state.peak.max(state.estimated);
                 self.changed.notify_all();
-                return Some(Permit { budget: Some(self), bytes });
+                return Some(Permit { budget: Some(self), bytes, estimate });
             }
             if rayon::current_thread_index().is_some() {
                 // A thread of the stages' pool (a batch worker) helps the files running while it
@@ -199,6 +220,8 @@ impl Budget {
         }
     }
 
+    /// The most estimated peak memory admitted at once: within the budget, unless a file over the
+    /// whole budget ran (alone).
     pub fn peak(&self) -> u64 {
         self.state.lock().unwrap_or_else(|e| e.into_inner()).peak
     }
@@ -246,7 +269,8 @@ fn bake_file_inner<'b>(
         }
         None => None,
     };
-    record.bytes_in = std::fs::metadata(input).map_or(0, |m| m.len());
+    // The input's bytes with a glTF's external buffers and images, as the batch's total counts them.
+    record.bytes_in = input_size(input);
     let bin_path = match &config.container {
         drafter_format::Container::Gltf { bin_uri } => Some(output.with_file_name(bin_uri)),
         drafter_format::Container::Glb => None,
@@ -256,6 +280,8 @@ fn bake_file_inner<'b>(
         record.cache = CacheUse::Uncacheable;
         if let Some(key) = key {
             if cache.receipt_matches(&outputs, &key) {
+                // The entry stays the one in use for eviction, although it was not read.
+                cache.touch(&key);
                 record.bytes_out = outputs.iter().map(|p| std::fs::metadata(p).map_or(0, |m| m.len())).sum();
                 record.status = Status::Cached;
                 record.cache = CacheUse::Hit;
@@ -270,6 +296,7 @@ fn bake_file_inner<'b>(
                     record.bytes_out = (payloads[0].len() + bin.map_or(0, <[u8]>::len)) as u64;
                     record.status = Status::Cached;
                     record.cache = CacheUse::Hit;
+                    record.notes = payloads.get(2).map_or_else(Vec::new, |report| stored_notes(report));
                     return Ok(());
                 }
                 Err(Miss::Absent) => record.cache = CacheUse::Miss,
@@ -280,32 +307,35 @@ fn bake_file_inner<'b>(
             {
                 record.cache = CacheUse::Hit;
                 let reason = reason.first().map(|r| String::from_utf8_lossy(r).into_owned()).unwrap_or_default();
-                return Err(Error::Input(reason));
+                return Err(Error::Input(reason.replace(INPUT_PLACEHOLDER, &input.display().to_string())));
             }
         }
     }
     let bytes = job::read_input(input)?;
-    record.bytes_in = bytes.len() as u64;
     let estimate = crate::estimate::peak_bytes(input, &bytes);
-    let Some(_permit) = admit(estimate) else {
+    let Some(permit) = admit(estimate) else {
         record.status = Status::Skipped;
         return Ok(());
     };
     record.estimated_peak_bytes = estimate;
+    record.over_budget = permit.over_budget();
     let baked = match job::bake_bytes(input, bytes, &config, limits, &mut |_| {}) {
         Ok(baked) => baked,
         Err(e) => {
             // The input's fault is decided by what the key covers: stored, so that a rerun replays
             // it (the two Draco files of the shared models cost 3 ms each to parse and refuse).
+            // The key covers the file's name and bytes, not its folder: the path is stored as a
+            // placeholder, so that a cache shared between machines names each one's own path.
             if let Some((cache, Some(key))) = key
                 && e.is_content_fault()
             {
-                let reason = e.to_string();
+                let reason = e.to_string().replace(&input.display().to_string(), INPUT_PLACEHOLDER);
                 let _ = cache.put(&crate::cache::failure_key(&key, limits), &[reason.as_bytes()], &guard);
             }
             return Err(e);
         }
     };
+    record.notes = notes(&baked.report.diagnostics);
     let bin = baked.written.bin.as_deref();
     crate::output::write_outputs(output, &baked.written.main, bin, &config.container, &[])?;
     record.bytes_out = (baked.written.main.len() + bin.map_or(0, <[u8]>::len)) as u64;
@@ -319,6 +349,24 @@ fn bake_file_inner<'b>(
         cache.write_receipt(&outputs, &key);
     }
     Ok(())
+}
+
+/// Stands for the input's path in a refusal stored in the cache (a character no path holds).
+const INPUT_PLACEHOLDER: &str = "\u{0}input\u{0}";
+
+/// The bake's notes as a single bake prints them: one line per kind.
+fn notes(diagnostics: &[drafter_core::Diagnostic]) -> Vec<String> {
+    drafter_core::summarize(diagnostics).iter().map(ToString::to_string).collect()
+}
+
+/// The notes of the bake whose report a cache entry stored.
+fn stored_notes(report: &[u8]) -> Vec<String> {
+    #[derive(serde::Deserialize)]
+    struct Stored {
+        #[serde(default)]
+        diagnostics: Vec<drafter_core::Diagnostic>,
+    }
+    serde_json::from_slice::<Stored>(report).map_or_else(|_| Vec::new(), |r| notes(&r.diagnostics))
 }
 
 /// Registers a temporary file with the signal handler ([`crate::interrupt`]).
@@ -366,6 +414,32 @@ pub struct Summary {
     /// The most estimated peak memory admitted at once.
     pub peak_admitted_bytes: u64,
     pub workers: usize,
+    /// Files whose estimated peak was over the whole budget (each ran alone).
+    pub over_budget: usize,
+    /// drafter's build ([`crate::cache::BUILD_ID`]), so that a report says what made its files.
+    pub build: String,
+    /// The effective configuration, in the canonical form the cache's key hashes.
+    pub config: serde_json::Value,
+}
+
+/// As [`run`] over what [`crate::discover::discover_all`] found: each folder that could not be
+/// listed is one more failed file of the report.
+pub fn run_discovered(
+    found: &crate::discover::Discovered,
+    out_dir: &Path,
+    options: &Options,
+    stop: &(dyn Fn() -> bool + Sync),
+    observer: &dyn Observer,
+) -> Summary {
+    let mut summary = run(&found.items, out_dir, options, stop, observer);
+    for (folder, why) in &found.unreadable {
+        let mut record = Record::new(folder, out_dir);
+        record.fail(&Error::Io(format!("{}: cannot list: {why}", folder.display())));
+        record.output = String::new();
+        summary.files.push(record);
+        summary.failed += 1;
+    }
+    summary
 }
 
 /// Bakes `items` into `out_dir`, `options.workers` files at a time under the memory budget.
@@ -385,6 +459,8 @@ pub fn run(
     let budget = Budget::new(options.memory_budget.max(1));
     let next = AtomicUsize::new(0);
     let records: Vec<Mutex<Option<Record>>> = items.iter().map(|_| Mutex::new(None)).collect();
+    // A folder no file can be written in fails every file at once, before any bake.
+    let unwritable = crate::output::check_writable(out_dir).err();
     let workers = options.workers.clamp(1, items.len().max(1));
     let work = || {
         loop {
@@ -394,16 +470,22 @@ pub fn run(
             let output = out_dir.join(&item.relative_output);
             let record = if stop() {
                 Record::new(&item.input, &output)
+            } else if let Some(e) = &unwritable {
+                let mut record = Record::new(&item.input, &output);
+                record.fail(e);
+                record
             } else {
                 observer.started(item, sizes[index]);
-                let record = match output.parent().map(std::fs::create_dir_all) {
-                    Some(Err(e)) => {
+                // Every output is named below `out_dir` through `output::confined`, which refuses
+                // `..`, absolute parts and symbolic links on the way: no caller of the batch can
+                // write outside it.
+                let record = match crate::output::confined(out_dir, &item.relative_output) {
+                    Err(e) => {
                         let mut record = Record::new(&item.input, &output);
-                        let folder = output.parent().unwrap_or(out_dir);
-                        record.fail(&Error::Io(format!("{}: cannot create: {e}", folder.display())));
+                        record.fail(&e);
                         record
                     }
-                    _ => bake_file(
+                    Ok(output) => bake_file(
                         &item.input,
                         &output,
                         &options.config,
@@ -456,6 +538,9 @@ pub fn run(
         memory_budget: options.memory_budget,
         peak_admitted_bytes: budget.peak(),
         workers,
+        over_budget: files.iter().filter(|r| r.over_budget).count(),
+        build: crate::cache::BUILD_ID.to_owned(),
+        config: crate::cache::canonical_config(&options.config),
         files,
     }
 }

@@ -4,10 +4,13 @@
 //! version and the commit it was built from), the extension's format version, the input's file name
 //! (the output records it), the effective configuration in a canonical form, the digest of the
 //! input's bytes, and the URI and digest of every external file a glTF input names (buffers and
-//! images, resolved by drafter-io's confined rule). The configuration's canonical form is its
-//! `Debug` text: derived, so it lists every field of every stage's options with floats in their
-//! shortest round-trip form, and an option added later can never be left out of the key. A bake is
-//! byte-identical at any thread count (an invariant of drafter-bake), so the key decides the bytes.
+//! images, resolved by drafter-io's confined rule). The configuration's canonical form
+//! ([`canonical_config`]) is its serde serialization as JSON with the keys sorted, tagged with
+//! [`CONFIG_FORM`]: derived, so it lists every field of every stage's options with floats in their
+//! shortest round-trip form, and an option added later can never be left out of the key; unlike
+//! `Debug` text, the form is a documented serialization that a compiler or a dependency's update
+//! does not change. A bake is byte-identical at any thread count (an invariant of drafter-bake), so
+//! the key decides the bytes.
 //!
 //! **Entries.** One file per key, `entries/KK/KEY` (KK its first two hex digits): a header (magic,
 //! layout version, payload count, then per payload its length and BLAKE3 digest) and the payloads
@@ -43,6 +46,8 @@ pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("DRAFTER
 
 const MAGIC: &[u8; 8] = b"DRFTCACH";
 const LAYOUT: u32 = 1;
+/// The version of the configuration's canonical form in the key: changed whenever the form does.
+pub const CONFIG_FORM: &str = "drafter-config-json-1";
 /// Payloads per entry: main file, .bin, report.
 const MAX_PAYLOADS: u32 = 4;
 /// Temporary files older than this are a killed writer's and are removed by [`Cache::evict`].
@@ -144,13 +149,25 @@ pub fn failure_key(key: &Key, limits: &drafter_io::Limits) -> Key {
     Key(*h.finalize().as_bytes())
 }
 
-fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &drafter_bake::BakeConfig) -> Option<Key> {
+/// The configuration as the key hashes it and a batch report records it: every option, the
+/// input's provenance left out (the key covers the input itself), as JSON whose objects have
+/// their keys sorted (serde_json's map), so the same options give the same text everywhere.
+pub fn canonical_config(config: &drafter_bake::BakeConfig) -> serde_json::Value {
     let mut config = config.clone();
     config.input = drafter_format::InputInfo { name: String::new(), format: String::new(), sha256: String::new() };
+    let mut value = serde_json::to_value(&config).unwrap_or(serde_json::Value::Null);
+    if let Some(map) = value.as_object_mut() {
+        map.remove("input");
+    }
+    value
+}
+
+fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &drafter_bake::BakeConfig) -> Option<Key> {
+    let config = format!("{CONFIG_FORM}\0{}", canonical_config(config));
     let mut h = blake3::Hasher::new();
     h.update(b"drafter-cache-key\0");
     h.update(&LAYOUT.to_le_bytes());
-    for text in [BUILD_ID, drafter_format::FORMAT_VERSION, &crate::job::input_name(path), &format!("{config:?}")] {
+    for text in [BUILD_ID, drafter_format::FORMAT_VERSION, &crate::job::input_name(path), &config] {
         h.update(&(text.len() as u64).to_le_bytes());
         h.update(text.as_bytes());
     }
@@ -268,9 +285,40 @@ static WRITES: AtomicU64 = AtomicU64::new(0);
 impl Cache {
     /// Opens (creating) the cache folder `root`.
     pub fn open(root: &Path, max_bytes: Option<u64>) -> std::io::Result<Self> {
-        std::fs::create_dir_all(root.join("entries"))?;
-        std::fs::create_dir_all(root.join("tmp"))?;
+        std::fs::create_dir_all(root)?;
+        let cache = Self { root: root.to_path_buf(), max_bytes };
+        for folder in ["entries", "tmp"] {
+            cache.confined(&Path::new(folder).join("x"))?;
+        }
+        Ok(cache)
+    }
+
+    /// Opens the cache folder `root` only if it exists (`drafter cache stats` on a folder that is
+    /// not there creates nothing).
+    pub fn open_existing(root: &Path, max_bytes: Option<u64>) -> std::io::Result<Self> {
+        let meta = std::fs::metadata(root)?;
+        if !meta.is_dir() {
+            return Err(std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a folder"));
+        }
         Ok(Self { root: root.to_path_buf(), max_bytes })
+    }
+
+    /// The path of `relative` in the cache, its folders created, through the batch's confinement
+    /// ([`crate::output::confined`]): no symbolic link inside the cache folder is followed, so no
+    /// write of the cache lands outside it.
+    fn confined(&self, relative: &Path) -> std::io::Result<PathBuf> {
+        crate::output::confined(&self.root, relative).map_err(|e| std::io::Error::other(e.to_string()))
+    }
+
+    /// Marks the entry of `key` used now, for eviction (an output found up to date by its receipt
+    /// uses the entry without reading it).
+    pub fn touch(&self, key: &Key) {
+        let path = self.entry_path(key);
+        if std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_file())
+            && let Ok(file) = std::fs::File::options().write(true).open(&path)
+        {
+            let _ = file.set_modified(SystemTime::now());
+        }
     }
 
     pub fn root(&self) -> &Path {
@@ -309,17 +357,15 @@ impl Cache {
     /// Stores `payloads` under `key`: written whole under `tmp/`, synced, renamed into place.
     /// `guard` registers the temporary file for removal should the process be interrupted.
     pub fn put(&self, key: &Key, payloads: &[&[u8]], guard: &dyn Fn(&Path) -> Box<dyn Send>) -> std::io::Result<()> {
-        let target = self.entry_path(key);
-        if let Some(folder) = target.parent() {
-            std::fs::create_dir_all(folder)?;
-        }
-        let temp = self.root.join("tmp").join(format!(
+        let hex = key.to_string();
+        let target = self.confined(&Path::new("entries").join(&hex[..2]).join(&hex))?;
+        let temp = self.confined(&Path::new("tmp").join(format!(
             "{}.{}.{}.{}.tmp",
             key,
             hostname(),
             std::process::id(),
             WRITES.fetch_add(1, Ordering::Relaxed)
-        ));
+        )))?;
         let _guard = guard(&temp);
         let written = (|| {
             let mut file = std::fs::File::create(&temp)?;
@@ -336,6 +382,7 @@ impl Cache {
         written
     }
 
+    /// The receipt of `output`, relative to the cache folder.
     fn receipt_path(&self, output: &Path) -> PathBuf {
         let absolute = std::path::absolute(output).unwrap_or_else(|_| output.to_path_buf());
         let mut h = blake3::Hasher::new();
@@ -343,13 +390,13 @@ impl Cache {
         h.update(b"\0");
         h.update(absolute.as_os_str().as_encoded_bytes());
         let hex = Key(*h.finalize().as_bytes()).to_string();
-        self.root.join("receipts").join(&hex[..2]).join(hex)
+        Path::new("receipts").join(&hex[..2]).join(hex)
     }
 
     /// Whether the files `outputs` (a main file and a .gltf's .bin) are still the ones written
     /// for `key` and recorded by [`Cache::write_receipt`].
     pub fn receipt_matches(&self, outputs: &[&Path], key: &Key) -> bool {
-        let Ok(recorded) = std::fs::read_to_string(self.receipt_path(outputs[0])) else { return false };
+        let Ok(recorded) = std::fs::read_to_string(self.root.join(self.receipt_path(outputs[0]))) else { return false };
         let mut now = key.to_string();
         for output in outputs {
             match identity(output) {
@@ -363,7 +410,7 @@ impl Cache {
     /// Records that `outputs` now hold the bytes of `key` (a hint: a failure only costs a rewrite
     /// next time).
     pub fn write_receipt(&self, outputs: &[&Path], key: &Key) {
-        let path = self.receipt_path(outputs[0]);
+        let Ok(path) = self.confined(&self.receipt_path(outputs[0])) else { return };
         let mut text = key.to_string();
         for output in outputs {
             match identity(output) {
@@ -373,7 +420,7 @@ impl Cache {
         }
         let temp =
             path.with_extension(format!("{}.{}.tmp", std::process::id(), WRITES.fetch_add(1, Ordering::Relaxed)));
-        let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).and_then(|()| std::fs::write(&temp, text));
+        let written = std::fs::write(&temp, text);
         if written.and_then(|()| std::fs::rename(&temp, &path)).is_err() {
             let _ = std::fs::remove_file(&temp);
         }
@@ -382,10 +429,20 @@ impl Cache {
     /// Every entry with its size and last use.
     fn entries(&self) -> Vec<(PathBuf, u64, SystemTime)> {
         let mut out = Vec::new();
-        let Ok(folders) = std::fs::read_dir(self.root.join("entries")) else { return out };
+        // Only real folders and files: eviction removes what this lists, and a symbolic link
+        // planted in the cache must not lead it to files outside.
+        let entries = self.root.join("entries");
+        if !std::fs::symlink_metadata(&entries).is_ok_and(|m| m.is_dir()) {
+            return out;
+        }
+        let Ok(folders) = std::fs::read_dir(entries) else { return out };
         for folder in folders.flatten() {
+            if !folder.file_type().is_ok_and(|t| t.is_dir()) {
+                continue;
+            }
             let Ok(files) = std::fs::read_dir(folder.path()) else { continue };
             for file in files.flatten() {
+                // DirEntry::metadata does not follow a symbolic link.
                 if let Ok(meta) = file.metadata()
                     && meta.is_file()
                 {
@@ -414,7 +471,9 @@ impl Cache {
     pub fn evict(&self) -> Evicted {
         let mut evicted = Evicted::default();
         let now = SystemTime::now();
-        if let Ok(temps) = std::fs::read_dir(self.root.join("tmp")) {
+        let tmp = self.root.join("tmp");
+        let real = std::fs::symlink_metadata(&tmp).is_ok_and(|m| m.is_dir());
+        if let Some(Ok(temps)) = real.then(|| std::fs::read_dir(&tmp)) {
             for temp in temps.flatten() {
                 let stale = temp
                     .metadata()
@@ -623,6 +682,42 @@ mod tests {
         std::fs::remove_file(dir.join("a.bin")).unwrap();
         assert_eq!(key_of(&path, gltf, &config), None, "a missing external file is not cached");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_configs_canonical_form_is_sorted_json_of_every_option() {
+        let config = drafter_bake::BakeConfig::default();
+        let form = canonical_config(&config);
+        // Objects' keys sorted at every depth, so the text does not depend on declaration order.
+        fn sorted(v: &serde_json::Value) -> bool {
+            match v {
+                serde_json::Value::Object(m) => {
+                    m.keys().zip(m.keys().skip(1)).all(|(a, b)| a < b) && m.values().all(sorted)
+                }
+                serde_json::Value::Array(a) => a.iter().all(sorted),
+                _ => true,
+            }
+        }
+        assert!(sorted(&form), "{form}");
+        let text = form.to_string();
+        let again: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+        assert_eq!(again.to_string(), text, "read back and written again, the same text");
+        for stage in ["segment", "normals", "lines", "textures", "obb", "gradient", "transfer", "overrides"] {
+            assert!(form.get(stage).is_some(), "{stage} missing from {form}");
+        }
+        assert!(form.get("input").is_none());
+        // Each option a TOML file sets changes the form, and so the key.
+        let base = key_from(Path::new("m.obj"), &[0; 32], &[], &config);
+        for toml in [
+            "[lines]\ncrease_angle_deg = 31.0\n",
+            "[segment]\nmode = \"components\"\n",
+            "[normals]\nenabled = false\n",
+            "[[part]]\nid = 0\nscale = 2.0\n",
+        ] {
+            let other = crate::job::config_from_toml(toml).expect("config");
+            assert_ne!(canonical_config(&other), form, "{toml}");
+            assert_ne!(key_from(Path::new("m.obj"), &[0; 32], &[], &other), base, "{toml}");
+        }
     }
 
     #[test]

@@ -20,15 +20,44 @@ pub struct Item {
 #[error("{0}")]
 pub struct DiscoverError(pub String);
 
+/// What a batch holds: the files to bake, and the folders below a named one that could not be
+/// read (each a failure of the batch, not a reason to refuse the others).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Discovered {
+    pub items: Vec<Item>,
+    /// A folder found below an input folder, and why it could not be listed.
+    pub unreadable: Vec<(PathBuf, String)>,
+}
+
 /// Lists the files to bake from `inputs` (files or folders) and `manifests`, in a stable order
 /// (the order given; a folder's files sorted by path). `skip` is a folder never entered (the
 /// output folder, when it lies inside an input folder). Two inputs whose outputs would be the same
-/// file are refused, as is a path that does not exist.
+/// file are refused, as is a path that does not exist. A folder below a named one that cannot be
+/// read is refused too, by its own path; [`discover_all`] lists it instead.
 pub fn discover(inputs: &[PathBuf], manifests: &[PathBuf], skip: Option<&Path>) -> Result<Vec<Item>, DiscoverError> {
+    let found = discover_all(inputs, manifests, skip)?;
+    match found.unreadable.first() {
+        Some((folder, why)) => Err(DiscoverError(format!("{}: cannot list: {why}", folder.display()))),
+        None => Ok(found.items),
+    }
+}
+
+/// As [`discover`], with the unreadable folders below named ones listed rather than refused.
+/// Every output path is relative, made of plain names only: a manifest's `../models` (a file or a
+/// folder) is written as `models` under the output folder, an absolute entry by its file name or
+/// below its folder, never above the output folder ([`crate::output::confined`] checks it again
+/// where the file is written).
+pub fn discover_all(
+    inputs: &[PathBuf],
+    manifests: &[PathBuf],
+    skip: Option<&Path>,
+) -> Result<Discovered, DiscoverError> {
     let skip = skip.and_then(|s| s.canonicalize().ok());
-    let mut items = Vec::new();
+    let mut found = Discovered::default();
+    let items = &mut found.items;
+    let unreadable = &mut found.unreadable;
     for input in inputs {
-        add(input, None, skip.as_deref(), &mut items)?;
+        add(input, None, skip.as_deref(), items, unreadable)?;
     }
     for manifest in manifests {
         let text = std::fs::read_to_string(manifest)
@@ -37,12 +66,12 @@ pub fn discover(inputs: &[PathBuf], manifests: &[PathBuf], skip: Option<&Path>) 
         for (line, entry) in manifest_entries(manifest, &text)? {
             let path = base.join(&entry);
             let relative = (Path::new(&entry).is_relative()).then(|| PathBuf::from(&entry));
-            add(&path, relative.as_deref(), skip.as_deref(), &mut items)
+            add(&path, relative.as_deref(), skip.as_deref(), items, unreadable)
                 .map_err(|e| DiscoverError(format!("{}:{line}: {e}", manifest.display())))?;
         }
     }
     let mut seen = std::collections::HashMap::new();
-    for item in &items {
+    for item in items.iter() {
         if let Some(first) = seen.insert(item.relative_output.clone(), item.input.clone()) {
             return Err(DiscoverError(format!(
                 "{} and {} would both be written to {}; bake them in separate runs or rename one",
@@ -52,7 +81,7 @@ pub fn discover(inputs: &[PathBuf], manifests: &[PathBuf], skip: Option<&Path>) 
             )));
         }
     }
-    Ok(items)
+    Ok(found)
 }
 
 /// The entries of a manifest with their line numbers: a `.toml` file's `inputs = [...]`, or one
@@ -79,13 +108,22 @@ fn manifest_entries(path: &Path, text: &str) -> Result<Vec<(usize, String)>, Dis
     Ok(manifest.inputs.into_iter().enumerate().map(|(i, s)| (i + 1, s)).collect())
 }
 
-fn add(path: &Path, relative: Option<&Path>, skip: Option<&Path>, items: &mut Vec<Item>) -> Result<(), DiscoverError> {
+fn add(
+    path: &Path,
+    relative: Option<&Path>,
+    skip: Option<&Path>,
+    items: &mut Vec<Item>,
+    unreadable: &mut Vec<(PathBuf, String)>,
+) -> Result<(), DiscoverError> {
     let meta = std::fs::metadata(path).map_err(|e| DiscoverError(format!("{}: {e}", path.display())))?;
     if meta.is_dir() {
+        // The folder named is read here (its own failure refuses the batch); its subfolders by
+        // `walk`, which lists the ones it cannot read.
+        std::fs::read_dir(path).map_err(|e| DiscoverError(format!("{}: cannot list: {e}", path.display())))?;
         let mut files = Vec::new();
-        walk(path, skip, &mut files).map_err(|e| DiscoverError(format!("{}: {e}", path.display())))?;
+        walk(path, skip, &mut files, unreadable);
         files.sort();
-        let prefix = relative.map(Path::to_path_buf).unwrap_or_default();
+        let prefix = relative.map(without_parent_steps).unwrap_or_default();
         for file in files {
             let below = file.strip_prefix(path).unwrap_or(&file);
             let relative_output = prefix.join(below).with_extension("glb");
@@ -103,33 +141,46 @@ fn add(path: &Path, relative: Option<&Path>, skip: Option<&Path>, items: &mut Ve
     Ok(())
 }
 
-/// A manifest's `../x.obj` is written as `x.obj` under the output folder, never above it.
+/// A manifest's `../x.obj` is written as `x.obj` under the output folder, never above it, and its
+/// `../models` folder as `models`.
 fn without_parent_steps(path: &Path) -> PathBuf {
     path.components().filter(|c| matches!(c, std::path::Component::Normal(_))).collect()
 }
 
 /// Every file of a supported format below `folder`: hidden files and folders (names starting with
 /// `.`, such as a bake's temporary files) and `skip` are left out; symbolic links to folders are
-/// not followed (no cycles).
-fn walk(folder: &Path, skip: Option<&Path>, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+/// not followed (no cycles). A folder that cannot be listed goes to `unreadable` with the reason.
+fn walk(folder: &Path, skip: Option<&Path>, out: &mut Vec<PathBuf>, unreadable: &mut Vec<(PathBuf, String)>) {
     if skip.is_some_and(|s| folder.canonicalize().is_ok_and(|c| c == s)) {
-        return Ok(());
+        return;
     }
-    for entry in std::fs::read_dir(folder)? {
-        let entry = entry?;
-        let name = entry.file_name();
-        if name.to_string_lossy().starts_with('.') {
-            continue;
+    let listed = (|| -> std::io::Result<Vec<(PathBuf, std::fs::FileType)>> {
+        let mut entries = Vec::new();
+        for entry in std::fs::read_dir(folder)? {
+            let entry = entry?;
+            if entry.file_name().to_string_lossy().starts_with('.') {
+                continue;
+            }
+            entries.push((entry.path(), entry.file_type()?));
         }
-        let path = entry.path();
-        let kind = entry.file_type()?;
+        // Sorted, so that the unreadable folders are listed in the same order on every run.
+        entries.sort_by(|a, b| a.0.cmp(&b.0));
+        Ok(entries)
+    })();
+    let entries = match listed {
+        Ok(entries) => entries,
+        Err(e) => {
+            unreadable.push((folder.to_path_buf(), e.to_string()));
+            return;
+        }
+    };
+    for (path, kind) in entries {
         if kind.is_dir() {
-            walk(&path, skip, out)?;
+            walk(&path, skip, out, unreadable);
         } else if (kind.is_file() || kind.is_symlink() && path.is_file()) && is_supported(&path) {
             out.push(path);
         }
     }
-    Ok(())
 }
 
 pub fn is_supported(path: &Path) -> bool {

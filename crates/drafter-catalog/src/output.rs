@@ -114,6 +114,75 @@ pub fn write_outputs(
     commit(staged)
 }
 
+/// The path of `relative` below the folder `root`, its folders created: the one way a batch (the
+/// CLI's, `drafter.bake_many`, `drafter.ray`) names an output file, and the cache names its files.
+/// Every component of `relative` must be a plain name (no `..`, `.`, root or drive), and no folder
+/// between `root` and the file, nor the file itself, may be a symbolic link: a link inside the
+/// output folder (left there by anyone) could lead a write out of it, so it is refused rather than
+/// followed. `root` itself is the caller's choice and is taken as it is.
+pub fn confined(root: &Path, relative: &Path) -> Result<PathBuf, Error> {
+    use std::path::Component;
+    let names: Vec<&std::ffi::OsStr> = relative
+        .components()
+        .map(|c| match c {
+            Component::Normal(name) => Ok(name),
+            _ => Err(Error::Input(format!(
+                "{}: leaves the output folder {} (only plain names below it are written)",
+                relative.display(),
+                root.display()
+            ))),
+        })
+        .collect::<Result<_, _>>()?;
+    let Some((file, folders)) = names.split_last() else {
+        return Err(Error::Input(format!("{}: an empty output name", root.display())));
+    };
+    let refuse = |path: &Path, what: &str| {
+        Error::Io(format!("{}: {what} inside the output folder; not written", path.display()))
+    };
+    let mut path = root.to_path_buf();
+    for name in folders {
+        path.push(name);
+        match std::fs::symlink_metadata(&path) {
+            Ok(meta) if meta.file_type().is_symlink() => return Err(refuse(&path, "a symbolic link")),
+            Ok(meta) if meta.is_dir() => {}
+            Ok(_) => return Err(refuse(&path, "a file where a folder is needed")),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => match std::fs::create_dir(&path) {
+                Ok(()) => {}
+                // Another worker made it in between: checked again as above.
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let meta =
+                        std::fs::symlink_metadata(&path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+                    if !meta.is_dir() {
+                        return Err(refuse(&path, "not a folder"));
+                    }
+                }
+                Err(e) => return Err(Error::Io(format!("{}: cannot create: {e}", path.display()))),
+            },
+            Err(e) => return Err(Error::Io(format!("{}: {e}", path.display()))),
+        }
+    }
+    path.push(file);
+    match std::fs::symlink_metadata(&path) {
+        Ok(meta) if meta.file_type().is_symlink() => Err(refuse(&path, "a symbolic link")),
+        Ok(meta) if meta.is_dir() => Err(refuse(&path, "a folder where the output file goes")),
+        _ => Ok(path),
+    }
+}
+
+/// Whether files can be created in `folder`: a batch asks before baking anything, so that a
+/// read-only output folder is one error at the start, not one per file after every bake.
+pub fn check_writable(folder: &Path) -> Result<(), Error> {
+    let probe = folder.join(format!(".drafter-write-check.{}.tmp", std::process::id()));
+    let _guard = crate::interrupt::TempFileGuard::new(&probe);
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(Error::Io(format!("{}: cannot write in the output folder: {e}", folder.display()))),
+    }
+}
+
 /// The container an output path asks for: `.glb`, or `.gltf` with its `.bin` beside it.
 pub fn container_for(output: &Path) -> Result<Container, Error> {
     let extension = output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();

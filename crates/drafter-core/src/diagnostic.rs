@@ -4,10 +4,10 @@
 //! entry per kind with a count and the first example, so a file with a million NaN vertices gives one
 //! line, not a million.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What went wrong, as a closed set so tools can match on it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DiagnosticKind {
     /// A vertex position with a NaN or infinite coordinate; faces using it were dropped.
@@ -97,7 +97,7 @@ impl DiagnosticKind {
 }
 
 /// One aggregated problem: its kind, how often it happened and the first place it happened.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Diagnostic {
     pub kind: DiagnosticKind,
     pub count: usize,

@@ -38,7 +38,7 @@ pub const EDGE_NONE: u32 = u32::MAX;
 pub const DEFAULT_SNAP_FRACTION: f64 = 1e-9;
 
 /// How positions are merged before connectivity is derived.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum Weld {
     /// Merge vertices whose coordinates are bit-identical (after mapping -0.0 to 0.0).
     Exact,

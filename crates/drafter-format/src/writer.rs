@@ -250,7 +250,7 @@ pub struct VertexData {
 }
 
 /// The file layout to write.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum Container {
     /// One self-contained .glb.
     Glb,

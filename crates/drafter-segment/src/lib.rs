@@ -266,7 +266,7 @@ pub enum FanPairing {
 }
 
 /// Options of [`segment`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SegmentOptions {
     /// How to cut. Default [`SegmentMode::Auto`].
     pub mode: SegmentMode,
