@@ -165,14 +165,21 @@ def bake_file(
     cache_max: _t.Optional[int] = None,
     threads: _t.Optional[int] = None,
     max_triangles: _t.Optional[int] = None,
+    out_dir: _t.Optional[_PathLike] = None,
 ) -> dict:
     """Bakes ``input`` into ``output`` (.glb, or .gltf with its .bin) atomically, through the cache
     folder ``cache`` when given, and returns the file's record as in a batch report:
     ``{"input", "output", "status": "baked"|"cached"|"failed", "cache", "ms", "bytes_in",
-    "bytes_out", "error", "exit_code", ...}``. A failure is reported in the record, not raised."""
+    "bytes_out", "error", "exit_code", ...}``. A failure is reported in the record, not raised.
+
+    With ``out_dir``, ``output`` is a path relative to that folder and is kept below it as
+    ``bake_many``'s outputs are: plain names only (no ``..``, not absolute), no symbolic link inside
+    the folder followed; anything else is a failed record and nothing is written (``drafter.ray``'s
+    tasks bake so)."""
     record = _drafter.bake_file(
         _os.fspath(input),
         _os.fspath(output),
+        root=None if out_dir is None else _os.fspath(out_dir),
         **_config(config),
         cache=_cache_path(cache),
         cache_max=_count("cache_max", cache_max, 0),

@@ -23,6 +23,7 @@ def bake_file(
     input: str,
     output: str,
     *,
+    root: Optional[str] = None,
     config_toml: Optional[str] = None,
     config_json: Optional[str] = None,
     cache: Optional[str] = None,

@@ -9,9 +9,11 @@ report as ``drafter bake DIR -o OUT --report``.
 
 Every path (inputs, manifests, ``out_dir``, ``cache``, ``report``, a config file) is resolved on
 the driver, against its working folder, before any task is sent: the workers' working folder is
-``/``. Every write is atomic (a temporary file renamed into place), so a task that Ray retries
-after a worker or node is lost leaves no partial file and bakes the same bytes again; with a
-cache, a retry of a file already baked is a hit. A file drafter refuses is a ``"failed"`` record (not retried).
+``/``. No file is written outside ``out_dir`` and the cache: each task writes its output through
+the local batch's confinement (``drafter.bake_file(..., out_dir=...)``). Every write is atomic (a
+temporary file renamed into place), so a task that Ray retries after a worker or node is lost
+leaves no partial file and bakes the same bytes again; with a cache, a retry of a file already
+baked is a hit. A file drafter refuses is a ``"failed"`` record (not retried).
 Inputs, outputs and the cache must be on storage every node sees (NFS or another shared folder).
 """
 
@@ -25,13 +27,14 @@ import drafter
 __all__ = ["bake_catalog", "bake_dataset"]
 
 
-def _bake_chunk(pairs: Sequence[Tuple[str, str]], options: dict, cpus: int) -> List[dict]:
-    """The work of one Ray task: each file through drafter.bake_file on ``cpus`` threads; each
+def _bake_chunk(pairs: Sequence[Tuple[str, str]], out_dir: str, options: dict, cpus: int) -> List[dict]:
+    """The work of one Ray task: each file through drafter.bake_file on ``cpus`` threads, its
+    output a path relative to ``out_dir`` and confined below it as the local batch's are; each
     record also names the node that baked it."""
     import ray
 
     node = ray.get_runtime_context().get_node_id()
-    return [dict(drafter.bake_file(i, o, threads=cpus, **options), node=node) for i, o in pairs]
+    return [dict(drafter.bake_file(i, o, out_dir=out_dir, threads=cpus, **options), node=node) for i, o in pairs]
 
 
 def _absolute(path: Any) -> str:
@@ -82,10 +85,9 @@ def bake_catalog(
     manifests = [_absolute(p) for p in drafter._paths(manifests, "manifests")]
     options = _options(config, cache, max_triangles)
     _os.makedirs(out_dir, exist_ok=True)
-    items = drafter.discover(inputs, manifests, skip=out_dir)
-    pairs = [(i, _os.path.join(out_dir, o)) for i, o in items]
-    for _, output in pairs:
-        _os.makedirs(_os.path.dirname(output) or ".", exist_ok=True)
+    # (input, output relative to out_dir): the tasks create the outputs' folders, through the
+    # same confinement as the local batch (no `..`, no symbolic link inside out_dir followed).
+    pairs = drafter.discover(inputs, manifests, skip=out_dir)
     # Largest first, as the local batch orders its files: a big file started last would keep the
     # cluster waiting on one task.
     order = sorted(range(len(pairs)), key=lambda k: (-_size(pairs[k][0]), k))
@@ -97,13 +99,13 @@ def bake_catalog(
         retry_exceptions=False,
         runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}},
     )
-    refs = [task.remote([pairs[k] for k in chunk], options, cpus) for chunk in chunks]
+    refs = [task.remote([pairs[k] for k in chunk], out_dir, options, cpus) for chunk in chunks]
     records: List[Optional[dict]] = [None] * len(pairs)
     for chunk, ref in zip(chunks, refs):
         try:
             results = ray.get(ref)
         except Exception as e:  # a task that failed past its retries: its files fail, the rest go on
-            results = [_lost(*pairs[k], e) for k in chunk]
+            results = [_lost(pairs[k][0], _os.path.join(out_dir, pairs[k][1]), e) for k in chunk]
         for k, record in zip(chunk, results):
             records[k] = record
     if options["cache"] is not None and cache_max is not None:
@@ -130,8 +132,8 @@ def bake_dataset(dataset: Any, out_dir: Any, *, column: str = "path", cpus_per_t
 
     def one(row: dict) -> dict:
         source = _os.path.join(base, _os.path.expanduser(_os.fspath(row[column])))
-        output = _os.path.join(out_dir, _os.path.splitext(_os.path.basename(source))[0] + ".glb")
-        return {"record": _json.dumps(drafter.bake_file(source, output, threads=cpus, **options))}
+        output = _os.path.splitext(_os.path.basename(source))[0] + ".glb"
+        return {"record": _json.dumps(drafter.bake_file(source, output, out_dir=out_dir, threads=cpus, **options))}
 
     return dataset.map(one, num_cpus=cpus, runtime_env={"env_vars": {"RAYON_NUM_THREADS": str(cpus)}})
 

@@ -139,13 +139,17 @@ fn bake(
 
 /// Bakes `input` into `output` (.glb or .gltf) atomically, through the cache when given; returns
 /// the file's record (JSON text, the batch report's per-file entry). A failure is in the record.
+/// With `root`, `output` is a path relative to the folder `root` and is confined below it as a
+/// batch's outputs are (`drafter_catalog::output::confined`: plain names only, no symbolic link
+/// followed, folders created); `drafter.ray`'s tasks bake so.
 #[pyfunction]
-#[pyo3(signature = (input, output, *, config_toml=None, config_json=None, cache=None, cache_max=None, threads=None, max_triangles=None))]
+#[pyo3(signature = (input, output, *, root=None, config_toml=None, config_json=None, cache=None, cache_max=None, threads=None, max_triangles=None))]
 #[allow(clippy::too_many_arguments)]
 fn bake_file(
     py: Python<'_>,
     input: PathBuf,
     output: PathBuf,
+    root: Option<PathBuf>,
     config_toml: Option<&str>,
     config_json: Option<&str>,
     cache: Option<PathBuf>,
@@ -158,9 +162,18 @@ fn bake_file(
     let cache = open_cache(cache.as_deref(), cache_max)?;
     let record = py.detach(|| {
         on_threads(threads, || {
-            if let Some(folder) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
-                let _ = std::fs::create_dir_all(folder);
-            }
+            let output = match &root {
+                Some(root) => match drafter_catalog::output::confined(root, &output) {
+                    Ok(path) => path,
+                    Err(e) => return refused(&input, &root.join(&output), &e),
+                },
+                None => {
+                    if let Some(folder) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
+                        let _ = std::fs::create_dir_all(folder);
+                    }
+                    output
+                }
+            };
             let admit = |bytes| Some(Permit::unbounded(bytes));
             let record = batch::bake_file(&input, &output, &config, &limits, cache.as_ref(), &admit);
             // Eviction lists the whole cache: only when a bound was asked for (a caller baking
@@ -168,10 +181,28 @@ fn bake_file(
             if let Some(cache) = cache.as_ref().filter(|c| c.max_bytes.is_some()) {
                 cache.evict();
             }
-            record
+            serde_json::to_value(&record)
+                .unwrap_or_else(|e| refused(&input, &output, &drafter_catalog::Error::Io(e.to_string())))
         })
     })?;
-    serde_json::to_string(&record).map_err(|e| InternalError::new_err(e.to_string()))
+    Ok(record.to_string())
+}
+
+/// The record of a file refused before its bake (an output path that would leave `root`), with
+/// the keys of a batch report's failed record.
+fn refused(input: &Path, output: &Path, e: &drafter_catalog::Error) -> serde_json::Value {
+    serde_json::json!({
+        "input": input.display().to_string(),
+        "output": output.display().to_string(),
+        "status": "failed",
+        "cache": "off",
+        "ms": 0.0,
+        "bytes_in": 0,
+        "bytes_out": 0,
+        "estimated_peak_bytes": 0,
+        "error": e.to_string().replace('\n', " "),
+        "exit_code": e.exit_code(),
+    })
 }
 
 fn open_cache(dir: Option<&Path>, max: Option<u64>) -> PyResult<Option<Cache>> {
@@ -199,9 +230,10 @@ impl batch::Observer for Progress<'_> {
     }
 
     fn finished(&self, _item: &drafter_catalog::discover::Item, _bytes: u64, record: &batch::Record) {
+        // Counted under the lock, so that the calls come in the order of `done`.
+        let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
         let done = self.done.fetch_add(1, Ordering::SeqCst) + 1;
         let Some(callback) = &self.callback else { return };
-        let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
         if error.is_some() {
             return;
         }
@@ -237,7 +269,9 @@ fn bake_many(
     max_triangles: Option<u64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(String, Option<Py<PyAny>>)> {
-    let items = discover(inputs, manifests, Some(out_dir.clone()))?;
+    // As the CLI's batch: a folder below a named one that cannot be listed is one failed record.
+    let found = drafter_catalog::discover::discover_all(&inputs, &manifests, Some(&out_dir))
+        .map_err(|e| InputError::new_err(e.to_string()))?;
     let options = batch::Options {
         config: config(config_toml, config_json)?,
         limits: limits(max_triangles),
@@ -245,10 +279,6 @@ fn bake_many(
         memory_budget: memory.unwrap_or_else(batch::default_memory_budget),
         workers: jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)).max(1),
     };
-    let items: Vec<_> = items
-        .into_iter()
-        .map(|(input, relative_output)| drafter_catalog::discover::Item { input, relative_output })
-        .collect();
     let stop = AtomicBool::new(false);
     let observer = Progress {
         callback: progress,
@@ -263,7 +293,8 @@ fn bake_many(
         let caller = std::thread::current();
         let (summary, interrupt) = std::thread::scope(|scope| {
             let batch = scope.spawn(|| {
-                let summary = batch::run(&items, &out_dir, &options, &|| stop.load(Ordering::SeqCst), &observer);
+                let summary =
+                    batch::run_discovered(&found, &out_dir, &options, &|| stop.load(Ordering::SeqCst), &observer);
                 caller.unpark();
                 summary
             });
