@@ -12,7 +12,8 @@
 //! The codec is Google's; only the framing (which accessors, which buffer, the JSON) is ours. The
 //! streams are decoded by `draco-oxide-decoder` (crates.io, MIT OR Apache-2.0, Re:Earth's pure-Rust
 //! port of draco's decoder, bitstream 2.2: sequential and edgebreaker connectivity, every
-//! prediction scheme, quantized and octahedral attributes), pinned exactly while it is an alpha.
+//! prediction scheme, quantized and octahedral attributes), pinned exactly while it is an alpha and
+//! patched in `vendor/` (below).
 //! Compared on 2026-12-06 (2-core VM, issue 61):
 //!
 //! * **Correctness.** On the Khronos sample assets' Draco variants in `../shared/models`
@@ -41,7 +42,10 @@
 //! face count must be the indices accessor's count / 3 (which the importer has already checked
 //! against `--max-triangles`), and the vertex and symbol counts cannot exceed what that many faces
 //! can use. A stream that decodes anything else than the accessors describe (components, types) is
-//! refused, naming the primitive. The decoder's own checks cover the rest, and a panic inside it
+//! refused, naming the primitive. One count deeper in the stream (texture-coordinate orientations,
+//! a u32 that drove a loop and an allocation of up to 2^32: 40 s and 4 GB for a mutated 2 KB
+//! stream) is checked by a one-line patch of the decoder, `vendor/draco-oxide-decoder`
+//! (`PATCHED.md`), until upstream has it. The decoder's own checks cover the rest, and a panic inside it
 //! (one is known, see [`guarded`]) becomes the primitive's error; the fuzzer (`fuzz/`, a Draco seed
 //! among the glTF and GLB ones) and `tests/draco.rs` mutate streams in every test run.
 //!
