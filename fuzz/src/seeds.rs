@@ -64,6 +64,30 @@ pub fn corpus(repo: &Path, max_bytes: usize) -> anyhow::Result<Corpus> {
         }
     }
 
+    // Committed seeds of what nothing in the workspace writes: a Draco-compressed glTF
+    // (KHR_draco_mesh_compression, issue 61; fuzz/seeds/draco-cylinder.py says how it was made),
+    // mutated as a GLB and as a .gltf with a data URI.
+    let committed = repo.join("fuzz/seeds");
+    let mut committed_files: Vec<_> = std::fs::read_dir(&committed)
+        .with_context(|| format!("{}: the committed seeds", committed.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    committed_files.sort();
+    anyhow::ensure!(
+        committed_files.iter().any(|p| p.file_name().is_some_and(|n| n == "draco-cylinder.glb")),
+        "{}: the Draco seed draco-cylinder.glb is missing",
+        committed.display()
+    );
+    for path in &committed_files {
+        let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
+        let name = format!("fuzz/seeds/{}", path.file_name().unwrap_or_default().to_string_lossy());
+        if let Some(gltf) = glb_to_gltf(&bytes) {
+            corpus.add(Target::Gltf, format!("{name} (as .gltf)"), gltf);
+        }
+        corpus.add(Target::Glb, name, bytes);
+    }
+
     let shared = repo.join("../shared/models");
     let mut files = Vec::new();
     walk(&shared, &mut files);

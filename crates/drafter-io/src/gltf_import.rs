@@ -68,7 +68,10 @@ pub(crate) fn import(
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e)).in_path(path))?;
     let document = gltf::Document::from_json_without_validation(root);
     check_required_extensions(document.as_json()).map_err(|e| e.in_path(path))?;
-    validate(document.as_json()).map_err(|e| e.in_path(path))?;
+    // Draco-compressed accessors have no bufferView until the streams are decoded below (and
+    // validated again then).
+    let draco_pending = draco::mentions_extension(json_bytes);
+    validate(document.as_json(), draco_pending).map_err(|e| e.in_path(path))?;
     check_listed_triangles(&document, limits).map_err(|e| e.in_path(path))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut buffers = load_buffers(&document, blob, folder).map_err(|e| e.in_path(path))?;
@@ -82,7 +85,7 @@ pub(crate) fn import(
             buffers.push(decoded.buffer);
             let root: gltf::json::Root = gltf::json::deserialize::from_str(&decoded.json)
                 .map_err(|e| ParseError::in_file(format!("{}: {e}", draco::EXTENSION)).in_path(path))?;
-            validate(&root).map_err(|e| e.in_path(path))?;
+            validate(&root, false).map_err(|e| e.in_path(path))?;
             (gltf::Document::from_json_without_validation(root), decoded.json)
         }
         Err(e) => {
@@ -209,7 +212,9 @@ fn check_required_extensions(root: &gltf::json::Root) -> Result<(), ParseError> 
     Ok(())
 }
 
-fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
+/// Validates `root`; with `draco_pending`, an accessor's missing `bufferView` is let through (a
+/// Draco stream fills it, and the decoded document is validated again).
+fn validate(root: &gltf::json::Root, draco_pending: bool) -> Result<(), ParseError> {
     // gltf-json 1.4's validation indexes `accessors` with a primitive's POSITION unchecked (its
     // min/max rule in mesh.rs), so an out-of-range POSITION would panic inside the dependency:
     // refuse it here first, as the validator would.
@@ -236,6 +241,13 @@ fn validate(root: &gltf::json::Root) -> Result<(), ParseError> {
         let path = path();
         // Required extensions were checked above against what we really support.
         let is_required_extension = path.as_str().starts_with("extensionsRequired");
+        let filled_by_draco = draco_pending
+            && error == gltf::json::validation::Error::Missing
+            && path.as_str().starts_with("accessors[")
+            && path.as_str().ends_with(".bufferView");
+        if filled_by_draco {
+            return;
+        }
         if !(is_required_extension && error == gltf::json::validation::Error::Unsupported) {
             errors.push((path, error));
         }
