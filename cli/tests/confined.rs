@@ -66,7 +66,7 @@ fn confined_run(t: &Path, args: &[&str], allowed: &[&str]) -> Output {
         .filter(|p| before.get(*p) != after.get(*p))
         // The folders on the way to `-o` are created as the user asked.
         .filter(|p| {
-            !(before.get(*p).is_none()
+            !(!before.contains_key(*p)
                 && after.get(*p) == Some(&Node::Folder)
                 && allowed.iter().any(|a| a.starts_with(p)))
         })
