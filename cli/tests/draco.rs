@@ -79,7 +79,7 @@ fn mesh_triangles(doc: &Value, bin: &[u8]) -> Vec<Vec<Triangle>> {
 }
 
 /// How many of `got` have no twin in `want` (same winding, any first corner, each corner within
-/// `tolerance` per axis); each twin is used once.
+/// `tolerance` per axis); each twin is used once, the closest first.
 fn unmatched(got: &[Triangle], want: &[Triangle], tolerance: f32) -> usize {
     let cell = 4.0 * tolerance;
     let key = |t: &Triangle| {
