@@ -22,18 +22,22 @@
 //!   the same order, with the same positions, and every triangle of the uncompressed siblings is
 //!   found with the same winding and positions within the 11-bit quantization step.
 //!   `tests/draco.rs` here and `cli/tests/draco.rs` keep that checked.
-//! * **Build.** Pure Rust: nothing beyond cargo. Its own dependencies (kiddo, fixed, tracing,
-//!   draco-oxide-core) took 1 min 16 s of CPU for a clean release build (3 min wall on the shared
-//!   2-core VM); `docs/usage.md` has the figure added to drafter's build. The C++ binding
-//!   `draco-rs` (0.1.3, MIT) builds Google's library with CMake and generates its bindings with
-//!   autocxx (libclang): CMake and libclang are build requirements drafter has nowhere else, and
-//!   its build was several times longer (figures in `docs/usage.md`). `draco_decoder` (0.0.31, "wip")
+//! * **Build.** Pure Rust: nothing beyond cargo. It brings 23 crates (draco-oxide-core, kiddo,
+//!   fixed, tracing-subscriber, …): about 45 s of CPU added to a clean release build (`docs/usage.md`).
+//!   The C++ binding `draco-rs` (0.1.3, MIT) builds Google's library with CMake and generates its
+//!   bindings with autocxx (libclang), build requirements drafter has nowhere else; here (Debian 12,
+//!   GCC 12, CMake 3.25, libclang 22) it did not build at all: after 10.4 min (2 jobs, shared VM) the
+//!   library was built and autocxx's generated C++ failed ("use of deleted function
+//!   `draco::PointCloud::PointCloud(const draco::PointCloud&)`"). `draco_decoder` (0.0.31, "wip")
 //!   compiles the C++ natively and loads Google's JavaScript decoder in the browser.
 //! * **Browser.** A C++ library has no `wasm32-unknown-unknown` build without a C++ standard
 //!   library (meshoptimizer compiles only because it needs no libc++), so `draco-rs` cannot go into
-//!   the page; the Rust port compiles with the rest of the viewer (`docs/web.md`).
-//! * **Maintenance.** draco-oxide is developed in the open by Re:Earth (reearth/draco-oxide), with
-//!   frequent releases through 2026; `draco-rs` is a single-author binding, last released 2024.
+//!   the page; the Rust port compiles for it, adding about 50 KB gzip (`docs/web.md`).
+//! * **License and maintenance.** Both MIT (draco-oxide: MIT OR Apache-2.0, as drafter). draco-oxide
+//!   is an organisation's repository (reearth/draco-oxide) with 13 releases so far (alpha.0 to
+//!   alpha.12), split into core and decoder crates; `draco-rs` is one author's binding
+//!   (soraxas/draco-rs, 4 releases). An alpha is the risk taken: pinned exactly, checked by the
+//!   tests below and the fuzzer, and patched here where they found a gap.
 //!
 //! # Hostile streams
 //!
@@ -43,7 +47,7 @@
 //! against `--max-triangles`), and the vertex and symbol counts cannot exceed what that many faces
 //! can use. A stream that decodes anything else than the accessors describe (components, types) is
 //! refused, naming the primitive. One count deeper in the stream (texture-coordinate orientations,
-//! a u32 that drove a loop and an allocation of up to 2^32: 40 s and 4 GB for a mutated 2 KB
+//! a u32 that drove a loop and an allocation of up to 2^32 entries: 30-40 s for a mutated 2 KB
 //! stream) is checked by a one-line patch of the decoder, `vendor/draco-oxide-decoder`
 //! (`PATCHED.md`), until upstream has it. The decoder's own checks cover the rest, and a panic inside it
 //! (one is known, see [`guarded`]) becomes the primitive's error; the fuzzer (`fuzz/`, a Draco seed
