@@ -23,7 +23,7 @@
 //!   found with the same winding and positions within the 11-bit quantization step.
 //!   `tests/draco.rs` here and `cli/tests/draco.rs` keep that checked.
 //! * **Build.** Pure Rust: nothing beyond cargo. It brings 23 crates (draco-oxide-core, kiddo,
-//!   fixed, tracing-subscriber, …): about 45 s of CPU added to a clean release build (`docs/usage.md`).
+//!   fixed, tracing-subscriber, …): about 33 s of CPU added to a clean release build (`docs/usage.md`).
 //!   The C++ binding `draco-rs` (0.1.3, MIT) builds Google's library with CMake and generates its
 //!   bindings with autocxx (libclang), build requirements drafter has nowhere else; here (Debian 12,
 //!   GCC 12, CMake 3.25, libclang 22) it did not build at all: after 10.4 min (2 jobs, shared VM) the
