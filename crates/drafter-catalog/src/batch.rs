@@ -323,7 +323,7 @@ fn bake_file_inner<'b>(
         Ok(baked) => baked,
         Err(e) => {
             // The input's fault is decided by what the key covers: stored, so that a rerun replays
-            // it (the two Draco files of the shared models cost 3 ms each to parse and refuse).
+            // it without parsing the file again.
             // The key covers the file's name and bytes, not its folder: the path is stored as a
             // placeholder, so that a cache shared between machines names each one's own path.
             if let Some((cache, Some(key))) = key
