@@ -456,6 +456,15 @@ fn refusals_are_replayed_from_the_cache_with_the_same_reason() {
     assert!(other.iter().all(|f| f.1 == "miss"), "{other:?}");
 }
 
+/// `drafter bake INPUT -o OUT EXTRA...`, its outcome not checked.
+fn batch(input: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    common::drafter().arg("bake").arg(input).arg("-o").arg(out).args(extra).output().expect("drafter runs")
+}
+
+fn utf8(path: &Path) -> &str {
+    path.to_str().expect("a UTF-8 path")
+}
+
 /// `[k/n] name: ...` lines on a pipe, and the notes a single bake prints (issue 56).
 #[test]
 fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
@@ -472,7 +481,7 @@ fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
     let single = common::drafter().arg("bake").arg(input.join("nan.obj")).arg("-o").arg(dir.join("one.glb")).output();
     let single = String::from_utf8_lossy(&single.unwrap().stderr).into_owned();
     assert!(single.contains("non-finite positions: 1"), "{single}");
-    let out = common::drafter().arg("bake").arg(&input).arg("-o").arg(dir.join("out")).output().unwrap();
+    let out = batch(&input, &dir.join("out"), &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains('\r'), "no carriage returns on a pipe: {stderr:?}");
@@ -482,7 +491,7 @@ fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
     assert!(lines.iter().all(|l| l.contains(": baked ")), "{stderr}");
     assert!(stderr.contains("note: non-finite positions: 1"), "{stderr}");
     // --quiet: nothing but failures.
-    let quiet = common::drafter().arg("bake").arg(&input).arg("-o").arg(dir.join("q")).arg("--quiet").output().unwrap();
+    let quiet = batch(&input, &dir.join("q"), &["--quiet"]);
     assert!(quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
 }
 
@@ -497,17 +506,7 @@ fn eviction_keeps_an_entry_whose_output_was_up_to_date() {
         std::fs::write(dir.join(name).join(format!("{name}.off")), tetrahedron(k)).unwrap();
     }
     let bake = |name: &str, out: &str| -> serde_json::Value {
-        let output = common::drafter()
-            .arg("bake")
-            .arg(dir.join(name))
-            .arg("-o")
-            .arg(dir.join(out))
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--json")
-            .arg("--quiet")
-            .output()
-            .unwrap();
+        let output = batch(&dir.join(name), &dir.join(out), &["--cache", utf8(&cache), "--json", "--quiet"]);
         assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
         serde_json::from_slice(&output.stdout).unwrap()
     };
@@ -539,17 +538,7 @@ fn a_file_over_the_memory_budget_runs_alone_and_the_report_says_so() {
     std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb"), input.join("s.glb")).unwrap();
     std::fs::write(input.join("a.off"), tetrahedron(1)).unwrap();
     let report_path = dir.join("r.json");
-    let out = common::drafter()
-        .arg("bake")
-        .arg(&input)
-        .arg("-o")
-        .arg(dir.join("out"))
-        .arg("--memory")
-        .arg("1M")
-        .arg("--report")
-        .arg(&report_path)
-        .output()
-        .unwrap();
+    let out = batch(&input, &dir.join("out"), &["--memory", "1M", "--report", utf8(&report_path)]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stderr = String::from_utf8_lossy(&out.stderr);
     let r = report(&report_path);
@@ -574,16 +563,7 @@ fn a_cached_refusal_names_this_runs_path() {
         let input = dir.join(runner).join("models");
         std::fs::create_dir_all(&input).unwrap();
         std::fs::write(input.join("truncated.glb"), &sample[..sample.len() / 3]).unwrap();
-        let out = common::drafter()
-            .arg("bake")
-            .arg(&input)
-            .arg("-o")
-            .arg(dir.join(runner).join("out"))
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--json")
-            .output()
-            .unwrap();
+        let out = batch(&input, &dir.join(runner).join("out"), &["--cache", utf8(&cache), "--json"]);
         assert_eq!(out.status.code(), Some(4));
         let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         errors.push((r["files"][0]["cache"].clone(), r["files"][0]["error"].as_str().unwrap().to_owned()));
@@ -617,16 +597,7 @@ fn the_report_counts_a_gltfs_buffers_and_names_the_build_and_config() {
     let text = serde_json::to_vec(&json).unwrap();
     std::fs::write(input.join("tri.gltf"), &text).unwrap();
     let report_path = dir.join("r.json");
-    let out = common::drafter()
-        .arg("bake")
-        .arg(&input)
-        .arg("-o")
-        .arg(dir.join("out"))
-        .arg("--report")
-        .arg(&report_path)
-        .arg("--quiet")
-        .output()
-        .unwrap();
+    let out = batch(&input, &dir.join("out"), &["--report", utf8(&report_path), "--quiet"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r = report(&report_path);
     assert_eq!(r["files"][0]["bytes_in"].as_u64().unwrap(), (text.len() + bin.len()) as u64, "{r}");

@@ -590,6 +590,7 @@ mod tests {
                 s.spawn(|| {
                     while let Some(&bytes) = requests.get(next.fetch_add(1, Ordering::SeqCst)) {
                         let permit = budget.admit(bytes, &never).unwrap();
+                        assert_eq!(permit.over_budget(), bytes > 100);
                         let now = running.fetch_add(permit.bytes, Ordering::SeqCst) + permit.bytes;
                         worst.fetch_max(now, Ordering::SeqCst);
                         std::thread::sleep(Duration::from_micros(200));
@@ -598,9 +599,10 @@ mod tests {
                 });
             }
         });
-        assert!(worst.load(Ordering::SeqCst) <= 100);
-        assert_eq!(budget.peak(), worst.load(Ordering::SeqCst).max(budget.peak()));
-        assert!(budget.peak() <= 100);
+        assert!(worst.load(Ordering::SeqCst) <= 100, "reserved at once");
+        // The peak is of the estimates: the request over the whole budget ran alone, and the peak
+        // says so rather than the budget it was held to.
+        assert_eq!(budget.peak(), 150);
         // A stop request releases a waiter.
         let held = budget.admit(100, &never).unwrap();
         assert!(budget.admit(50, &|| true).is_none());
