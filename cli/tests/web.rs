@@ -336,6 +336,13 @@ fn a_gltf_dropped_with_its_files_loads_and_a_lone_gltf_says_what_to_drop() {
     assert_eq!(json["state"], "ready", "{json}");
     assert_eq!(json["summary"]["name"], "GearboxAssy.gltf", "{json}");
     assert!(json["summary"]["triangles"].as_u64().is_some_and(|t| t > 600_000), "{json}");
+    // Its Draco-compressed variant (KHR_draco_mesh_compression), dropped the same way: the module
+    // decodes it as the CLI does, to the same triangles.
+    let draco = folder.join("draco");
+    let both = format!("{},{}", draco.join("GearboxAssy.gltf").display(), draco.join("GearboxAssy.bin").display());
+    let compressed = probe(&sample(), &["--drop", &both]);
+    assert_eq!(compressed["state"], "ready", "{compressed}");
+    assert_eq!(compressed["summary"]["triangles"], json["summary"]["triangles"], "{compressed}");
 
     // The same with an image beside it (a texture the file lists): dropped with the rest, it loads;
     // left out, the page names it.
