@@ -3,9 +3,9 @@
 
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use drafter_viewer::{Image, Model, Renderer};
+use drafter_viewer::{Image, Renderer};
 
 /// Mean absolute difference (RGB, in [0, 1]) a golden image may show.
 pub const MAX_MEAN_ABS: f64 = 0.02;
@@ -26,38 +26,11 @@ pub fn renderer() -> Renderer {
     }
 }
 
-pub fn repo_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(relative)
-}
-
-/// A model from ../shared/models, failing loudly when the corpus is missing.
-pub fn corpus_path(relative: &str) -> PathBuf {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models").join(relative);
-    assert!(
-        path.is_file(),
-        "test model {} is missing: the tests need ../shared/models beside the repository",
-        path.display()
-    );
-    path
-}
-
-/// Imports `path`, bakes it in memory with the default config and loads the result as the viewer
-/// would load the file `drafter bake` writes.
-pub fn baked(path: &Path) -> Model {
-    let imported = drafter_io::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let baked = drafter_bake::bake(&imported.scene, &drafter_bake::BakeConfig::default())
-        .unwrap_or_else(|e| panic!("{}: bake failed: {e}", path.display()));
-    assert!(baked.written.bin.is_none(), "the default container is .glb");
-    let name = format!("{}.baked.glb", path.file_stem().map(|s| s.to_string_lossy()).unwrap_or_default());
-    let model = Model::load_bytes(Path::new(&name), &baked.written.main).expect("baked file loads");
-    assert!(model.baked, "{name}: the extension was read");
-    model
-}
-
-/// The sample assembly, baked.
-pub fn sample() -> Model {
-    baked(&repo_path("samples/assembly.glb"))
-}
+// The baked models come from the drawing's test helpers, one copy for both crates.
+#[path = "../../../crates/drafter-draw/tests/common/mod.rs"]
+mod baking;
+#[allow(unused_imports)] // each test binary uses some of them
+pub use baking::{baked, corpus_path, repo_path, sample};
 
 /// Compares `image` with `golden/<name>.png` (or rewrites it when [`UPDATE_ENV`] is 1). Returns a
 /// description of the failure, if any; the actual image is then saved beside the test's temp dir.

@@ -1,4 +1,5 @@
-//! Shared by the drawing's tests: models baked in memory, as `drafter bake` writes them.
+//! Shared by the drawing's tests and the viewer's (which include this file): models baked in
+//! memory, as `drafter bake` writes them.
 
 #![allow(dead_code)]
 
@@ -6,8 +7,11 @@ use std::path::{Path, PathBuf};
 
 use drafter_scene::Model;
 
+/// `relative` in the repository: the folder above the including crate that holds Cargo.lock.
 pub fn repo_path(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(relative)
+    let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = crate_dir.ancestors().find(|p| p.join("Cargo.lock").is_file()).unwrap_or(crate_dir);
+    root.join(relative)
 }
 
 /// A model from ../shared/models, failing loudly when the corpus is missing.
