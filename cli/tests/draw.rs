@@ -243,7 +243,10 @@ fn chromium_draws_the_svg_where_drafter_render_draws_its_lines() {
     assert!(common::bake(&sample, &baked, &[]).status.success());
     let (svg, shot, render) = (dir.join("view.svg"), dir.join("chromium.png"), dir.join("render.png"));
     let view = ["--size", "800x600", "--view", "35,25"];
-    let drawn = common::run(&[&["draw", baked.to_str().unwrap(), "-o", svg.to_str().unwrap()][..], &view].concat());
+    // Gooch's weights, as the raster pass draws them (ISO 128's one 0.5 mm width is 1.89 px).
+    let drawn = common::run(
+        &[&["draw", baked.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--style", "gooch"][..], &view].concat(),
+    );
     assert!(drawn.status.success(), "{}", String::from_utf8_lossy(&drawn.stderr));
     // The raster pass draws creases white: hide the drawing's with a stylesheet, as a user would.
     let text = std::fs::read_to_string(&svg).unwrap();

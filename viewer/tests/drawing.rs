@@ -160,7 +160,7 @@ fn the_fills_match_the_renderers_parts() {
             let wrong = ids.iter().zip(&parts.ids).filter(|(a, b)| a != b).count();
             let share = wrong as f64 / covered.max(1) as f64;
             let loops: usize = drawing.fills.iter().flat_map(|f| &f.regions).map(|r| r.loops.len()).sum();
-            let svg = drawing::to_svg(&drawing, Hidden::None);
+            let svg = drawing::to_svg(&drawing, Hidden::None, drawing::LineStyle::default());
             eprintln!(
                 "{name} {fill:?}: {} parts, {loops} loops, {} SVG bytes; {wrong} of {covered} covered pixels ({:.3}%) differ from the renderer's part",
                 drawing.fills.len(),

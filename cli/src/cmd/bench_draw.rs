@@ -139,7 +139,7 @@ pub fn run(args: Args) -> Result<()> {
                 tolerance_px,
                 ms: time.as_secs_f64() * 1e3,
                 strokes: drawing.strokes.len(),
-                svg_bytes: drawing::to_svg(drawing, Hidden::Dashed).len(),
+                svg_bytes: drawing::to_svg(drawing, Hidden::Dashed, drafter_draw::LineStyle::default()).len(),
                 visible_px: drawing.stats.visible_px,
                 hidden_px: drawing.stats.hidden_px,
                 visible_reference_covered: covered(&reference_points[0], &points[0]),

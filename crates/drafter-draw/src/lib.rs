@@ -52,11 +52,15 @@ use drafter_scene::edges::LineClass;
 use drafter_scene::model::Model;
 use drafter_scene::style::{DEFAULT_FOV_Y_DEG, View};
 
+pub mod dxf;
 pub mod fills;
 pub mod merge;
+pub mod style;
 
+pub use crate::dxf::to_dxf;
 pub use crate::fills::{Fill, PartFill};
 pub use crate::merge::doubled_visible_length;
+pub use crate::style::{LineStyle, MM_PER_PX, Pen};
 
 /// What a drawing shows of the lines hidden by surfaces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -717,6 +721,22 @@ fn chain(pieces: &[Piece], tolerance: f64) -> Vec<Stroke> {
     strokes
 }
 
+/// The order the writers draw the classes in, within the hidden lines and then the visible ones:
+/// silhouettes last, on top ([`to_svg`], [`to_pdf`], [`dxf::to_dxf`]).
+pub const CLASS_ORDER: [LineClass; 5] =
+    [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
+
+/// The strokes in the order the writers draw them: hidden ones first (when `hidden` draws them),
+/// each visibility by [`CLASS_ORDER`], each class in the drawing's order. One SVG path, one PDF
+/// subpath, one DXF polyline per stroke, in this order.
+pub fn strokes_in_order(drawing: &Drawing, hidden: Hidden) -> impl Iterator<Item = &Stroke> {
+    [false, true].into_iter().filter(move |&visible| visible || hidden != Hidden::None).flat_map(move |visible| {
+        CLASS_ORDER
+            .into_iter()
+            .flat_map(move |class| drawing.strokes.iter().filter(move |st| st.visible == visible && st.class == class))
+    })
+}
+
 /// The class names of the SVG groups and paths.
 pub fn class_name(class: LineClass) -> &'static str {
     match class {
@@ -728,32 +748,27 @@ pub fn class_name(class: LineClass) -> &'static str {
     }
 }
 
-/// Stroke widths in pixels, after Gooch et al. 1999 (§3): silhouettes heaviest, black; creases
-/// lighter; hidden lines thin.
-fn width_of(class: LineClass, visible: bool) -> f64 {
-    if !visible {
-        return 0.6;
-    }
-    match class {
-        LineClass::Silhouette => 1.6,
-        LineClass::Boundary | LineClass::PartBorder | LineClass::NonManifold => 1.2,
-        LineClass::Crease => 0.9,
-    }
-}
-
 /// The drawing as SVG: a group per visibility, a group per class inside, one path per stroke
 /// carrying its part (`class="part-N"`); coordinates at a hundredth of a pixel (or the tolerance,
-/// if finer). Restyle with CSS on the ids and classes.
-pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
+/// if finer), in a viewBox of the drawing's pixels on a page of [`MM_PER_PX`] millimetres a pixel
+/// (96 per inch), so the `style`'s widths and dashes in millimetres are exact on paper
+/// ([`style`]). Restyle with CSS on the ids and classes.
+pub fn to_svg(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let (w, h) = (drawing.width, drawing.height);
+    let (page_w, page_h) = (style::short(f64::from(w) * MM_PER_PX), style::short(f64::from(h) * MM_PER_PX));
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{page_w}mm" height="{page_h}mm" viewBox="0 0 {w} {h}" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
     );
-    let _ = writeln!(s, "<desc>drafter draw: {} strokes</desc>", drawing.strokes.len());
+    let _ = writeln!(
+        s,
+        "<desc>drafter draw: {} strokes, style {}; 1 px = 25.4/96 mm (96 px per inch), 1:1</desc>",
+        drawing.strokes.len(),
+        style.name()
+    );
     if !drawing.fills.is_empty() {
         // Farthest part first (painter's order); the nonzero rule fills each region's loops.
         let _ = writeln!(s, r#"<g id="fills" stroke-width="0.5">"#);
@@ -786,26 +801,30 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
         }
         let _ = writeln!(s, "</g>");
     }
-    let classes =
-        [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
     for visible in [false, true] {
         if !visible && hidden == Hidden::None {
             continue;
         }
-        let (id, extra) = match (visible, hidden) {
-            (true, _) => ("visible", String::new()),
-            (false, Hidden::Dashed) => ("hidden", r#" stroke-dasharray="4 3""#.to_string()),
-            (false, _) => ("hidden", String::new()),
-        };
-        let colour = if visible { "#000" } else { "#666" };
-        let _ = writeln!(s, r#"<g id="{id}" stroke="{colour}"{extra}>"#);
-        for class in classes {
+        // The visibility's group carries the colour and dashes of its creases' pen; a class whose
+        // pen differs says so on its own group.
+        let id = if visible { "visible" } else { "hidden" };
+        let group = style.pen(LineClass::Crease, visible, hidden);
+        let _ = writeln!(s, r#"<g id="{id}" stroke="{}"{}>"#, group.svg_colour(), svg_dashes(group.dash));
+        for class in CLASS_ORDER {
             let strokes: Vec<&Stroke> =
                 drawing.strokes.iter().filter(|st| st.visible == visible && st.class == class).collect();
             if strokes.is_empty() {
                 continue;
             }
-            let _ = writeln!(s, r#"<g class="{}" stroke-width="{}">"#, class_name(class), width_of(class, visible));
+            let pen = style.pen(class, visible, hidden);
+            let mut extra = String::new();
+            if pen.grey != group.grey {
+                let _ = write!(extra, r#" stroke="{}""#, pen.svg_colour());
+            }
+            if pen.dash != group.dash {
+                extra += &pen.dash.map_or_else(|| r#" stroke-dasharray="none""#.to_string(), |d| svg_dashes(Some(d)));
+            }
+            let _ = writeln!(s, r#"<g class="{}" stroke-width="{}"{extra}>"#, class_name(class), pen.width.svg());
             for stroke in strokes {
                 let part = stroke.part.map(|p| format!(r#" class="part-{p}""#)).unwrap_or_default();
                 let _ = write!(s, r#"<path{part} d=""#);
@@ -822,10 +841,16 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden) -> String {
     s
 }
 
+/// ` stroke-dasharray="…"` for a dashed pen, nothing for a continuous one.
+fn svg_dashes(dash: Option<[style::Length; 2]>) -> String {
+    dash.map(|[on, off]| format!(r#" stroke-dasharray="{} {}""#, on.svg(), off.svg())).unwrap_or_default()
+}
+
 /// The drawing as a one-page PDF (pdf-writer), the same strokes, widths, greys and dashes as
-/// [`to_svg`], a pixel drawn as 0.75 pt (96 per inch), y turned up as PDF wants it. Hidden lines
-/// first, then each visible class, silhouettes last, as in the SVG.
-pub fn to_pdf(drawing: &Drawing, hidden: Hidden) -> Vec<u8> {
+/// [`to_svg`] on the same page: a pixel drawn as 0.75 pt (96 per inch), widths and dashes in
+/// millimetres at 72/25.4 pt each, y turned up as PDF wants it. Hidden lines first, then each
+/// visible class, silhouettes last, as in the SVG.
+pub fn to_pdf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
     use pdf_writer::{Content, Finish, Pdf, Rect, Ref};
     const POINTS_PER_PIXEL: f32 = 0.75;
     let (catalog, tree, page, content_id) = (Ref::new(1), Ref::new(2), Ref::new(3), Ref::new(4));
@@ -859,19 +884,19 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden) -> Vec<u8> {
     }
     content.set_line_cap(pdf_writer::types::LineCapStyle::RoundCap);
     content.set_line_join(pdf_writer::types::LineJoinStyle::RoundJoin);
-    let classes =
-        [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
     for visible in [false, true] {
         if !visible && hidden == Hidden::None {
             continue;
         }
-        content.set_stroke_gray(if visible { 0.0 } else { 0.4 });
-        match (visible, hidden) {
-            (false, Hidden::Dashed) => content.set_dash_pattern([4.0 * POINTS_PER_PIXEL, 3.0 * POINTS_PER_PIXEL], 0.0),
-            _ => content.set_dash_pattern([], 0.0),
-        };
-        for class in classes {
-            content.set_line_width(width_of(class, visible) as f32 * POINTS_PER_PIXEL);
+        for class in CLASS_ORDER {
+            let pen = style.pen(class, visible, hidden);
+            let points = |length: style::Length| length.px() as f32 * POINTS_PER_PIXEL;
+            content.set_stroke_gray(pen.grey as f32);
+            match pen.dash {
+                Some([on, off]) => content.set_dash_pattern([points(on), points(off)], 0.0),
+                None => content.set_dash_pattern([], 0.0),
+            };
+            content.set_line_width(points(pen.width));
             let mut any = false;
             for stroke in drawing.strokes.iter().filter(|st| st.visible == visible && st.class == class) {
                 for (i, q) in stroke.points.iter().enumerate() {

@@ -8,7 +8,7 @@
 mod common;
 
 use drafter_draw::brute::{blocked, world_triangles};
-use drafter_draw::{self as drawing, DrawOptions, Hidden};
+use drafter_draw::{self as drawing, DrawOptions, Hidden, LineStyle};
 use drafter_scene::edges::{LineClass, WorldView};
 use drafter_scene::{Model, View};
 use glam::DVec2;
@@ -106,15 +106,27 @@ fn the_svg_groups_classes_and_chains_pieces() {
     let drawing = drawing::draw(&model, &options);
     let pieces: usize = drawing.strokes.iter().map(|s| s.points.len() - 1).sum();
     assert!(drawing.strokes.len() * 3 < pieces * 2, "chained: {} strokes for {pieces} pieces", drawing.strokes.len());
-    let svg = drawing::to_svg(&drawing, options.hidden);
-    for needle in
-        [r#"<g id="visible""#, r#"<g id="hidden""#, r#"class="silhouette""#, r#"class="crease""#, "stroke-dasharray"]
-    {
-        assert!(svg.contains(needle), "{needle}");
+    let again = drawing::draw(&model, &options);
+    for style in [LineStyle::Iso128, LineStyle::Gooch] {
+        let svg = drawing::to_svg(&drawing, options.hidden, style);
+        for needle in [
+            r#"<g id="visible""#,
+            r#"<g id="hidden""#,
+            r#"class="silhouette""#,
+            r#"class="crease""#,
+            "stroke-dasharray",
+        ] {
+            assert!(svg.contains(needle), "{style:?}: {needle}");
+        }
+        assert!(svg.contains(r#"class="part-"#), "paths name their parts");
+        assert_eq!(svg, drawing::to_svg(&again, options.hidden, style), "deterministic");
+        assert_eq!(drawing::to_dxf(&drawing, options.hidden, style), drawing::to_dxf(&again, options.hidden, style));
     }
-    assert!(svg.contains(r#"class="part-"#), "paths name their parts");
-    assert_eq!(svg, drawing::to_svg(&drawing::draw(&model, &options), options.hidden), "deterministic");
-    let none = drawing::to_svg(&drawing::draw(&model, &DrawOptions { hidden: Hidden::None, ..options }), Hidden::None);
+    let none = drawing::to_svg(
+        &drawing::draw(&model, &DrawOptions { hidden: Hidden::None, ..options }),
+        Hidden::None,
+        LineStyle::default(),
+    );
     assert!(!none.contains(r#"<g id="hidden""#));
 }
 
