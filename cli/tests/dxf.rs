@@ -247,6 +247,7 @@ fn dxf_of_the_sample_and_a_cad_assembly_reads_back_in_ezdxf_and_librecad() {
                 worst = worst.max((vx - x * MM_PER_PX).abs()).max((vy - (height - y) * MM_PER_PX).abs());
             }
         }
+        eprintln!("{name}: the farthest DXF vertex {worst:.5} mm from its SVG point");
         assert!(worst <= 0.01, "{name}: a vertex {worst} mm from the SVG's point");
         // The layers' pens: ISO 128 by default, exact in DXF's lineweights.
         let table = &read["layer_table"];
