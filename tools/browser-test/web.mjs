@@ -10,7 +10,7 @@
 //       Loads the page with FILE, then draws each style and saves the canvas as DIR/STYLE.png
 //       (with --capture, and always on WebGPU: the pixels of viewer.capture(), the same frame
 //       drawn offscreen).
-//       Prints {ok, backend, summary, timings, shots, frameMs, consoleErrors}: timings in ms from
+//       Prints {ok, backend, summary, timings, startup, shots, frameMs, consoleErrors}: timings in ms from
 //       the navigation's start (wasmReady, fileFetched, modelLoaded, firstFrame); with --frames,
 //       frameMs holds N full frames of the first style, each timed from recording until the GPU
 //       finished it (a one-pixel readPixels waits for it, as `drafter bench render` waits).
@@ -239,6 +239,7 @@ async function main() {
         message: v.message,
         summary: v.summary,
         timings: v.timings,
+        startup: v.startup ?? null,
         backend: v.viewer?.backend() ?? null,
       };
     });
@@ -306,7 +307,7 @@ async function main() {
           Number(options.frames),
         );
       }
-      result = { ok: true, backend: status.backend, summary: status.summary, timings: status.timings, shots, frameMs };
+      result = { ok: true, backend: status.backend, summary: status.summary, timings: status.timings, startup: status.startup, shots, frameMs };
     } else if (command === 'interact') {
       const pixels = () =>
         page.evaluate(() => {

@@ -24,7 +24,7 @@
 // For scripts and tests the element reports `state` ("starting", "loading", "ready", "error",
 // "empty"), `message` (the error shown), `notice` (the note shown under the model, e.g. an unbaked
 // file or a WebGPU device that was lost), `summary` (what was loaded), `timings` (ms since the
-// page's start: wasmReady, fileFetched, modelLoaded, firstFrame) and fires "drafter-ready" /
+// page's start: wasmReady, viewerCreated, fileFetched, modelLoaded, firstFrame) and fires "drafter-ready" /
 // "drafter-error".
 
 import init, { Viewer } from './drafter_web.js';
@@ -297,6 +297,8 @@ export class DrafterViewer extends HTMLElement {
     try {
       this.sizeCanvas();
       this.viewer = await Viewer.create(this.canvas, attributes.backend ?? '');
+      this.timings.viewerCreated = performance.now();
+      this.startup = JSON.parse(this.viewer.startup());
     } catch (err) {
       this.fail(`This browser cannot run the viewer: ${err.message ?? err}`);
       return;

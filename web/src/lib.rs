@@ -64,6 +64,8 @@ pub struct Viewer {
     orbit: Orbit,
     model: Option<Model>,
     backend: String,
+    /// Milliseconds of [`Viewer::create`]'s steps, as JSON (see [`Viewer::startup`]).
+    startup: String,
 }
 
 /// Resolves on a later task of the page's event loop (`setTimeout(…, 0)`).
@@ -88,6 +90,7 @@ impl Viewer {
     /// WebGPU where the browser gives an adapter and WebGL2 otherwise.
     pub async fn create(canvas: web_sys::HtmlCanvasElement, backend: &str) -> Result<Viewer, JsError> {
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let start = web_time::Instant::now();
         let backends = match backend {
             "webgpu" => wgpu::Backends::BROWSER_WEBGPU,
             "webgl2" => wgpu::Backends::GL,
@@ -97,9 +100,11 @@ impl Viewer {
             wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() };
         // WebGPU only where an adapter answers: `navigator.gpu` alone does not promise one.
         let instance = wgpu::util::new_instance_with_webgpu_detection(descriptor).await;
+        let instanced = start.elapsed();
         let surface = instance
             .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
             .map_err(|e| js_error(format!("cannot draw into the canvas: {e}")))?;
+        let surfaced = start.elapsed();
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
@@ -108,6 +113,7 @@ impl Viewer {
             })
             .await
             .map_err(|e| js_error(format!("this browser gives no WebGPU or WebGL2 adapter: {e}")))?;
+        let adapted = start.elapsed();
         let capabilities = surface.get_capabilities(&adapter);
         // As the window does: display values end to end, so a non-sRGB 8-bit surface.
         let format = [wgpu::TextureFormat::Rgba8Unorm, wgpu::TextureFormat::Bgra8Unorm]
@@ -117,6 +123,7 @@ impl Viewer {
             .or_else(|| capabilities.formats.first().copied())
             .ok_or_else(|| js_error("the canvas supports no texture format"))?;
         let gpu = Gpu::request(instance, adapter).await.map_err(js_error)?;
+        let requested = start.elapsed();
         // A lost device draws nothing and fails every read: the page hears of it (and re-creates
         // the viewer on WebGL2) through an event on the window.
         let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -136,8 +143,24 @@ impl Viewer {
         };
         surface.configure(&gpu.device, &config);
         let renderer = Renderer::with_gpu(gpu, format).map_err(js_error)?;
+        let ms = |d: std::time::Duration| (d.as_secs_f64() * 1e4).round() / 10.0;
+        let startup = serde_json::json!({
+            "instance": ms(instanced),
+            "surface": ms(surfaced - instanced),
+            "adapter": ms(adapted - surfaced),
+            "device": ms(requested - adapted),
+            "renderer": ms(start.elapsed() - requested),
+        })
+        .to_string();
         let options = RenderOptions { size: (width, height), interactive_scale, ..RenderOptions::default() };
-        Ok(Viewer { id, renderer, surface, config, options, orbit: Orbit::default(), model: None, backend })
+        Ok(Viewer { id, renderer, surface, config, options, orbit: Orbit::default(), model: None, backend, startup })
+    }
+
+    /// Where [`Viewer::create`]'s time went, in milliseconds, as JSON: `instance` (with WebGPU's
+    /// detection where it may be used), `surface` (the canvas's context), `adapter`, `device`, `renderer` (the passes' shaders and layouts;
+    /// pipelines compile at the first frame that uses them).
+    pub fn startup(&self) -> String {
+        self.startup.clone()
     }
 
     /// This viewer's number on the page: the `id` of its [`DEVICE_LOST_EVENT`].
@@ -169,10 +192,16 @@ impl Viewer {
     /// settings are kept.
     pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<String, JsError> {
         let limits = drafter_io::Limits { max_triangles: max_triangles.max(0.0) as u64 };
+        let start = web_time::Instant::now();
         let model = Model::load_bytes_within(Path::new(name), bytes, &limits).map_err(js_error)?;
+        let read = start.elapsed();
         self.renderer.set_model(&model).map_err(js_error)?;
+        let uploaded = start.elapsed();
         self.orbit = Orbit::default();
+        let ms = |d: std::time::Duration| (d.as_secs_f64() * 1e4).round() / 10.0;
         let summary = serde_json::json!({
+            // Where the load's time went: reading the file into the CPU model, then the upload.
+            "loadMs": { "read": ms(read), "upload": ms(uploaded - read) },
             "name": name,
             "triangles": model.triangle_count(),
             "parts": model.parts.len(),

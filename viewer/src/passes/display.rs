@@ -114,7 +114,9 @@ impl DisplayPass {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let mut pass = DisplayPass {
+        // No pipeline yet: [`Self::prepare`] compiles the one a frame's flags ask for (as the
+        // G-buffer pass does).
+        DisplayPass {
             layout,
             module,
             pipeline_layout,
@@ -123,9 +125,7 @@ impl DisplayPass {
             flags: 0,
             uniforms,
             sampler,
-        };
-        pass.specialise(device, 0);
-        pass
+        }
     }
 
     /// Compiles (once) and selects the pipeline for `flags`.

@@ -319,7 +319,10 @@ impl GBufferPass {
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
-        let mut pass = GBufferPass {
+        // No pipeline yet: each frame's [`Self::specialise`] compiles the one it draws with. Compiling
+        // the every-style pipeline up front cost a browser's first frame a compile it never used
+        // (issue 60: a WebGL2 link on a CPU rasteriser is hundreds of milliseconds).
+        GBufferPass {
             bind_group_layout,
             module,
             layout,
@@ -327,9 +330,7 @@ impl GBufferPass {
             styles: ALL_STYLES,
             clamp_sampler,
             repeat_sampler,
-        };
-        pass.specialise(device, ALL_STYLES);
-        pass
+        }
     }
 
     /// Makes the frames that follow use the pipeline specialised for `styles` (bit
