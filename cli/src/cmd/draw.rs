@@ -1,5 +1,5 @@
 //! `drafter draw FILE -o view.svg|view.pdf|view.dxf [--view AZ,EL] [--ortho] [--size WxH] [--hidden none|dashed|solid]
-//! [--style iso128|gooch] [--fill none|flat|bands] [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
+//! [--style iso128|gooch] [--fill none|flat|bands] [--smooth none|thin|dashed] [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
 //! (drafter-draw, which reads drafter-scene's model and links no GPU code): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
 
@@ -36,6 +36,11 @@ pub struct Args {
     /// Lines hidden by surfaces: left out, dashed or thin solid, in a group of their own.
     #[arg(long, value_enum, default_value_t = HiddenArg::None)]
     pub hidden: HiddenArg,
+    /// Tangent edges (the borders between the input's CAD faces that meet below the crease angle: a
+    /// fillet meeting a plane): thin solid lines of their own class `tangent`, thin dashed, or left
+    /// out; where one is this view's outline it is drawn as a silhouette whatever this says.
+    #[arg(long, value_enum, default_value_t = SmoothArg::Thin)]
+    pub smooth: SmoothArg,
     /// Line widths and dashes: ISO 128 (one wide visible width, 0.5 mm; hidden lines narrow,
     /// 0.25 mm, dashed 3 mm on and 0.75 mm off), or Gooch et al.'s illustration weights in pixels
     /// (silhouettes 1.6, boundaries 1.2, creases 0.9, hidden 0.6 grey).
@@ -68,6 +73,23 @@ pub enum HiddenArg {
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum StyleArg {
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum SmoothArg {
+    None,
+    Thin,
+    Dashed,
+}
+
+impl From<SmoothArg> for drawing::Smooth {
+    fn from(s: SmoothArg) -> drawing::Smooth {
+        match s {
+            SmoothArg::None => drawing::Smooth::None,
+            SmoothArg::Thin => drawing::Smooth::Thin,
+            SmoothArg::Dashed => drawing::Smooth::Dashed,
+        }
+    }
+}
+
     Iso128,
     Gooch,
 }
@@ -193,6 +215,7 @@ pub fn run(args: Args) -> Result<()> {
     let drawing = drawing::draw(&model, &options);
     let style = LineStyle::from(args.style);
     let bytes = match format {
+        smooth: args.smooth.into(),
         Format::Svg => drawing::to_svg(&drawing, options.hidden, style).into_bytes(),
         Format::Pdf => drawing::to_pdf(&drawing, options.hidden, style),
         Format::Dxf => drawing::to_dxf(&drawing, options.hidden, style),

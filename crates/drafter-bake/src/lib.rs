@@ -517,9 +517,12 @@ fn compute_lines(
             }
             let topology = &owned_topology;
             let face_parts: Option<Vec<PartId>> = labels[m].map(|l| l.iter().map(|&x| PartId(x)).collect());
+            let input_faces = input_faces(mesh);
+            let labels =
+                drafter_lines::FaceLabels { parts: face_parts.as_deref(), input_faces: input_faces.as_deref() };
             // Without the candidates' normals and points (47 MB on the dragon): the encoder does not
             // read them, and the hierarchies are built from what the file holds.
-            let feature = match drafter_lines::classify_edges_for_encoding(topology, face_parts.as_deref(), &options) {
+            let feature = match drafter_lines::classify_edges_for_encoding(topology, labels, &options) {
                 Ok(f) => f,
                 Err(e) => {
                     let d = Diagnostic {
@@ -598,6 +601,8 @@ fn compute_lines(
                 e.silhouette_candidate += counts.silhouette_candidate;
                 e.coplanar += counts.coplanar;
                 e.degenerate += counts.degenerate;
+                e.tangent += counts.tangent;
+                e.continued += counts.continued;
                 e.inconsistent_orientation += counts.inconsistent_orientation;
                 if let Some(s) = &silhouettes {
                     summary.silhouette_candidates += s.candidate_corners.len();
@@ -617,8 +622,27 @@ fn compute_lines(
     (all_edges, all_silhouettes, summary, diagnostics)
 }
 
+/// The input face of each triangle of `mesh`: the glTF primitive its group was read from (the
+/// chunks of a primitive split for 16-bit indices keep their source primitive, so they are one
+/// face). `None` where the mesh says nothing of its faces (no group names a primitive: STL, OBJ,
+/// a synthesized mesh) or names one alone.
+pub fn input_faces(mesh: &drafter_core::Mesh) -> Option<Vec<u32>> {
+    let mut primitives = mesh.groups.iter().filter_map(|g| g.primitive);
+    let first = primitives.next()?;
+    if primitives.all(|p| p == first) {
+        return None;
+    }
+    let mut faces = vec![u32::MAX; mesh.triangles.len()];
+    for g in &mesh.groups {
+        let range = g.start as usize..(g.start as usize + g.count as usize).min(faces.len());
+        faces[range].fill(g.primitive.unwrap_or(u32::MAX));
+    }
+    Some(faces)
+}
+
 fn hard_edge_code(class: EdgeClass) -> u8 {
     match class {
+        EdgeClass::Tangent => HardEdgeClass::Tangent as u8,
         EdgeClass::Crease => HardEdgeClass::Crease as u8,
         EdgeClass::Boundary => HardEdgeClass::Boundary as u8,
         EdgeClass::PartBorder => HardEdgeClass::PartBorder as u8,

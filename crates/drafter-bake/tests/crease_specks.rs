@@ -71,7 +71,8 @@ fn the_dragon_keeps_no_crease_specks() {
     let topology = Topology::build(&imported.scene.meshes[0], Weld::default());
     let stage = drafter_bake::LinesStage::default();
     let options = stage.line_options();
-    let before = chains(&topology, &LineOptions { crease_min_edges: 0, ..options });
+    // The threshold alone: neither the speck rule nor the bridging of gaps (hysteresis).
+    let before = chains(&topology, &LineOptions { crease_min_edges: 0, crease_continue: 1.0, ..options });
     let after = chains(&topology, &options);
     let isolated = |c: &Chains| c.short.iter().filter(|s| s.0 == 1).count();
     eprintln!(

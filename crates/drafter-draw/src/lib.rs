@@ -5,7 +5,8 @@
 //!
 //! # What is drawn
 //! The lines the raster lines pass draws ([`drafter_scene::edges`]): every hard edge of the file (crease,
-//! boundary, part border, non-manifold) and this view's silhouettes among the file's candidates,
+//! boundary, part border, non-manifold, and tangent edges as [`DrawOptions::smooth`] says) and this
+//! view's silhouettes among the file's candidates,
 //! decided from face normals computed in f64 from the positions (the stored normals are rounded),
 //! under the camera `drafter render --lines` uses ([`Camera::fit`] on
 //! [`Model::frame_points`], the same `--view`, `--ortho`, `--size` and field of view).
@@ -74,6 +75,22 @@ pub enum Hidden {
 }
 
 /// One view's drawing options.
+/// What a drawing shows of tangent edges (the borders between the input's faces that meet below
+/// the crease angle: a fillet meeting a plane), after FreeCAD TechDraw's "smooth lines". Wherever
+/// a tangent edge is this view's outline (its two faces turn opposite ways to the viewer) it is
+/// drawn as a silhouette, whatever this says.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Smooth {
+    /// Left out.
+    None,
+    /// Thin solid lines of their own class, `tangent` (the default: CAD viewers show tangent
+    /// edges, and without them a fillet's outline stops in mid-air).
+    #[default]
+    Thin,
+    /// Thin dashed lines of their own class ([`pen_of`]).
+    Dashed,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DrawOptions {
     /// Width and height in pixels (the SVG's user units).
@@ -87,6 +104,8 @@ pub struct DrawOptions {
     /// Part fills under the lines ([`crate::fills`]).
     pub fill: Fill,
 }
+    /// Tangent edges ([`Smooth`]); default [`Smooth::Thin`].
+    pub smooth: Smooth,
 
 impl Default for DrawOptions {
     fn default() -> Self {
@@ -99,6 +118,7 @@ impl Default for DrawOptions {
             tolerance_px: 0.05,
             fill: Fill::None,
         }
+            smooth: Smooth::Thin,
     }
 }
 
@@ -142,6 +162,8 @@ pub struct Drawing {
     pub fills: Vec<PartFill>,
     pub strokes: Vec<Stroke>,
     pub stats: DrawStats,
+    /// How the tangent strokes are drawn (what [`DrawOptions::smooth`] said).
+    pub smooth: Smooth,
 }
 
 /// A projected point: pixels and closeness (see the module docs).
@@ -311,7 +333,7 @@ pub(crate) fn part_of(
 
 /// The edges of `model` for a view from `projection`: hard edges of every instance and the
 /// view's silhouettes, in world space.
-fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
+fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Edge>, usize) {
     let mut edges = Vec::new();
     let faces_of: Vec<MeshFaces> =
         model.lines.meshes.par_iter().map(|mesh| MeshFaces::of_instance(model, mesh.instances.start)).collect();
@@ -324,11 +346,12 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
             for (k, &([a, b], class)) in mesh.hard.iter().enumerate() {
                 let corner = mesh.hard_corners.get(k).copied();
                 let part = corner.and_then(|c| part_of(model, batch, instance, (c / 3) as usize));
-                // A crease whose faces turn opposite ways to the viewer lies on the contour: drawn
-                // as a silhouette, as the raster lines pass draws a crease across which the depth
-                // jumps (Gooch et al. 1999 draw every silhouette black and heavy).
+                // A crease or tangent edge whose faces turn opposite ways to the viewer lies on the
+                // contour: drawn as a silhouette, as the raster lines pass draws a crease across
+                // which the depth jumps (Gooch et al. 1999 draw every silhouette black and heavy).
+                // A tangent edge is never a candidate, so this is its only way to be an outline.
                 let class = match (class, corner.and_then(|c| faces.pair(c))) {
-                    (LineClass::Crease, Some(normals)) => {
+                    (LineClass::Crease | LineClass::Tangent, Some(normals)) => {
                         let middle = (a.as_dvec3() + b.as_dvec3()) * 0.5;
                         let towards = match projection.view {
                             drafter_scene::edges::WorldView::Perspective { eye } => {
@@ -347,6 +370,9 @@ fn view_edges(model: &Model, projection: &Projection) -> (Vec<Edge>, usize) {
                     (class, _) => class,
                 };
                 edges.push(Edge {
+                if class == LineClass::Tangent && smooth == Smooth::None {
+                    continue;
+                }
                     a: world.transform_point3(a.as_dvec3()),
                     b: world.transform_point3(b.as_dvec3()),
                     class,
@@ -586,7 +612,7 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
     let start = Instant::now();
     let projection = Projection::new(model, options);
     let triangles = world_triangles(model);
-    let (edges, silhouettes) = view_edges(model, &projection);
+    let (edges, silhouettes) = view_edges(model, &projection, options.smooth);
     let occluders = Occluders::new(&triangles, &projection);
     let mut stats =
         DrawStats { triangles: triangles.corners.len(), edges: edges.len(), silhouettes, ..Default::default() };
@@ -673,7 +699,7 @@ pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
     }
     let strokes = chain(&pieces, tolerance);
     stats.elapsed = start.elapsed();
-    Drawing { width: options.size.0, height: options.size.1, fills, strokes, stats }
+    Drawing { width: options.size.0, height: options.size.1, fills, strokes, smooth: options.smooth, stats }
 }
 
 /// Joins pieces of one class and visibility that meet end to end (within `tolerance`) into
@@ -723,8 +749,30 @@ fn chain(pieces: &[Piece], tolerance: f64) -> Vec<Stroke> {
 
 /// The order the writers draw the classes in, within the hidden lines and then the visible ones:
 /// silhouettes last, on top ([`to_svg`], [`to_pdf`], [`dxf::to_dxf`]).
-pub const CLASS_ORDER: [LineClass; 5] =
-    [LineClass::Crease, LineClass::Boundary, LineClass::PartBorder, LineClass::NonManifold, LineClass::Silhouette];
+pub const CLASS_ORDER: [LineClass; 6] = [
+    LineClass::Tangent,
+    LineClass::Crease,
+    LineClass::Boundary,
+    LineClass::PartBorder,
+    LineClass::NonManifold,
+    LineClass::Silhouette,
+];
+
+/// The pen of a stroke of `class` in `drawing`: `style`'s ([`LineStyle::pen`]), with visible
+/// tangent edges dashed where the drawing was made with [`Smooth::Dashed`]: dashes of 6 and gaps
+/// of 3 line widths, half the dash of ISO 128's dashed line (12 and 3) that hidden lines use, so
+/// the two read apart.
+pub fn pen_of(drawing: &Drawing, style: LineStyle, class: LineClass, visible: bool, hidden: Hidden) -> Pen {
+    let mut pen = style.pen(class, visible, hidden);
+    if visible && class == LineClass::Tangent && drawing.smooth == Smooth::Dashed {
+        let times = |k: f64| match pen.width {
+            style::Length::Mm(w) => style::Length::Mm(k * w),
+            style::Length::Px(w) => style::Length::Px(k * w),
+        };
+        pen.dash = Some([times(6.0), times(3.0)]);
+    }
+    pen
+}
 
 /// The strokes in the order the writers draw them: hidden ones first (when `hidden` draws them),
 /// each visibility by [`CLASS_ORDER`], each class in the drawing's order. One SVG path, one PDF
@@ -757,6 +805,7 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let (w, h) = (drawing.width, drawing.height);
+        LineClass::Tangent => "tangent",
     let (page_w, page_h) = (style::short(f64::from(w) * MM_PER_PX), style::short(f64::from(h) * MM_PER_PX));
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
@@ -816,7 +865,7 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> String {
             if strokes.is_empty() {
                 continue;
             }
-            let pen = style.pen(class, visible, hidden);
+            let pen = pen_of(drawing, style, class, visible, hidden);
             let mut extra = String::new();
             if pen.grey != group.grey {
                 let _ = write!(extra, r#" stroke="{}""#, pen.svg_colour());
@@ -889,7 +938,7 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
             continue;
         }
         for class in CLASS_ORDER {
-            let pen = style.pen(class, visible, hidden);
+            let pen = pen_of(drawing, style, class, visible, hidden);
             let points = |length: style::Length| length.px() as f32 * POINTS_PER_PIXEL;
             content.set_stroke_gray(pen.grey as f32);
             match pen.dash {

@@ -31,11 +31,12 @@ pub const SAME_PIXELS_PX: f64 = 0.25;
 /// Which piece is drawn where pieces overlap: higher wins.
 fn rank(p: &Piece) -> u32 {
     let class = match p.class {
-        LineClass::Crease => 0,
-        LineClass::NonManifold => 1,
-        LineClass::PartBorder => 2,
-        LineClass::Boundary => 3,
-        LineClass::Silhouette => 4,
+        LineClass::Tangent => 0,
+        LineClass::Crease => 1,
+        LineClass::NonManifold => 2,
+        LineClass::PartBorder => 3,
+        LineClass::Boundary => 4,
+        LineClass::Silhouette => 5,
     };
     class + if p.visible { 8 } else { 0 }
 }

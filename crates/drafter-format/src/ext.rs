@@ -393,6 +393,9 @@ pub enum HardEdgeClass {
     PartBorder = 3,
     /// Three or more incident faces: drawn black.
     NonManifold = 4,
+    /// Between two faces of the input (glTF primitives of one mesh: CAD faces) meeting below the
+    /// crease angle: a tangent edge (a fillet meeting a plane), drawn thin or left out.
+    Tangent = 5,
 }
 
 /// Mesh-level object: data that spans all primitives of a mesh.

@@ -6,6 +6,8 @@
 pub enum LinesError {
     #[error("{parts} part ids for {faces} faces")]
     PartCount { parts: usize, faces: usize },
+    #[error("{labels} input-face labels for {faces} faces")]
+    InputFaceCount { labels: usize, faces: usize },
 }
 
 /// A serialised hierarchy that is inconsistent or does not bound its candidates.

@@ -105,9 +105,10 @@ pub use brute::{
     unit_direction,
 };
 pub use classify::{
-    DEFAULT_COPLANAR_ANGLE_DEG, DEFAULT_CREASE_ANGLE_DEG, DEFAULT_CREASE_MIN_EDGES, DEFAULT_CREASE_MIN_LENGTH,
-    DEFAULT_STRONG_CREASE_DEG, EdgeClass, EdgeClassCounts, FeatureEdges, LineOptions, classify_edges,
-    classify_edges_for_encoding, face_normals,
+    DEFAULT_COPLANAR_ANGLE_DEG, DEFAULT_CREASE_ANGLE_DEG, DEFAULT_CREASE_CONTINUE, DEFAULT_CREASE_MIN_EDGES,
+    DEFAULT_CREASE_MIN_LENGTH, DEFAULT_CREASE_TURN_DEG, DEFAULT_STRONG_CREASE_DEG, EdgeClass, EdgeClassCounts,
+    FaceLabels, FeatureEdges, LineOptions, classify_edges, classify_edges_for_encoding, classify_edges_labelled,
+    face_normals,
 };
 pub use cone_bvh::{
     CONE_MARGIN, ConeBvh, ConeBvhArrays, ConeBvhOptions, DEFAULT_LEAF_SIZE, DEFAULT_SAMPLE_EYES, DUAL_NORMAL_WEIGHT,

@@ -61,7 +61,7 @@ fn classification_for_encoding_equals_the_full_one() {
     for mesh in &meshes {
         let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
         let full = classify_edges(&topology, None, &LineOptions::default()).unwrap();
-        let lean = classify_edges_for_encoding(&topology, None, &LineOptions::default()).unwrap();
+        let lean = classify_edges_for_encoding(&topology, FaceLabels::default(), &LineOptions::default()).unwrap();
         assert!(!full.candidates.is_empty() && lean.candidate_normals.is_empty() && lean.candidate_points.is_empty());
         assert!(lean.dihedral_deg.is_empty() && full.dihedral_deg.len() == topology.edges.len());
         let expected = FeatureEdges {

@@ -121,8 +121,9 @@ fn crease_counts_match_an_independent_count() {
         let (mesh, _) = load_model(&shared_model(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
         let topology = Topology::from_triangles(&mesh.positions, &mesh.triangles, Weld::Exact);
         // The dihedral rule alone: the speck rule (short chains of weak creases) is counted by
-        // drafter-bake's `tests/crease_specks.rs`.
-        let options = LineOptions { crease_min_edges: 0, ..LineOptions::default() };
+        // drafter-bake's `tests/crease_specks.rs`, the bridging of gaps (hysteresis) by
+        // `tests/creases_whole.rs`.
+        let options = LineOptions { crease_min_edges: 0, crease_continue: 1.0, ..LineOptions::default() };
         let lines = classify_edges(&topology, None, &options).unwrap();
 
         let key = |p: glam::Vec3| p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });

@@ -3,7 +3,8 @@
 //! # What a baked file gives
 //! Per glTF primitive, `EXT_mesh_primitive_edge_visibility` marks every triangle edge with 2 bits
 //! (0 hidden, 1 silhouette candidate, 2 hard edge, 3 hard edge already written) and our
-//! `hardEdgeClasses` gives each hard edge its class (crease, boundary, part border, non-manifold).
+//! `hardEdgeClasses` gives each hard edge its class (crease, boundary, part border, non-manifold,
+//! tangent).
 //! Per mesh, `DRAFTER_illustration.silhouettes` lists every candidate as a triangle corner `3·t + k`
 //! with its two face normals in full precision, plus the hierarchies drafter-lines chose to store:
 //! a Gauss-map arc hierarchy for orthographic views and a normal-cone BVH for eye points (Gooch et
@@ -40,7 +41,9 @@ use glam::{DMat4, DVec3, Vec3};
 
 use crate::layout::LineSegmentGpu;
 
-/// Class of a drawn line (`lines.wgsl`: `CLASS_*`). Codes 1–4 are the file's `hardEdgeClasses`.
+/// Class of a drawn line. Codes 1–4 are the file's `hardEdgeClasses`; the file's tangent code (5)
+/// is [`LineClass::Tangent`] (6) here, since 5 was the silhouette's first. What the lines pass
+/// uploads is [`LineClass::gpu_kind`] (`lines.wgsl`: `CLASS_*`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u32)]
 pub enum LineClass {
@@ -50,6 +53,9 @@ pub enum LineClass {
     NonManifold = HardEdgeClass::NonManifold as u32,
     /// A silhouette of the current view.
     Silhouette = 5,
+    /// A tangent edge: a border between two faces of the input meeting below the crease angle
+    /// (`hardEdgeClasses` code 5).
+    Tangent = 6,
 }
 
 impl LineClass {
@@ -59,7 +65,17 @@ impl LineClass {
             1 => LineClass::Crease,
             3 => LineClass::PartBorder,
             4 => LineClass::NonManifold,
+            c if c == HardEdgeClass::Tangent as u8 => LineClass::Tangent,
             _ => LineClass::Boundary,
+        }
+    }
+
+    /// The `kind` the raster lines pass draws by (`lines.wgsl`): a tangent edge as a crease (a
+    /// light inner line; the shader makes it a contour where the depth jumps across it).
+    pub fn gpu_kind(self) -> u32 {
+        match self {
+            LineClass::Tangent => LineClass::Crease as u32,
+            other => other as u32,
         }
     }
 }

@@ -87,7 +87,7 @@ pub struct MaterialGpu {
 
 /// One line of the lines pass (`lines.wgsl`: `Segment`), in a segment table indexed by
 /// `instance_index`: an edge in its mesh's object space, the model instance that places it, and its
-/// [`crate::edges::LineClass`].
+/// [`crate::edges::LineClass`] as the shader draws it ([`crate::edges::LineClass::gpu_kind`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LineSegmentGpu {
@@ -100,7 +100,7 @@ pub struct LineSegmentGpu {
 
 impl LineSegmentGpu {
     pub fn new(a: glam::Vec3, b: glam::Vec3, instance: u32, class: crate::edges::LineClass) -> Self {
-        Self { a_in_object: a.to_array(), instance, b_in_object: b.to_array(), class: class as u32 }
+        Self { a_in_object: a.to_array(), instance, b_in_object: b.to_array(), class: class.gpu_kind() }
     }
 }
 
