@@ -62,6 +62,8 @@ pub struct Args {
     /// Refuse a model that lists more triangles than this.
     #[arg(long, value_name = "N", default_value_t = drafter_io::DEFAULT_MAX_TRIANGLES)]
     pub max_triangles: u64,
+    #[command(flatten)]
+    pub sheet: crate::cmd::sheet::SheetArgs,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -135,7 +137,7 @@ impl From<HiddenArg> for Hidden {
 /// `bake_bytes`, as `drafter bake` runs it, with the default settings), so it draws the lines its
 /// bake would. Import errors keep their exit code; a file that loads but cannot be drawn is bad
 /// input.
-fn load(path: &Path, max_triangles: u64) -> Result<(Model, bool)> {
+pub(crate) fn load(path: &Path, max_triangles: u64) -> Result<(Model, bool)> {
     let limits = drafter_io::Limits { max_triangles };
     let bytes = drafter_catalog::job::read_input(path)?;
     let bad = |e: LoadError| match e {
@@ -167,6 +169,9 @@ enum Format {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if args.sheet.sheet.is_some() {
+        return crate::cmd::sheet::run(args);
+    }
     let extension = args.output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let format = match extension.as_deref() {
         Some("svg") => Format::Svg,

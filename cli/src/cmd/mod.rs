@@ -10,6 +10,7 @@ pub mod cache;
 pub mod draw;
 pub mod inspect;
 pub mod render;
+pub mod sheet;
 pub mod view;
 pub mod web;
 

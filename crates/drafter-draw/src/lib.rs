@@ -56,6 +56,7 @@ use drafter_scene::style::{DEFAULT_FOV_Y_DEG, View};
 pub mod dxf;
 pub mod fills;
 pub mod merge;
+pub mod sheet;
 pub mod style;
 
 pub use crate::dxf::to_dxf;
@@ -609,8 +610,13 @@ pub struct Visibility {
 
 /// The edges of `model` in the view `options` describe, each with its hidden intervals.
 pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
+    visibility_in(model, options, Projection::new(model, options))
+}
+
+/// [`visibility`] under a given projection (a drawing sheet's views, [`sheet`]) instead of the
+/// camera `options` fit; `options.view`, `orthographic` and `size` are then not read.
+pub fn visibility_in(model: &Model, options: &DrawOptions, projection: Projection) -> Visibility {
     let start = Instant::now();
-    let projection = Projection::new(model, options);
     let triangles = world_triangles(model);
     let (edges, silhouettes) = view_edges(model, &projection, options.smooth);
     let occluders = Occluders::new(&triangles, &projection);
@@ -659,8 +665,14 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
 
 /// Draws `model` as `options` say.
 pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
+    draw_in(model, options, Projection::new(model, options))
+}
+
+/// [`draw`] under a given projection (a drawing sheet's views, [`sheet`]) instead of the camera
+/// `options` fit; `options.view` and `orthographic` are then not read.
+pub fn draw_in(model: &Model, options: &DrawOptions, projection: Projection) -> Drawing {
     let start = Instant::now();
-    let Visibility { edges, mut stats, projection } = visibility(model, options);
+    let Visibility { edges, mut stats, projection } = visibility_in(model, options, projection);
     let fills = crate::fills::fills(model, &projection, options.fill);
     let tolerance = options.tolerance_px.max(0.0);
     let mut pieces = Vec::new();

@@ -1,0 +1,196 @@
+//! A sheet as SVG or PDF: its views' strokes with the pens of [`crate::style`] (the same table
+//! and class order as a single view's [`crate::to_svg`] and [`crate::to_pdf`], through
+//! [`LineStyle::pen`] and [`crate::CLASS_ORDER`]), then the frame. Millimetres throughout: the SVG's
+//! user unit is a millimetre (`viewBox="0 0 420 297"` on a `420mm` × `297mm` page), coordinates to
+//! a thousandth; the PDF's page is the sheet in points (72/25.4 a millimetre), y turned up. No
+//! dates, no generator versions: the bytes depend only on the sheet.
+
+use std::fmt::Write as _;
+
+use drafter_scene::edges::LineClass;
+use glam::DVec2;
+
+use super::{FrameLine, Sheet};
+use crate::style::{Length, LineStyle, Pen};
+use crate::{CLASS_ORDER, Hidden, Stroke, class_name};
+
+/// A number of millimetres to a thousandth, without trailing zeros.
+fn mm(v: f64) -> String {
+    let text = format!("{v:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" { "0".to_string() } else { text.to_string() }
+}
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn svg_path(s: &mut String, class: &str, points: &[DVec2]) {
+    let _ = write!(s, "<path{class} d=\"");
+    for (i, p) in points.iter().enumerate() {
+        let _ = write!(s, "{}{} {}", if i == 0 { "M" } else { " L" }, mm(p.x), mm(p.y));
+    }
+    let _ = writeln!(s, "\"/>");
+}
+
+fn svg_dashes(dash: Option<[Length; 2]>) -> String {
+    dash.map(|[on, off]| format!(r#" stroke-dasharray="{} {}""#, mm(on.mm()), mm(off.mm()))).unwrap_or_default()
+}
+
+/// The strokes of one visibility and class, in the drawing's order.
+fn of_class(strokes: &[Stroke], visible: bool, class: LineClass) -> impl Iterator<Item = &Stroke> {
+    strokes.iter().filter(move |s| s.visible == visible && s.class == class)
+}
+
+/// The visibilities a sheet draws: hidden lines first when it has them.
+fn visibilities(hidden: Hidden) -> impl Iterator<Item = bool> {
+    [false, true].into_iter().filter(move |&v| v || hidden != Hidden::None)
+}
+
+/// The sheet as SVG: a group per view (`id="view-front"`, …) holding a group per visibility
+/// (`class="hidden"`, `class="visible"`) and per line class as a single view's SVG does, each
+/// path naming its part; then the frame (`id="frame"`: border, title block, lettering, symbol).
+pub fn to_svg(sheet: &Sheet, style: LineStyle) -> String {
+    let mut s = String::new();
+    let (w, h) = sheet.mm;
+    let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(
+        s,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w}mm" height="{h}mm" viewBox="0 0 {w} {h}" fill="none" stroke="#000" stroke-linecap="round" stroke-linejoin="round">"##,
+        w = mm(w),
+        h = mm(h)
+    );
+    let _ = writeln!(s, "<title>{}</title>", escape(&sheet.title));
+    let _ = writeln!(
+        s,
+        "<desc>drafter draw --sheet {}: scale {}, {}-angle projection, style {}; user unit 1 mm, y down</desc>",
+        sheet.size.name(),
+        sheet.scale,
+        sheet.angle.name(),
+        style.name()
+    );
+    for view in &sheet.views {
+        let r = &view.rect;
+        let _ = writeln!(
+            s,
+            r#"<g id="view-{}" class="view" data-rect="{} {} {} {}">"#,
+            view.kind.name(),
+            mm(r.min.x),
+            mm(r.min.y),
+            mm(r.max.x),
+            mm(r.max.y)
+        );
+        for visible in visibilities(sheet.hidden) {
+            let group = style.pen(LineClass::Crease, visible, sheet.hidden);
+            let _ = writeln!(
+                s,
+                r#"<g class="{}" stroke="{}"{}>"#,
+                if visible { "visible" } else { "hidden" },
+                group.svg_colour(),
+                svg_dashes(group.dash)
+            );
+            for class in CLASS_ORDER {
+                let mut strokes = of_class(&view.drawing.strokes, visible, class).peekable();
+                if strokes.peek().is_none() {
+                    continue;
+                }
+                let pen = style.pen(class, visible, sheet.hidden);
+                let mut extra = String::new();
+                if pen.grey != group.grey {
+                    let _ = write!(extra, r#" stroke="{}""#, pen.svg_colour());
+                }
+                if pen.dash != group.dash {
+                    extra +=
+                        &pen.dash.map_or_else(|| r#" stroke-dasharray="none""#.to_string(), |d| svg_dashes(Some(d)));
+                }
+                let _ =
+                    writeln!(s, r#"<g class="{}" stroke-width="{}"{extra}>"#, class_name(class), mm(pen.width.mm()));
+                for stroke in strokes {
+                    let part = stroke.part.map(|p| format!(r#" class="part-{p}""#)).unwrap_or_default();
+                    svg_path(&mut s, &part, &stroke.points);
+                }
+                let _ = writeln!(s, "</g>");
+            }
+            let _ = writeln!(s, "</g>");
+        }
+        let _ = writeln!(s, "</g>");
+    }
+    let _ = writeln!(s, r#"<g id="frame">"#);
+    for line in &sheet.frame {
+        let dashes = if line.dashes.is_empty() {
+            String::new()
+        } else {
+            format!(r#" stroke-dasharray="{}""#, line.dashes.iter().map(|d| mm(*d)).collect::<Vec<_>>().join(" "))
+        };
+        svg_path(&mut s, &format!(r#" stroke-width="{}"{dashes}"#, mm(line.width)), &line.points);
+    }
+    let _ = writeln!(s, "</g>");
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// PDF points per millimetre.
+const PT_PER_MM: f32 = 72.0 / 25.4;
+
+/// The sheet as a one-page PDF (pdf-writer) the size of the sheet: the views' strokes with the
+/// same pens and order as [`to_svg`], then the frame; the title in the document's information.
+pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
+    use pdf_writer::types::{LineCapStyle, LineJoinStyle};
+    use pdf_writer::{Content, Finish, Pdf, Rect, Ref, TextStr};
+    let (catalog, tree, page, content_id, info) = (Ref::new(1), Ref::new(2), Ref::new(3), Ref::new(4), Ref::new(5));
+    let (w, h) = (sheet.mm.0 as f32 * PT_PER_MM, sheet.mm.1 as f32 * PT_PER_MM);
+    let mut pdf = Pdf::new();
+    pdf.catalog(catalog).pages(tree);
+    pdf.pages(tree).kids([page]).count(1);
+    let mut p = pdf.page(page);
+    p.media_box(Rect::new(0.0, 0.0, w, h)).parent(tree).contents(content_id);
+    p.resources();
+    p.finish();
+    pdf.document_info(info).title(TextStr(&sheet.title));
+    let mut content = Content::new();
+    content.set_line_cap(LineCapStyle::RoundCap);
+    content.set_line_join(LineJoinStyle::RoundJoin);
+    let at = |q: DVec2| (q.x as f32 * PT_PER_MM, h - q.y as f32 * PT_PER_MM);
+    let path = |content: &mut Content, points: &[DVec2]| {
+        for (i, q) in points.iter().enumerate() {
+            let (x, y) = at(*q);
+            if i == 0 {
+                content.move_to(x, y);
+            } else {
+                content.line_to(x, y);
+            }
+        }
+    };
+    let set_pen = |content: &mut Content, pen: &Pen| {
+        content.set_stroke_gray(pen.grey as f32);
+        match pen.dash {
+            Some([on, off]) => content.set_dash_pattern([on.mm() as f32 * PT_PER_MM, off.mm() as f32 * PT_PER_MM], 0.0),
+            None => content.set_dash_pattern([], 0.0),
+        };
+        content.set_line_width(pen.width.mm() as f32 * PT_PER_MM);
+    };
+    for view in &sheet.views {
+        for visible in visibilities(sheet.hidden) {
+            for class in CLASS_ORDER {
+                let mut strokes = of_class(&view.drawing.strokes, visible, class).peekable();
+                if strokes.peek().is_none() {
+                    continue;
+                }
+                set_pen(&mut content, &style.pen(class, visible, sheet.hidden));
+                for stroke in strokes {
+                    path(&mut content, &stroke.points);
+                }
+                content.stroke();
+            }
+        }
+    }
+    content.set_stroke_gray(0.0);
+    for FrameLine { width, dashes, points } in &sheet.frame {
+        content.set_dash_pattern(dashes.iter().map(|d| *d as f32 * PT_PER_MM), 0.0);
+        content.set_line_width(*width as f32 * PT_PER_MM);
+        path(&mut content, points);
+        content.stroke();
+    }
+    pdf.stream(content_id, &content.finish());
+    pdf.finish()
+}
