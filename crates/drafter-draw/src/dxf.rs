@@ -47,7 +47,7 @@ use drafter_scene::edges::LineClass;
 use glam::DVec2;
 
 use crate::style::{Length, LineStyle, MM_PER_PX, Pen};
-use crate::{Drawing, Hidden, Stroke, strokes_in_order};
+use crate::{Drawing, Hidden, Stroke, pen_of, strokes_in_order};
 
 /// DXF's lineweights (group 370), in hundredths of a millimetre: the only values a reader accepts.
 const LINEWEIGHTS: [i64; 24] =
@@ -125,7 +125,11 @@ pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
     for stroke in &strokes {
         let name = layer_of(stroke.class, stroke.visible);
         if !layers.iter().any(|l| l.name == name) {
-            layers.push(Layer { name, pen: style.pen(stroke.class, stroke.visible, hidden), linetype: "Continuous" });
+            layers.push(Layer {
+                name,
+                pen: pen_of(drawing, style, stroke.class, stroke.visible, hidden),
+                linetype: "Continuous",
+            });
         }
     }
     for layer in &mut layers {
@@ -300,7 +304,7 @@ pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
     for (k, stroke) in strokes.iter().enumerate() {
         let name = layer_of(stroke.class, stroke.visible);
         let layer = layers.iter().find(|l| l.name == name).unwrap_or(&layers[0]);
-        let pen = style.pen(stroke.class, stroke.visible, hidden);
+        let pen = pen_of(drawing, style, stroke.class, stroke.visible, hidden);
         debug_assert_eq!(pen.dash.is_some(), layer.pen.dash.is_some(), "a layer's strokes share its linetype");
         w.str(0, "LWPOLYLINE").handle(5, handle::FIRST_ENTITY + k as u32).handle(330, handle::MODEL_SPACE);
         w.str(100, "AcDbEntity").str(8, name);
@@ -507,5 +511,27 @@ mod tests {
         assert!(text.contains(" 49\n3\n 74\n0\n 49\n-0.75\n"));
         let without = String::from_utf8(to_dxf(&drawing, Hidden::None, LineStyle::Iso128)).unwrap();
         assert_eq!(without.matches("\nLWPOLYLINE\n").count(), 1);
+    }
+
+    #[test]
+    fn tangent_edges_get_a_layer_of_their_own_with_their_dashes() {
+        let tangent = Stroke {
+            class: LineClass::Tangent,
+            visible: true,
+            part: None,
+            points: vec![DVec2::new(0.0, 0.0), DVec2::new(10.0, 0.0)],
+        };
+        let drawing = Drawing {
+            width: 96,
+            height: 96,
+            strokes: vec![tangent],
+            smooth: crate::Smooth::Dashed,
+            ..Drawing::default()
+        };
+        let text = String::from_utf8(to_dxf(&drawing, Hidden::Dashed, LineStyle::Iso128)).unwrap();
+        assert!(text.contains("\n  8\nTANGENT\n100\nAcDbPolyline\n"), "{text}");
+        // Narrow (0.25 mm), dashed 6 d on and 3 d off: a linetype named after the layer.
+        assert!(text.contains("  2\nTANGENT\n 70\n0\n 62\n7\n  6\nTANGENT\n370\n25\n"), "{text}");
+        assert!(text.contains(" 49\n1.5\n 74\n0\n 49\n-0.75\n"), "{text}");
     }
 }
