@@ -123,7 +123,12 @@ fn options(args: &Args) -> Result<(SheetOptions, SheetSize)> {
         mm_per_unit: s.units.map_or_else(|| default_mm_per_unit(&args.file), UnitArg::mm),
         title,
         date: s.date.clone(),
-        draw: DrawOptions { hidden: args.hidden.into(), tolerance_px: args.tolerance, ..DrawOptions::default() },
+        draw: DrawOptions {
+            hidden: args.hidden.into(),
+            tolerance_px: args.tolerance,
+            smooth: args.smooth.into(),
+            ..DrawOptions::default()
+        },
     };
     Ok((options, size))
 }

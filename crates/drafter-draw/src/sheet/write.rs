@@ -1,6 +1,6 @@
 //! A sheet as SVG or PDF: its views' strokes with the pens of [`crate::style`] (the same table
 //! and class order as a single view's [`crate::to_svg`] and [`crate::to_pdf`], through
-//! [`LineStyle::pen`] and [`crate::CLASS_ORDER`]), then the frame. Millimetres throughout: the SVG's
+//! [`crate::pen_of`] and [`crate::CLASS_ORDER`]), then the frame. Millimetres throughout: the SVG's
 //! user unit is a millimetre (`viewBox="0 0 420 297"` on a `420mm` × `297mm` page), coordinates to
 //! a thousandth; the PDF's page is the sheet in points (72/25.4 a millimetre), y turned up. No
 //! dates, no generator versions: the bytes depend only on the sheet.
@@ -12,7 +12,7 @@ use glam::DVec2;
 
 use super::{FrameLine, Sheet};
 use crate::style::{Length, LineStyle, Pen};
-use crate::{CLASS_ORDER, Hidden, Stroke, class_name};
+use crate::{CLASS_ORDER, Hidden, Stroke, class_name, pen_of};
 
 /// A number of millimetres to a thousandth, without trailing zeros.
 fn mm(v: f64) -> String {
@@ -94,7 +94,7 @@ pub fn to_svg(sheet: &Sheet, style: LineStyle) -> String {
                 if strokes.peek().is_none() {
                     continue;
                 }
-                let pen = style.pen(class, visible, sheet.hidden);
+                let pen = pen_of(&view.drawing, style, class, visible, sheet.hidden);
                 let mut extra = String::new();
                 if pen.grey != group.grey {
                     let _ = write!(extra, r#" stroke="{}""#, pen.svg_colour());
@@ -176,7 +176,7 @@ pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
                 if strokes.peek().is_none() {
                     continue;
                 }
-                set_pen(&mut content, &style.pen(class, visible, sheet.hidden));
+                set_pen(&mut content, &pen_of(&view.drawing, style, class, visible, sheet.hidden));
                 for stroke in strokes {
                     path(&mut content, &stroke.points);
                 }
