@@ -11,6 +11,29 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
+/// Reads a DXF with ezdxf (Debian's python3-ezdxf, as `cli/tests/dxf.rs` runs it): the recover
+/// and strict audits' errors and fixes, polylines per layer, and the extent of the model's lines.
+const EZDXF_READER: &str = r#"
+import json, sys
+import ezdxf
+from ezdxf import recover
+
+doc, auditor = recover.readfile(sys.argv[1])
+audit = ezdxf.readfile(sys.argv[1]).audit()
+counts, xs, ys = {}, [], []
+for e in doc.modelspace():
+    counts[e.dxf.layer] = counts.get(e.dxf.layer, 0) + 1
+    if e.dxf.layer != "FRAME":
+        for p in e.get_points("xy"):
+            xs.append(p[0])
+            ys.append(p[1])
+print(json.dumps({
+    "problems": [len(auditor.errors), len(auditor.fixes), len(audit.errors), len(audit.fixes)],
+    "counts": counts,
+    "model_extent": [min(xs), min(ys), max(xs), max(ys)],
+}))
+"#;
+
 /// A rectangle `[x0, y0, x1, y1]` in millimetres.
 type Rect = [f64; 4];
 
@@ -149,6 +172,42 @@ fn a_gearbox_sheet_is_valid_aligned_and_reproducible() {
         }
     }
     assert!(parsed.frame.iter().all(|&(x, y)| (0.0..=420.0).contains(&x) && (0.0..=297.0).contains(&y)));
+
+    // The DXF: ezdxf reads it with no error and nothing to fix; as many polylines on VISIBLE and
+    // HIDDEN as the SVG's views have paths, the frame on FRAME; the model's lines span the views'
+    // boxes, in millimetres with y up.
+    let dxf = dir.join("gearbox.dxf");
+    let run = sheet(&baked, &dxf, "2");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let script = dir.join("read_dxf.py");
+    std::fs::write(&script, EZDXF_READER).expect("the reader script is written");
+    let read = Command::new("/usr/bin/python3")
+        .arg(&script)
+        .arg(&dxf)
+        .output()
+        .expect("/usr/bin/python3 (apt python3-ezdxf; scripts/test installs it) reads the DXF");
+    assert!(read.status.success(), "ezdxf: {}", String::from_utf8_lossy(&read.stderr));
+    let read: serde_json::Value = serde_json::from_slice(&read.stdout).expect("the reader's JSON");
+    assert_eq!(read["problems"], serde_json::json!([0, 0, 0, 0]), "{read}");
+    let paths_of = |group: &str| text.matches(group).count();
+    let model_paths = text.split(r#"<g id="frame">"#).next().unwrap_or_default().matches("<path").count();
+    let counts = &read["counts"];
+    assert_eq!(
+        counts["VISIBLE"].as_u64().unwrap_or(0)
+            + counts["HIDDEN"].as_u64().unwrap_or(0)
+            + counts["TANGENT"].as_u64().unwrap_or(0),
+        model_paths as u64,
+        "{read}"
+    );
+    assert_eq!(counts["FRAME"].as_u64(), Some(paths_of("<path") as u64 - model_paths as u64), "{read}");
+    let union =
+        parsed.views.values().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |r, v| {
+            [r[0].min(v.rect[0]), r[1].min(v.rect[1]), r[2].max(v.rect[2]), r[3].max(v.rect[3])]
+        });
+    let model: Vec<f64> =
+        read["model_extent"].as_array().expect("an extent").iter().filter_map(|v| v.as_f64()).collect();
+    let flipped = [union[0], 297.0 - union[3], union[2], 297.0 - union[1]];
+    assert!((0..4).all(|k| close(model[k], flipped[k])), "DXF {model:?} against the SVG's views {flipped:?}");
 
     // The same bytes again, on one thread.
     for (threads, out) in [("1", dir.join("one.svg")), ("1", dir.join("one.pdf"))] {

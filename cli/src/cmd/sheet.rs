@@ -1,5 +1,5 @@
 //! `drafter draw FILE --sheet A4|A3|A2|A1|A0 [--views front,top,right,iso] [--projection first|third]
-//! [--scale 1:2] [--up y] [--front z] [--units m] [--date TEXT] -o sheet.svg|sheet.pdf`: the standard
+//! [--scale 1:2] [--up y] [--front z] [--units m] [--date TEXT] -o sheet.svg|sheet.pdf|sheet.dxf`: the standard
 //! views of a model on one drawing sheet (drafter-draw's `sheet`), the options `draw` flattens in
 //! and the glue that runs them.
 
@@ -136,10 +136,13 @@ fn options(args: &Args) -> Result<(SheetOptions, SheetSize)> {
 /// `drafter draw … --sheet SIZE`.
 pub fn run(args: Args) -> Result<()> {
     let extension = args.output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    let pdf = match extension.as_deref() {
-        Some("svg") => false,
-        Some("pdf") => true,
-        _ => return Err(BadInput(format!("{}: a sheet is written as .svg or .pdf", args.output.display())).into()),
+    let write: fn(&sheet::Sheet, LineStyle) -> Vec<u8> = match extension.as_deref() {
+        Some("svg") => |sheet, style| sheet::to_svg(sheet, style).into_bytes(),
+        Some("pdf") => sheet::to_pdf,
+        Some("dxf") => sheet::to_dxf,
+        _ => {
+            return Err(BadInput(format!("{}: a sheet is written as .svg, .pdf or .dxf", args.output.display())).into());
+        }
     };
     let (options, size) = options(&args)?;
     let folder = args.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
@@ -155,7 +158,7 @@ pub fn run(args: Args) -> Result<()> {
     let sheet = sheet::draw_sheet(&model, &options).map_err(|e| BadInput(e.to_string()))?;
     let drawn = start.elapsed() - loaded;
     let style = LineStyle::from(args.style);
-    let bytes = if pdf { sheet::to_pdf(&sheet, style) } else { sheet::to_svg(&sheet, style).into_bytes() };
+    let bytes = write(&sheet, style);
     drafter_catalog::output::write_atomically(&args.output, &bytes)?;
     let strokes: usize = sheet.views.iter().map(|v| v.drawing.strokes.len()).sum();
     if args.json {

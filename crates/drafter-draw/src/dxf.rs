@@ -111,9 +111,25 @@ struct Layer {
     linetype: &'static str,
 }
 
+/// Polylines beside a drawing's strokes, on a layer of their own (a sheet's border, title block
+/// and lettering, [`crate::sheet`]), in the drawing's pixels; each carries its own lineweight
+/// where its width is not the layer's.
+#[derive(Clone, Copy, Debug)]
+pub struct ExtraLayer<'a> {
+    pub name: &'static str,
+    /// The layer's pen; continuous lines only.
+    pub pen: Pen,
+    pub lines: &'a [(Length, Vec<DVec2>)],
+}
+
 /// The drawing as a DXF R2000 file (see the module docs), with its hidden lines as `hidden` says
 /// and the pens of `style`.
 pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
+    to_dxf_with(drawing, hidden, style, &[])
+}
+
+/// [`to_dxf`] with `extra` layers of polylines after the drawing's strokes.
+pub fn to_dxf_with(drawing: &Drawing, hidden: Hidden, style: LineStyle, extra: &[ExtraLayer]) -> Vec<u8> {
     let strokes: Vec<&Stroke> = strokes_in_order(drawing, hidden).collect();
     // Layers: VISIBLE and HIDDEN always (a reader sees what the drawing can hold), TANGENT when
     // strokes go there. A layer's pen: its outlines' for VISIBLE, the hidden lines' for HIDDEN,
@@ -132,6 +148,9 @@ pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
             });
         }
     }
+    for layer in extra {
+        layers.push(Layer { name: layer.name, pen: Pen { dash: None, ..layer.pen }, linetype: "Continuous" });
+    }
     for layer in &mut layers {
         if layer.pen.dash.is_some() {
             layer.linetype = layer.name;
@@ -142,16 +161,18 @@ pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
     let to_mm = |p: DVec2| DVec2::new(p.x * MM_PER_PX, (f64::from(drawing.height) - p.y) * MM_PER_PX);
     // The extents of what is drawn (the sheet when nothing is).
     let (mut low, mut high) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for p in strokes.iter().flat_map(|s| &s.points) {
+    let extra_points = extra.iter().flat_map(|l| l.lines.iter().flat_map(|(_, points)| points));
+    for p in strokes.iter().flat_map(|s| &s.points).chain(extra_points) {
         let q = to_mm(*p);
         (low, high) = (low.min(q), high.max(q));
     }
-    if strokes.is_empty() {
+    if low.x > high.x {
         (low, high) = (DVec2::ZERO, DVec2::new(width_mm, height_mm));
     }
 
     let mut w = Writer::default();
-    let entities_end = handle::FIRST_ENTITY + strokes.len() as u32;
+    let extra_lines: usize = extra.iter().map(|l| l.lines.len()).sum();
+    let entities_end = handle::FIRST_ENTITY + (strokes.len() + extra_lines) as u32;
 
     // HEADER
     w.section("HEADER");
@@ -317,6 +338,21 @@ pub fn to_dxf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
         w.str(100, "AcDbPolyline").int(90, stroke.points.len() as i64).int(70, 0);
         for p in &stroke.points {
             w.point(10, to_mm(*p), false);
+        }
+    }
+    let mut next_entity = handle::FIRST_ENTITY + strokes.len() as u32;
+    for layer in extra {
+        for (width, points) in layer.lines {
+            w.str(0, "LWPOLYLINE").handle(5, next_entity).handle(330, handle::MODEL_SPACE);
+            w.str(100, "AcDbEntity").str(8, layer.name);
+            if lineweight(*width) != lineweight(layer.pen.width) {
+                w.int(370, lineweight(*width));
+            }
+            w.str(100, "AcDbPolyline").int(90, points.len() as i64).int(70, 0);
+            for p in points {
+                w.point(10, to_mm(*p), false);
+            }
+            next_entity += 1;
         }
     }
     w.end_section();

@@ -49,7 +49,7 @@ use crate::{DrawOptions, Drawing, Fill, Hidden, Projection, Stroke};
 pub mod font;
 pub mod write;
 
-pub use write::{to_pdf, to_svg};
+pub use write::{to_dxf, to_pdf, to_svg};
 
 /// Gap between neighbouring views, millimetres.
 pub const GAP_MM: f64 = 12.0;

@@ -1,4 +1,4 @@
-//! A sheet as SVG or PDF: its views' strokes with the pens of [`crate::style`] (the same table
+//! A sheet as SVG, PDF or DXF: its views' strokes with the pens of [`crate::style`] (the same table
 //! and class order as a single view's [`crate::to_svg`] and [`crate::to_pdf`], through
 //! [`crate::pen_of`] and [`crate::CLASS_ORDER`]), then the frame. Millimetres throughout: the SVG's
 //! user unit is a millimetre (`viewBox="0 0 420 297"` on a `420mm` × `297mm` page), coordinates to
@@ -11,8 +11,9 @@ use drafter_scene::edges::LineClass;
 use glam::DVec2;
 
 use super::{FrameLine, Sheet};
-use crate::style::{Length, LineStyle, Pen};
-use crate::{CLASS_ORDER, Hidden, Stroke, class_name, pen_of};
+use crate::dxf::ExtraLayer;
+use crate::style::{Length, LineStyle, MM_PER_PX, Pen};
+use crate::{CLASS_ORDER, Drawing, Hidden, Stroke, class_name, pen_of};
 
 /// A number of millimetres to a thousandth, without trailing zeros.
 fn mm(v: f64) -> String {
@@ -193,4 +194,40 @@ pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
     }
     pdf.stream(content_id, &content.finish());
     pdf.finish()
+}
+
+/// The sheet as DXF R2000 through [`crate::dxf::to_dxf_with`]: the views' strokes on the layers
+/// of a single view's DXF (`VISIBLE`, `HIDDEN`, `TANGENT`, with the pens of `style`), the frame
+/// (border, title block, lettering, projection symbol) on a layer `FRAME` (0.7 mm, each line with
+/// its own lineweight where it differs; the symbol's centre lines continuous), millimetres with y up
+/// and the sheet's lower left corner at the origin. The writer's page is whole pixels
+/// ([`MM_PER_PX`]), so the file's limits are the sheet rounded up to the next pixel (A3: 420.16 ×
+/// 297.13 mm); the coordinates are exact.
+pub fn to_dxf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
+    let (w, h) = sheet.mm;
+    let height = (h / MM_PER_PX).ceil();
+    // The writer puts a pixel (x, y) at (x, height − y) · MM_PER_PX millimetres.
+    let to_px = |p: DVec2| DVec2::new(p.x / MM_PER_PX, height - (h - p.y) / MM_PER_PX);
+    let mut drawing = Drawing {
+        width: (w / MM_PER_PX).ceil() as u32,
+        height: height as u32,
+        smooth: sheet.views.first().map(|v| v.drawing.smooth).unwrap_or_default(),
+        ..Drawing::default()
+    };
+    for view in &sheet.views {
+        drawing.strokes.extend(
+            view.drawing
+                .strokes
+                .iter()
+                .map(|s| Stroke { points: s.points.iter().map(|p| to_px(*p)).collect(), ..s.clone() }),
+        );
+    }
+    let frame: Vec<(Length, Vec<DVec2>)> =
+        sheet.frame.iter().map(|l| (Length::Mm(l.width), l.points.iter().map(|p| to_px(*p)).collect())).collect();
+    let layer = ExtraLayer {
+        name: "FRAME",
+        pen: Pen { width: Length::Mm(super::BORDER_WIDTH_MM), grey: 0.0, dash: None },
+        lines: &frame,
+    };
+    crate::dxf::to_dxf_with(&drawing, sheet.hidden, style, &[layer])
 }
