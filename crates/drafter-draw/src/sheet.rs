@@ -47,6 +47,7 @@ use crate::style::MM_PER_PX;
 use crate::{DrawOptions, Drawing, Fill, Hidden, Projection, Stroke};
 
 pub mod font;
+pub mod section;
 pub mod write;
 
 pub use write::{to_dxf, to_pdf, to_svg};
