@@ -229,6 +229,8 @@ fn sheet_mistakes_end_with_exit_2_and_one_line_naming_the_value() {
         (&["--sheet", "A3", "--scale", "500:1"], "500:1"),
         (&["--sheet", "A3", "--scale", "1:0"], "1:0"),
         (&["--sheet", "A3", "--up", "w"], "w"),
+        (&["--sheet", "A3", "--section", "w=1"], "w=1"),
+        (&["--sheet", "A3", "--section", "0,0,0,0,0,0"], "0,0,0,0,0,0"),
         (&["--sheet", "A3", "--up", "z", "--front", "-z"], "-z"),
     ] {
         let run = common::drafter()
@@ -254,4 +256,34 @@ fn sheet_mistakes_end_with_exit_2_and_one_line_naming_the_value() {
         .output()
         .unwrap();
     assert!(run.status.success(), "{largest}: {}", String::from_utf8_lossy(&run.stderr));
+}
+
+#[test]
+fn a_section_sheet_of_the_sample_is_valid_svg_and_dxf() {
+    let dir = common::scratch("sheet-section");
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/assembly.glb");
+    let (svg, dxf) = (dir.join("section.svg"), dir.join("section.dxf"));
+    for out in [&svg, &dxf] {
+        let run = common::drafter()
+            .args(["draw", &sample.display().to_string(), "-o", &out.display().to_string()])
+            .args(["--sheet", "A3", "--section", "0.01,0.02,0,0.25,0.4,1", "--hidden", "dashed"])
+            .output()
+            .expect("drafter runs");
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    }
+    let lint = Command::new("xmllint").arg("--noout").arg(&svg).output().expect("xmllint checks the SVG");
+    assert!(lint.status.success(), "xmllint: {}", String::from_utf8_lossy(&lint.stderr));
+    let text = std::fs::read_to_string(&svg).expect("the SVG");
+    let section = text.split(r#"<g id="view-section""#).nth(1).expect("a section view");
+    assert!(section.contains(r#"<g class="hatching""#) && section.contains(r#"<g class="cut""#));
+    let script = dir.join("read_dxf.py");
+    std::fs::write(&script, EZDXF_READER).expect("the reader script is written");
+    let read = Command::new("/usr/bin/python3").arg(&script).arg(&dxf).output().expect("ezdxf reads the DXF");
+    assert!(read.status.success(), "ezdxf: {}", String::from_utf8_lossy(&read.stderr));
+    let read: serde_json::Value = serde_json::from_slice(&read.stdout).expect("the reader's JSON");
+    assert_eq!(read["problems"], serde_json::json!([0, 0, 0, 0]), "{read}");
+    let hatching = section.split(r#"<g class="hatching""#).nth(1).unwrap_or_default();
+    let hatch_lines = hatching[..hatching.find("</g>").unwrap_or(0)].matches("<path").count() as u64;
+    assert!(hatch_lines > 0);
+    assert_eq!(read["counts"]["HATCH"].as_u64(), Some(hatch_lines), "{read}");
 }

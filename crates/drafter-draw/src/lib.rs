@@ -616,9 +616,23 @@ pub fn visibility(model: &Model, options: &DrawOptions) -> Visibility {
 /// [`visibility`] under a given projection (a drawing sheet's views, [`sheet`]) instead of the
 /// camera `options` fit; `options.view`, `orthographic` and `size` are then not read.
 pub fn visibility_in(model: &Model, options: &DrawOptions, projection: Projection) -> Visibility {
+    visibility_clipped(model, options, projection, None)
+}
+
+/// [`visibility_in`] of what a section leaves ([`sheet::section::Clip`]): edges and occluders cut
+/// at its plane, and the cut faces hiding what lies behind them.
+pub fn visibility_clipped(
+    model: &Model,
+    options: &DrawOptions,
+    projection: Projection,
+    clip: Option<&sheet::section::Clip>,
+) -> Visibility {
     let start = Instant::now();
-    let triangles = world_triangles(model);
-    let (edges, silhouettes) = view_edges(model, &projection, options.smooth);
+    let mut triangles = world_triangles(model);
+    let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth);
+    if let Some(clip) = clip {
+        clip.keep_below(&mut triangles.corners, &mut edges);
+    }
     let occluders = Occluders::new(&triangles, &projection);
     let mut stats =
         DrawStats { triangles: triangles.corners.len(), edges: edges.len(), silhouettes, ..Default::default() };
@@ -644,7 +658,8 @@ pub fn visibility_in(model: &Model, options: &DrawOptions, projection: Projectio
         .par_iter()
         .map(|(_, a, b)| {
             let mut tested = 0;
-            (occluders.hidden(*a, *b, &mut tested), tested)
+            let hidden = occluders.hidden(*a, *b, &mut tested);
+            (if let Some(clip) = clip { clip.hide(*a, *b, hidden) } else { hidden }, tested)
         })
         .collect();
     let mut out = Vec::with_capacity(unique.len());
@@ -671,8 +686,18 @@ pub fn draw(model: &Model, options: &DrawOptions) -> Drawing {
 /// [`draw`] under a given projection (a drawing sheet's views, [`sheet`]) instead of the camera
 /// `options` fit; `options.view` and `orthographic` are then not read.
 pub fn draw_in(model: &Model, options: &DrawOptions, projection: Projection) -> Drawing {
+    draw_clipped(model, options, projection, None)
+}
+
+/// [`draw_in`] of what a section leaves ([`visibility_clipped`]).
+pub fn draw_clipped(
+    model: &Model,
+    options: &DrawOptions,
+    projection: Projection,
+    clip: Option<&sheet::section::Clip>,
+) -> Drawing {
     let start = Instant::now();
-    let Visibility { edges, mut stats, projection } = visibility_in(model, options, projection);
+    let Visibility { edges, mut stats, projection } = visibility_clipped(model, options, projection, clip);
     let fills = crate::fills::fills(model, &projection, options.fill);
     let tolerance = options.tolerance_px.max(0.0);
     let mut pieces = Vec::new();

@@ -31,8 +31,11 @@
 //!   128 truncated-cone symbol, sheet size, date) lettered in a stroke font ([`font`]). The date is
 //!   left empty unless given, so a sheet's bytes depend only on its input.
 //!
-//! Limits: one sheet, no dimensions, no view labels, no section views yet; the lettering is
-//! capitals only.
+//! - **Section** ([`SheetOptions::section`], [`section`]): a view A–A looking down a cutting
+//!   plane's normal at what lies below it, the cut faces of closed bodies hatched.
+//!
+//! Limits: one sheet, no dimensions, no view labels but the section's; the lettering is capitals
+//! only.
 
 use std::fmt;
 use std::str::FromStr;
@@ -126,6 +129,9 @@ pub enum ViewKind {
     Rear,
     /// Isometric: from front, right and top alike, orthographic.
     Iso,
+    /// The section view A–A ([`SheetOptions::section`]): from above the cutting plane, looking down
+    /// its normal at what lies below it; not named in `--views`.
+    Section,
 }
 
 impl ViewKind {
@@ -148,6 +154,7 @@ impl ViewKind {
             ViewKind::Bottom => "bottom",
             ViewKind::Rear => "rear",
             ViewKind::Iso => "iso",
+            ViewKind::Section => "section",
         }
     }
 
@@ -180,6 +187,8 @@ impl ViewKind {
                 let towards = (front + right + up).normalize();
                 (towards, (up - towards * towards.dot(up)).normalize())
             }
+            // Set from the plane by `section_frame`.
+            ViewKind::Section => (front, up),
         };
         ViewFrame { right: screen_up.cross(towards), up: screen_up, towards }
     }
@@ -196,6 +205,7 @@ impl ViewKind {
             ViewKind::Left => (0, -flip),
             ViewKind::Rear => (0, 2),
             ViewKind::Iso => (-1, 1),
+            ViewKind::Section => (1, 1),
         }
     }
 }
@@ -340,6 +350,9 @@ pub struct SheetOptions {
     /// The title block's date; `None` (the default) leaves the field empty, so the sheet's bytes
     /// depend only on its input.
     pub date: Option<String>,
+    /// A section view A–A through this plane (world units), after the other views; `None` (the
+    /// default): none.
+    pub section: Option<section::Plane>,
     /// Each view's hidden lines, tolerance and tangent edges; its size, view, projection and fill
     /// are the sheet's own.
     pub draw: DrawOptions,
@@ -357,6 +370,7 @@ impl Default for SheetOptions {
             mm_per_unit: 1000.0,
             title: String::new(),
             date: None,
+            section: None,
             draw: DrawOptions::default(),
         }
     }
@@ -446,6 +460,14 @@ pub struct PlacedView {
     /// The view's lines in sheet millimetres (y down); `width` and `height` are the sheet's in
     /// pixels, rounded.
     pub drawing: Drawing,
+    /// A section view's cut faces: their outlines (closed, the first point repeated) and hatching,
+    /// sheet millimetres; empty for the other views.
+    pub cut_outlines: Vec<Vec<DVec2>>,
+    pub hatching: Vec<[DVec2; 2]>,
+    /// The view's projection onto the sheet's pixels and, for a section, what it cuts away: what
+    /// [`crate::visibility_clipped`] takes to redo the view's visibility.
+    pub projection: Projection,
+    pub clip: Option<section::Clip>,
 }
 
 impl PlacedView {
@@ -481,6 +503,8 @@ pub struct Sheet {
     pub border: Rect,
     pub title_block: Rect,
     pub frame: Vec<FrameLine>,
+    /// With a section: the bodies the plane crosses that are not closed, left uncut.
+    pub open_components: usize,
 }
 
 /// The layout of the views at scale 1 (world units), before a scale is chosen.
@@ -495,25 +519,57 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(kinds: &[ViewKind], angle: Angle, front: DVec3, up: DVec3, points: &[DVec3]) -> Layout {
+    fn new(
+        kinds: &[ViewKind],
+        angle: Angle,
+        front: DVec3,
+        up: DVec3,
+        points: &[DVec3],
+        section: Option<&section::Plane>,
+    ) -> Layout {
         let right = up.cross(front);
-        let frames: Vec<ViewFrame> = kinds.iter().map(|k| k.frame(front, up, right)).collect();
-        let extents: Vec<(DVec3, DVec3)> = frames
+        let frames: Vec<ViewFrame> = kinds
+            .iter()
+            .map(|k| match (k, section) {
+                (ViewKind::Section, Some(plane)) => section_frame(plane, front, up),
+                _ => k.frame(front, up, right),
+            })
+            .collect();
+        let extents: Vec<(DVec3, DVec3)> = kinds
             .par_iter()
-            .map(|f| {
-                points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            .zip(&frames)
+            .map(|(kind, f)| {
+                let project = |(lo, hi): (DVec3, DVec3), p: &DVec3| {
                     let q = DVec3::new(f.right.dot(*p), f.up.dot(*p), f.towards.dot(*p));
                     (lo.min(q), hi.max(q))
-                })
+                };
+                let empty = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                match (kind, section) {
+                    // What the plane leaves: every triangle cut to its part below the plane.
+                    (ViewKind::Section, Some(plane)) => points
+                        .chunks_exact(3)
+                        .flat_map(|t| section::below(plane, &[t[0], t[1], t[2]]))
+                        .fold(empty, |e, p| project(e, &p)),
+                    _ => points.iter().fold(empty, project),
+                }
             })
             .collect();
         // Grid cells: the orthographic views by the convention, iso above the right-hand column.
         let mut cells: Vec<(i32, i32)> = kinds.iter().map(|k| k.cell(angle)).collect();
-        let right_column =
-            kinds.iter().zip(&cells).filter(|(k, _)| **k != ViewKind::Iso).map(|(_, c)| c.1).max().unwrap_or(0).max(1);
+        let right_column = kinds
+            .iter()
+            .zip(&cells)
+            .filter(|(k, _)| !matches!(k, ViewKind::Iso | ViewKind::Section))
+            .map(|(_, c)| c.1)
+            .max()
+            .unwrap_or(0)
+            .max(1);
         for (k, c) in kinds.iter().zip(cells.iter_mut()) {
-            if *k == ViewKind::Iso {
-                *c = (-1, right_column);
+            match k {
+                ViewKind::Iso => *c = (-1, right_column),
+                // The section below the right-hand column.
+                ViewKind::Section => *c = (1, right_column),
+                _ => {}
             }
         }
         let mut row_ids: Vec<i32> = cells.iter().map(|c| c.0).collect();
@@ -611,7 +667,13 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
         max: DVec2::new(w - EDGE_MARGIN_MM, h - EDGE_MARGIN_MM),
     };
     let title_block = Rect { min: border.max - DVec2::new(TITLE_BLOCK_MM.0, TITLE_BLOCK_MM.1), max: border.max };
-    let layout = Layout::new(&options.views, options.angle, front, up, &points);
+    let mut kinds = options.views.clone();
+    kinds.retain(|k| *k != ViewKind::Section);
+    if options.section.is_some() {
+        kinds.push(ViewKind::Section);
+    }
+    let cut = options.section.as_ref().map(|plane| section::cut(model, plane));
+    let layout = Layout::new(&kinds, options.angle, front, up, &points, options.section.as_ref());
     let fit = |scale: Scale| layout.place(scale.ratio() * options.mm_per_unit, &border, &title_block);
     let (scale, rects) = match options.scale {
         Some(scale) => match fit(scale) {
@@ -643,13 +705,43 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
             // `right`, its top edge the highest `up`.
             let origin = DVec2::new(rect.min.x - s * lo.x, rect.min.y + s * hi.y);
             let projection = view_projection(model, frame, origin, s, (lo.z, hi.z), (w, h));
-            let mut drawing = crate::draw_in(model, &view_options, projection);
+            let to_sheet = |p: DVec3| origin + s * DVec2::new(frame.right.dot(p), -frame.up.dot(p));
+            let (mut cut_outlines, mut hatching, mut clip) = (Vec::new(), Vec::new(), None);
+            if let (ViewKind::Section, Some(plane), Some(cut)) = (kind, &options.section, &cut) {
+                let mut loops_px = Vec::new();
+                for (k, face) in cut.faces.iter().enumerate() {
+                    let loops: Vec<Vec<DVec2>> =
+                        face.loops.iter().map(|l| l.iter().map(|p| to_sheet(*p)).collect()).collect();
+                    // ISO 128-50: 45° thin lines; neighbouring parts told apart by direction and spacing.
+                    let part = face.part.map_or(k, |p| p as usize);
+                    let angle = if part % 2 == 0 { 45.0 } else { 135.0 };
+                    let spacing = [2.0, 3.0, 2.5][(part / 2) % 3];
+                    hatching.extend(section::hatch(&loops, angle, spacing));
+                    for ring in &loops {
+                        loops_px.push(ring.iter().map(|p| *p / MM_PER_PX).collect());
+                        cut_outlines.push(ring.iter().chain(ring.first()).copied().collect());
+                    }
+                }
+                clip = Some(section::Clip { plane: *plane, cut: loops_px });
+            }
+            let mut drawing = crate::draw_clipped(model, &view_options, projection, clip.as_ref());
             for stroke in &mut drawing.strokes {
                 for p in &mut stroke.points {
                     *p *= MM_PER_PX;
                 }
             }
-            PlacedView { kind, frame, rect: *rect, origin, mm_per_world: s, drawing }
+            PlacedView {
+                kind,
+                frame,
+                rect: *rect,
+                origin,
+                mm_per_world: s,
+                drawing,
+                cut_outlines,
+                hatching,
+                projection,
+                clip,
+            }
         })
         .collect();
     let mut sheet = Sheet {
@@ -664,9 +756,23 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
         border,
         title_block,
         frame: Vec::new(),
+        open_components: cut.map_or(0, |c| c.open_components),
     };
     sheet.frame = frame_lines(&sheet);
     Ok(sheet)
+}
+
+/// The section view's axes: looking down the plane's normal from above it, the model's up (or,
+/// across a horizontal plane, its back) up on the sheet.
+fn section_frame(plane: &section::Plane, front: DVec3, up: DVec3) -> ViewFrame {
+    let towards = plane.normal;
+    let upright = up - towards * towards.dot(up);
+    let screen_up = if upright.length() > 1e-6 {
+        upright.normalize()
+    } else {
+        (-front - towards * towards.dot(-front)).normalize()
+    };
+    ViewFrame { right: screen_up.cross(towards), up: screen_up, towards }
 }
 
 /// The projection of one view onto the whole sheet in its pixels ([`MM_PER_PX`] mm each):
@@ -718,6 +824,10 @@ fn frame_lines(sheet: &Sheet) -> Vec<FrameLine> {
     let (w, h) = sheet.mm;
     let b = &sheet.border;
     let mut out = vec![line(BORDER_WIDTH_MM, rectangle(b))];
+    // The section view's name above it (ISO 128-40 letters it A–A).
+    for view in sheet.views.iter().filter(|v| v.kind == ViewKind::Section) {
+        text(&mut out, "SECTION A-A", DVec2::new(view.rect.min.x, view.rect.min.y - 2.0), 3.5);
+    }
     // ISO 5457 centring marks: from the border 5 mm outwards, at the middle of each side.
     for (from, to) in [
         (DVec2::new(w / 2.0, b.min.y), DVec2::new(w / 2.0, b.min.y - 5.0)),

@@ -260,3 +260,108 @@ fn section_cuts_have_the_area_of_the_bodies_plane_cut() {
     check_sections(&common::sample(), "sample");
     check_sections(&common::baked(&common::corpus_path("gltf/GearboxAssy/GearboxAssy.gltf")), "GearboxAssy");
 }
+
+#[test]
+fn a_section_view_hatches_its_cut_and_hides_exactly_what_brute_force_hides() {
+    let model = common::sample();
+    let (lo, hi) = world_box(&model);
+    let size = (hi - lo).max_element();
+    // An oblique plane: in a view along an axis, edges lie exactly behind others and rays graze
+    // faces, where "hidden" depends on a boundary convention (docs/drawing.md, axis views).
+    let normal = DVec3::new(0.25, 0.4, 1.0).normalize();
+    let plane = section::Plane { normal, offset: normal.dot((lo + hi) * 0.5) + 0.0123457 * size };
+    let options = SheetOptions {
+        size: SheetSize::A3,
+        angle: Angle::Third,
+        section: Some(plane),
+        draw: DrawOptions { hidden: Hidden::Dashed, ..DrawOptions::default() },
+        ..SheetOptions::default()
+    };
+    let sheet = sheet::draw_sheet(&model, &options).expect("sheet");
+    let view = sheet.views.iter().find(|v| v.kind == ViewKind::Section).expect("a section view");
+    assert_eq!(sheet.views.len(), 5);
+    for (i, a) in sheet.views.iter().enumerate() {
+        assert!(sheet.border.contains(&a.rect) && !a.rect.overlaps(&sheet.title_block), "{:?}", a.kind);
+        for b in &sheet.views[i + 1..] {
+            assert!(!a.rect.overlaps(&b.rect), "{:?} and {:?} overlap", a.kind, b.kind);
+        }
+    }
+    // The cut on the sheet: the model's cut area times the scale squared; hatching inside it.
+    let cut = section::cut(&model, &plane);
+    let area: f64 = cut.faces.iter().map(|f| f.area(&plane)).sum();
+    let outlines: Vec<Vec<DVec2>> = view.cut_outlines.iter().map(|ring| ring[..ring.len() - 1].to_vec()).collect();
+    let on_sheet: f64 = outlines
+        .iter()
+        .map(|ring| {
+            // y runs down on the sheet: clockwise there is counter-clockwise seen from above.
+            -0.5 * (0..ring.len()).map(|k| ring[k].perp_dot(ring[(k + 1) % ring.len()])).sum::<f64>()
+        })
+        .sum();
+    let s2 = view.mm_per_world * view.mm_per_world;
+    assert!((on_sheet - area * s2).abs() <= 1e-6 * area * s2, "{on_sheet} mm² against {}", area * s2);
+    assert!(!view.hatching.is_empty());
+    for [a, b] in &view.hatching {
+        assert!(section::inside(&outlines, (*a + *b) * 0.5), "a hatch line outside the cut");
+    }
+    for s in view.drawing.strokes.iter().flat_map(|s| &s.points) {
+        assert!(s.x >= view.rect.min.x - 1e-6 && s.x <= view.rect.max.x + 1e-6, "{s}");
+        assert!(s.y >= view.rect.min.y - 1e-6 && s.y <= view.rect.max.y + 1e-6, "{s}");
+    }
+
+    // Brute force: what lies below the plane, as triangles, and the cut faces in the plane. A point
+    // of an edge is hidden when a ray from it up the normal meets one of those triangles, or its
+    // foot on the plane lies inside a cut face (even-odd in the plane).
+    let below: Vec<[DVec3; 3]> = drafter_draw::brute::world_triangles(&model)
+        .iter()
+        .flat_map(|t| {
+            let polygon = section::below(&plane, t);
+            (1..polygon.len().saturating_sub(1))
+                .map(move |i| [polygon[0], polygon[i], polygon[i + 1]])
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let u = plane.normal.any_orthonormal_vector();
+    let v = plane.normal.cross(u);
+    let faces_2d: Vec<Vec<DVec2>> = cut
+        .faces
+        .iter()
+        .flat_map(|f| f.loops.iter().map(|l| l.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect()))
+        .collect();
+    let visibility = drafter_draw::visibility_clipped(&model, &options.draw, view.projection, view.clip.as_ref());
+    let (mut compared, mut hidden_points, mut disagreements) = (0, 0, 0);
+    for edge in &visibility.edges {
+        let length = edge.screen[0].distance(edge.screen[1]);
+        if length < 1.0 {
+            continue;
+        }
+        for k in 1..5 {
+            let t = f64::from(k) / 5.0;
+            // Away from the drawing's change points by more than the tolerance.
+            let margin = 0.1 / length;
+            if edge.hidden.iter().any(|&(a, b)| (t - a).abs() < margin || (t - b).abs() < margin) {
+                continue;
+            }
+            let p = edge.a + (edge.b - edge.a) * t;
+            if plane.distance(p) > -1e-6 * size {
+                continue;
+            }
+            let drawn_hidden = edge.hidden.iter().any(|&(a, b)| a < t && t < b);
+            let foot = p - plane.normal * plane.distance(p);
+            let brute = section::inside(&faces_2d, DVec2::new(foot.dot(u), foot.dot(v)))
+                || drafter_draw::brute::blocked(p, p + plane.normal * (2.0 * size), &below);
+            compared += 1;
+            hidden_points += usize::from(brute);
+            disagreements += usize::from(brute != drawn_hidden);
+            if brute != drawn_hidden && disagreements < 6 {
+                let by_cut = section::inside(&faces_2d, DVec2::new(foot.dot(u), foot.dot(v)));
+                println!(
+                    "p {p} drawn hidden {drawn_hidden} brute {brute} (cut {by_cut}) {:?} t {t} screen {:?}",
+                    edge.class, edge.screen
+                );
+            }
+        }
+    }
+    println!("section view: {compared} points compared, {hidden_points} hidden, {disagreements} disagreements");
+    assert!(compared > 1000 && hidden_points > 100, "{compared} {hidden_points}");
+    assert_eq!(disagreements, 0);
+}

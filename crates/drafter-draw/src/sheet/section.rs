@@ -17,9 +17,11 @@
 //! material and loops around holes turn opposite ways; with the body's orientation that makes the signed area of a cut the
 //! area of material.
 //!
-//! Limits: not yet drawn on a sheet (no section view A–A, no `--section`, no `[draw] uncut`);
-//! bodies whose meshes do not weld into closed surfaces (cracks, slivers collapsed to a point) are
-//! left uncut and counted.
+//! On a sheet ([`super::SheetOptions::section`]) the cut faces are outlined and hatched in a
+//! section view whose lines are drawn by [`crate::draw_clipped`] with a [`Clip`].
+//!
+//! Limits: no `[draw] uncut` list (shafts, bolts); bodies whose meshes do not weld into closed
+//! surfaces (cracks, slivers collapsed to a point) are left uncut and counted.
 
 use glam::{DVec2, DVec3, Vec3};
 
@@ -244,6 +246,126 @@ fn cut_instance(
         by_component.entry(component).or_insert_with(|| CutFace { instance, part, loops: Vec::new() }).loops.push(ring);
     }
     section.faces.extend(by_component.into_values());
+}
+
+/// What a section leaves of a view ([`crate::visibility_clipped`]): what lies above the plane is
+/// taken away (edges and occluding triangles cut at it), and the cut faces, which lie in the plane
+/// in front of everything left (the view looks down the plane's normal), hide what lies behind them
+/// on the screen. Exact as the rest of the drawing: a triangle cut by the plane is the polygon
+/// below it (as triangles from its first corner), and an edge behind a cut face is hidden where its
+/// projection is inside the face's loops (even-odd, decided at the middle of every piece between
+/// crossings of the loops).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Clip {
+    pub plane: Plane,
+    /// The cut faces' loops on the screen (the view's pixels).
+    pub cut: Vec<Vec<DVec2>>,
+}
+
+impl Default for Plane {
+    fn default() -> Self {
+        Plane { normal: DVec3::Z, offset: 0.0 }
+    }
+}
+
+impl Clip {
+    /// Cuts `triangles` and `edges` to what lies below the plane (on it counts as below).
+    pub(crate) fn keep_below(&self, triangles: &mut Vec<[DVec3; 3]>, edges: &mut Vec<crate::Edge>) {
+        let s = |p: DVec3| self.plane.distance(p);
+        let mut kept = Vec::with_capacity(triangles.len());
+        for t in triangles.iter() {
+            if t.iter().all(|p| s(*p) <= 0.0) {
+                kept.push(*t);
+                continue;
+            }
+            let polygon = self.below(t);
+            for i in 1..polygon.len().saturating_sub(1) {
+                kept.push([polygon[0], polygon[i], polygon[i + 1]]);
+            }
+        }
+        *triangles = kept;
+        edges.retain_mut(|e| {
+            let (sa, sb) = (s(e.a), s(e.b));
+            match (sa <= 0.0, sb <= 0.0) {
+                (true, true) => true,
+                (false, false) => false,
+                (true, false) => {
+                    e.b = e.a + (e.b - e.a) * (sa / (sa - sb));
+                    true
+                }
+                (false, true) => {
+                    e.a = e.b + (e.a - e.b) * (sb / (sb - sa));
+                    true
+                }
+            }
+        });
+    }
+
+    /// `hidden` (intervals of the screen segment `a → b`) with the stretches behind the cut faces added.
+    pub(crate) fn hide(&self, a: crate::Projected, b: crate::Projected, hidden: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+        let (pa, pb) = (DVec2::new(a.x, a.y), DVec2::new(b.x, b.y));
+        let (lo, hi) = (pa.min(pb), pa.max(pb));
+        let d = pb - pa;
+        let mut cuts = vec![0.0, 1.0];
+        let mut near = false;
+        for ring in &self.cut {
+            let (rlo, rhi) =
+                ring.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
+            if rhi.x < lo.x || rhi.y < lo.y || rlo.x > hi.x || rlo.y > hi.y {
+                continue;
+            }
+            near = true;
+            for (i, p) in ring.iter().enumerate() {
+                let q = ring[(i + 1) % ring.len()];
+                let e = q - *p;
+                let denominator = d.perp_dot(e);
+                if denominator == 0.0 {
+                    continue;
+                }
+                let w = *p - pa;
+                let (u, v) = (w.perp_dot(e) / denominator, w.perp_dot(d) / denominator);
+                if u > 0.0 && u < 1.0 && (0.0..=1.0).contains(&v) {
+                    cuts.push(u);
+                }
+            }
+        }
+        if !near {
+            return hidden;
+        }
+        cuts.sort_by(f64::total_cmp);
+        let mut intervals = hidden;
+        for w in cuts.windows(2) {
+            if w[1] > w[0] && inside(&self.cut, pa + d * (0.5 * (w[0] + w[1]))) {
+                intervals.push((w[0], w[1]));
+            }
+        }
+        crate::union(&mut intervals)
+    }
+}
+
+impl Clip {
+    fn below(&self, t: &[DVec3; 3]) -> Vec<DVec3> {
+        below(&self.plane, t)
+    }
+}
+
+/// The part of triangle `t` below `plane` (Sutherland–Hodgman against one plane; on it counts as below).
+pub fn below(plane: &Plane, t: &[DVec3; 3]) -> Vec<DVec3> {
+    {
+        let s = |p: DVec3| plane.distance(p);
+        let mut out = Vec::with_capacity(4);
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let (sa, sb) = (s(a), s(b));
+            if sa <= 0.0 {
+                out.push(a);
+            }
+            if (sa <= 0.0) != (sb <= 0.0) {
+                out.push(a + (b - a) * (sa / (sa - sb)));
+            }
+        }
+        out
+    }
 }
 
 /// Hatching of a cut face seen in a view: lines at `angle_deg` (from the view's x axis, counter-

@@ -114,6 +114,22 @@ pub fn to_svg(sheet: &Sheet, style: LineStyle) -> String {
             }
             let _ = writeln!(s, "</g>");
         }
+        if !view.cut_outlines.is_empty() {
+            // A section's cut faces: their hatching (narrow) under their outlines (wide).
+            let (thin, wide) = section_pens(style);
+            let _ = writeln!(s, r#"<g class="section">"#);
+            let _ = writeln!(s, r#"<g class="hatching" stroke-width="{}">"#, mm(thin.width.mm()));
+            for line in &view.hatching {
+                svg_path(&mut s, "", line);
+            }
+            let _ = writeln!(s, "</g>");
+            let _ = writeln!(s, r#"<g class="cut" stroke-width="{}">"#, mm(wide.width.mm()));
+            for ring in &view.cut_outlines {
+                svg_path(&mut s, "", ring);
+            }
+            let _ = writeln!(s, "</g>");
+            let _ = writeln!(s, "</g>");
+        }
         let _ = writeln!(s, "</g>");
     }
     let _ = writeln!(s, r#"<g id="frame">"#);
@@ -184,6 +200,19 @@ pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
                 content.stroke();
             }
         }
+        if !view.cut_outlines.is_empty() {
+            let (thin, wide) = section_pens(style);
+            set_pen(&mut content, &thin);
+            for line in &view.hatching {
+                path(&mut content, line);
+            }
+            content.stroke();
+            set_pen(&mut content, &wide);
+            for ring in &view.cut_outlines {
+                path(&mut content, ring);
+            }
+            content.stroke();
+        }
     }
     content.set_stroke_gray(0.0);
     for FrameLine { width, dashes, points } in &sheet.frame {
@@ -221,7 +250,17 @@ pub fn to_dxf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
                 .iter()
                 .map(|s| Stroke { points: s.points.iter().map(|p| to_px(*p)).collect(), ..s.clone() }),
         );
+        // A section's cut outlines are visible outlines.
+        drawing.strokes.extend(view.cut_outlines.iter().map(|ring| Stroke {
+            class: LineClass::Silhouette,
+            visible: true,
+            part: None,
+            points: ring.iter().map(|p| to_px(*p)).collect(),
+        }));
     }
+    let (thin, _) = section_pens(style);
+    let hatching: Vec<(Length, Vec<DVec2>)> =
+        sheet.views.iter().flat_map(|v| &v.hatching).map(|[a, b]| (thin.width, vec![to_px(*a), to_px(*b)])).collect();
     let frame: Vec<(Length, Vec<DVec2>)> =
         sheet.frame.iter().map(|l| (Length::Mm(l.width), l.points.iter().map(|p| to_px(*p)).collect())).collect();
     let layer = ExtraLayer {
@@ -229,5 +268,17 @@ pub fn to_dxf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
         pen: Pen { width: Length::Mm(super::BORDER_WIDTH_MM), grey: 0.0, dash: None },
         lines: &frame,
     };
-    crate::dxf::to_dxf_with(&drawing, sheet.hidden, style, &[layer])
+    let hatch = ExtraLayer { name: "HATCH", pen: thin, lines: &hatching };
+    if hatching.is_empty() {
+        crate::dxf::to_dxf_with(&drawing, sheet.hidden, style, &[layer])
+    } else {
+        crate::dxf::to_dxf_with(&drawing, sheet.hidden, style, &[layer, hatch])
+    }
+}
+
+/// The pens of a section's hatching (the style's narrow continuous line, ISO 128-50's thin
+/// hatching) and its cut outlines (the style's outline).
+fn section_pens(style: LineStyle) -> (Pen, Pen) {
+    let thin = Pen { dash: None, ..style.pen(LineClass::Crease, false, Hidden::Solid) };
+    (thin, style.pen(LineClass::Silhouette, true, Hidden::None))
 }
