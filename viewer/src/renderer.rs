@@ -242,6 +242,24 @@ impl Renderer {
     }
 
     /// Hard-edge segments of the loaded model (edges × instances).
+    /// Whether the model's silhouette hierarchies wait to be built (a
+    /// [`drafter_scene::Hierarchies::Deferred`] load): brute force answers until then.
+    pub fn hierarchies_pending(&self) -> bool {
+        self.scene.as_ref().is_some_and(|s| s.lines.lines.hierarchies_pending())
+    }
+
+    /// Builds the silhouette hierarchies a deferred load left (the lines pass's copy of the
+    /// model's lines is the one every frame queries); returns the notices of any that did not
+    /// validate.
+    pub fn complete_hierarchies(&mut self) -> Vec<String> {
+        self.complete_hierarchies_of(usize::MAX).0
+    }
+
+    /// [`Self::complete_hierarchies`] for at most `meshes` meshes; also returns how many still wait.
+    pub fn complete_hierarchies_of(&mut self, meshes: usize) -> (Vec<String>, usize) {
+        self.scene.as_mut().map(|s| s.lines.lines.complete_hierarchies_of(meshes)).unwrap_or_default()
+    }
+
     pub fn hard_edge_count(&self) -> u32 {
         self.scene.as_ref().map_or(0, |s| s.lines.hard_count())
     }
@@ -330,6 +348,9 @@ impl Renderer {
             &drawn_layers
         };
         let plan = shadow::plan(drawn_shadow, layers, camera.clip_from_render(), &scene.fit_points, mask_size);
+        if drawn_shadow != ShadowMode::None {
+            self.shadow.ensure_pipelines(&self.gpu.device);
+        }
         self.shadow.prepare(queue, &plan);
         let radius = (max - min).length() * 0.5;
         self.enhance
@@ -358,6 +379,9 @@ impl Renderer {
         output: Option<&wgpu::TextureView>,
     ) -> Result<FrameInfo, RenderError> {
         let info = self.prepare(options)?;
+        if options.interactive {
+            self.upscale.ensure_pipeline(&self.gpu.device);
+        }
         if options.interactive && output.is_none() {
             self.ensure_upscaled(info.target_size)?;
         }

@@ -15,12 +15,13 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use drafter_lines::{BruteForce, EdgeSet, View as LinesView};
-use drafter_viewer::edges::DrawnSilhouette;
+use drafter_viewer::edges::{DrawnSilhouette, Hierarchies};
 use drafter_viewer::{Camera, Model, RenderOptions, Renderer, Style, View};
 use glam::{DMat4, Vec3};
 
 /// A baked file in memory: the viewer's model, the file's extension data and its imported scene.
 struct Baked {
+    bytes: Vec<u8>,
     model: Model,
     file: drafter_format::BakedFile,
     scene: drafter_core::Scene,
@@ -35,7 +36,7 @@ fn bake(path: &Path) -> Baked {
     let model = Model::load_bytes(name, &bytes).expect("baked file loads");
     let file = drafter_format::read(&bytes, &|_| None).expect("baked file reads");
     let scene = drafter_io::import_bytes(name, &bytes).expect("baked file imports").scene;
-    Baked { model, file, scene }
+    Baked { bytes, model, file, scene }
 }
 
 /// Brute force over the file's candidates of every instance, in its object space.
@@ -155,6 +156,25 @@ fn drawn_silhouettes_equal_brute_force_through_the_hierarchies() {
     renderer.set_model(&b.model).expect("upload");
     let (total, _) = check(&b, &mut renderer, "bunny");
     assert!(total > 1000, "only {total} silhouettes");
+}
+
+#[test]
+fn deferred_hierarchies_draw_the_same_silhouettes_before_and_after_they_are_built() {
+    // The browser's load: brute force answers the first frames, the stored hierarchies come later.
+    let mut b = bake(&common::corpus_path("obj/common-3d-test-models/stanford-bunny.obj"));
+    b.model = Model::load_bytes_with(Path::new("baked.glb"), &b.bytes, &Default::default(), Hierarchies::Deferred)
+        .expect("loads deferred");
+    let lines = b.model.lines.meshes[0].silhouettes.as_ref().expect("candidates");
+    assert!(lines.pending.is_some() && lines.index.gauss_map().is_none() && lines.index.cone_bvh().is_none());
+    let mut renderer = common::renderer();
+    renderer.set_model(&b.model).expect("upload");
+    assert!(renderer.hierarchies_pending());
+    let (before, _) = check(&b, &mut renderer, "bunny, brute force");
+    assert!(renderer.complete_hierarchies().is_empty(), "the stored hierarchies validate");
+    assert!(!renderer.hierarchies_pending());
+    let (after, _) = check(&b, &mut renderer, "bunny, hierarchies built");
+    assert_eq!(before, after);
+    assert!(after > 1000, "only {after} silhouettes");
 }
 
 #[test]

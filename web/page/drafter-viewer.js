@@ -422,6 +422,21 @@ export class DrafterViewer extends HTMLElement {
     this.timings.firstFrame = performance.now();
     this.state = 'ready';
     this.dispatchEvent(new CustomEvent('drafter-ready', { detail: this.summary }));
+    // The silhouette hierarchies were left for after the first frame (brute force answered it):
+    // built on a later task, so the frame is on screen first.
+    // One mesh a task, so input between them is not held up.
+    const viewer = this.viewer;
+    const loads = this.loads;
+    const step = () => {
+      if (this.viewer !== viewer || this.loads !== loads) return;
+      try {
+        if (viewer.complete_load() > 0) setTimeout(step, 0);
+        else this.timings.hierarchiesBuilt = performance.now();
+      } catch (err) {
+        console.warn(`drafter: silhouette hierarchies not built: ${err.message ?? err}`);
+      }
+    };
+    setTimeout(step, 0);
   }
 
   /**

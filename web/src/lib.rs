@@ -15,6 +15,7 @@
 use std::path::Path;
 
 use drafter_viewer::controls::{Action, Orbit, PIXELS_PER_LINE, action_for_char};
+use drafter_viewer::edges::Hierarchies;
 use drafter_viewer::{Enhancements, Gpu, Model, RenderOptions, Renderer, ShadowMode, Style};
 use wasm_bindgen::prelude::*;
 
@@ -193,7 +194,8 @@ impl Viewer {
     pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<String, JsError> {
         let limits = drafter_io::Limits { max_triangles: max_triangles.max(0.0) as u64 };
         let start = web_time::Instant::now();
-        let model = Model::load_bytes_within(Path::new(name), bytes, &limits).map_err(js_error)?;
+        // The silhouette hierarchies wait until the first frame is on screen (`complete_load`).
+        let model = Model::load_bytes_with(Path::new(name), bytes, &limits, Hierarchies::Deferred).map_err(js_error)?;
         let read = start.elapsed();
         self.renderer.set_model(&model).map_err(js_error)?;
         let uploaded = start.elapsed();
@@ -212,6 +214,18 @@ impl Viewer {
         });
         self.model = Some(model);
         Ok(summary.to_string())
+    }
+
+    /// Builds part of what [`Viewer::load`] left for after the first frame: the silhouette
+    /// hierarchies of the next mesh that waits (they answer later frames' silhouettes faster than
+    /// brute force does; frames drawn before are the same, only slower to find). Returns how
+    /// many meshes still wait, so the page calls it again on a later task, between input events.
+    pub fn complete_load(&mut self) -> u32 {
+        let (notices, left) = self.renderer.complete_hierarchies_of(1);
+        for notice in notices {
+            web_sys::console::warn_1(&notice.into());
+        }
+        left as u32
     }
 
     /// Follows the canvas's new size in pixels.

@@ -88,6 +88,23 @@ pub struct MeshSilhouetteLines {
     pub corners: Vec<u32>,
     /// Object-space endpoints of each candidate, in the index's candidate order.
     pub segments: Vec<[Vec3; 2]>,
+    /// The file's hierarchies, not built yet: brute force answers until
+    /// [`ModelLines::complete_hierarchies`] builds them (see [`Hierarchies::Deferred`]).
+    pub pending: Option<Box<MeshSilhouettes>>,
+}
+
+/// When a loaded file's silhouette hierarchies are built.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Hierarchies {
+    /// At load: every query after it is answered by the stored hierarchies.
+    #[default]
+    AtLoad,
+    /// Later, by [`ModelLines::complete_hierarchies`]; until then each mesh's candidates are
+    /// answered by brute force (the same sets). Checking a stored hierarchy means assigning its
+    /// candidates down the stored tree again, most of a large file's load (GearboxAssy: 0.6 of
+    /// 1.1 s in the browser, where one query by brute force is a few milliseconds), so the page
+    /// shows its first frame first and builds them after it.
+    Deferred,
 }
 
 /// The edges of one mesh and the instances that draw it.
@@ -164,6 +181,17 @@ impl ModelLines {
     /// The edges of `scene` (the import of the baked file) from `baked`. `instance_meshes[i]` and
     /// `world_from_object[i]` describe model instance `i`; instances of a mesh are contiguous.
     pub fn from_scene(scene: &Scene, baked: &BakedFile, instance_meshes: &[u32], world_from_object: &[DMat4]) -> Self {
+        Self::from_scene_with(scene, baked, instance_meshes, world_from_object, Hierarchies::AtLoad)
+    }
+
+    /// [`Self::from_scene`], building the stored hierarchies when `hierarchies` says.
+    pub fn from_scene_with(
+        scene: &Scene,
+        baked: &BakedFile,
+        instance_meshes: &[u32],
+        world_from_object: &[DMat4],
+        hierarchies: Hierarchies,
+    ) -> Self {
         let mut notices = Vec::new();
         let mut meshes = Vec::new();
         let mut bad_slots = 0usize;
@@ -199,11 +227,11 @@ impl ModelLines {
                     }
                 }
             }
-            let silhouettes = baked
-                .mesh_silhouettes
-                .iter()
-                .find(|(mm, _)| *mm as usize == m)
-                .and_then(|(_, s)| load_silhouettes(m, s, &position, &mut notices));
+            let silhouettes =
+                baked.mesh_silhouettes.iter().find(|(mm, _)| *mm as usize == m).and_then(|(_, s)| match hierarchies {
+                    Hierarchies::AtLoad => load_silhouettes(m, s, &position, &mut notices),
+                    Hierarchies::Deferred => load_silhouettes_deferred(m, s, &position, &mut notices),
+                });
             if hard.is_empty() && silhouettes.is_none() {
                 continue;
             }
@@ -234,6 +262,54 @@ impl ModelLines {
             }
         }
         out
+    }
+
+    /// Whether some mesh's stored hierarchies wait for [`Self::complete_hierarchies`].
+    pub fn hierarchies_pending(&self) -> bool {
+        self.meshes.iter().any(|m| m.silhouettes.as_ref().is_some_and(|s| s.pending.is_some()))
+    }
+
+    /// Builds the stored hierarchies that a [`Hierarchies::Deferred`] load left for later, as
+    /// [`load_silhouettes`] does at load (one that does not validate is dropped with a notice, and
+    /// brute force keeps answering). Returns the new notices (also added to [`Self::notices`]).
+    pub fn complete_hierarchies(&mut self) -> Vec<String> {
+        self.complete_hierarchies_of(usize::MAX).0
+    }
+
+    /// [`Self::complete_hierarchies`] for at most `meshes` meshes (the page builds one at a time
+    /// between input events). Returns the notices and how many meshes still wait.
+    pub fn complete_hierarchies_of(&mut self, meshes: usize) -> (Vec<String>, usize) {
+        let mut notices = Vec::new();
+        let mut built = 0;
+        for mesh in &mut self.meshes {
+            if built == meshes {
+                break;
+            }
+            let Some(lines) = mesh.silhouettes.as_mut() else { continue };
+            let Some(stored) = lines.pending.take() else { continue };
+            built += 1;
+            // The brute-force index keeps the file's candidate order: each corner's segment is
+            // at the corner's place in the file.
+            let by_corner: std::collections::HashMap<u32, [Vec3; 2]> =
+                lines.corners.iter().copied().zip(lines.segments.iter().copied()).collect();
+            let position = |t: usize, k: usize| -> Option<Vec3> {
+                let corner = (3 * t + k % 3) as u32;
+                // Corner k's start point is the segment of corner k, or the end of corner k − 1.
+                by_corner.get(&corner).map(|s| s[0]).or_else(|| {
+                    let previous = (3 * t + (k + 2) % 3) as u32;
+                    by_corner.get(&previous).map(|s| s[1])
+                })
+            };
+            match load_silhouettes(mesh.mesh as usize, &stored, &position, &mut notices) {
+                Some(full) => *lines = full,
+                None => {
+                    // The candidates loaded once; keep answering them by brute force.
+                }
+            }
+        }
+        self.notices.extend(notices.iter().cloned());
+        let left = self.meshes.iter().filter(|m| m.silhouettes.as_ref().is_some_and(|s| s.pending.is_some())).count();
+        (notices, left)
     }
 
     /// Candidates of every mesh (for reports).
@@ -271,6 +347,29 @@ impl ModelLines {
         frame.elapsed = start.elapsed();
         frame
     }
+}
+
+/// [`load_silhouettes`] without the hierarchies: the candidates by brute force, in the file's
+/// order, and the stored hierarchies kept for [`ModelLines::complete_hierarchies`].
+fn load_silhouettes_deferred(
+    m: usize,
+    s: &MeshSilhouettes,
+    position: &dyn Fn(usize, usize) -> Option<Vec3>,
+    notices: &mut Vec<String>,
+) -> Option<MeshSilhouetteLines> {
+    if s.gauss_map.is_none() && s.cone_bvh.is_none() {
+        return load_silhouettes(m, s, position, notices);
+    }
+    let candidates = MeshSilhouettes {
+        gauss_map: None,
+        cone_bvh: None,
+        orthographic: drafter_format::OrthographicHierarchy::BruteForce,
+        perspective: drafter_format::PerspectiveHierarchy::BruteForce,
+        ..s.clone()
+    };
+    let mut lines = load_silhouettes(m, &candidates, position, notices)?;
+    lines.pending = Some(Box::new(s.clone()));
+    Some(lines)
 }
 
 /// The index of one mesh's stored candidates and hierarchies, as every reader of the file loads it
@@ -366,7 +465,9 @@ pub fn load_silhouettes(
     let corners = index.candidate_edges().to_vec();
     let segments: Option<Vec<[Vec3; 2]>> = corners.iter().map(|&c| segment(c)).collect();
     match segments {
-        Some(segments) if segments.len() == index.len() => Some(MeshSilhouetteLines { index, corners, segments }),
+        Some(segments) if segments.len() == index.len() => {
+            Some(MeshSilhouetteLines { index, corners, segments, pending: None })
+        }
         _ => {
             notices.push(format!("mesh {m}: silhouette index and candidates disagree: none drawn"));
             None

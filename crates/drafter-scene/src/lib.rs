@@ -23,5 +23,6 @@ pub mod model;
 pub mod style;
 
 pub use camera::Camera;
+pub use edges::Hierarchies;
 pub use model::{LoadError, Model, Part};
 pub use style::{Style, UnknownStyle, View};

@@ -40,6 +40,7 @@ use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
+use crate::edges::Hierarchies;
 use crate::layout::{InstanceGpu, MaterialGpu, NO_STYLE, NOT_FLAT, PartGpu, Vertex};
 use crate::lookups::BakedLookups;
 use crate::style::{Style, transfer_index};
@@ -149,6 +150,17 @@ impl Model {
 
     /// As [`Self::load_bytes`], refusing a file that lists more than `limits` allows.
     pub fn load_bytes_within(path: &Path, bytes: &[u8], limits: &drafter_io::Limits) -> Result<Model, LoadError> {
+        Self::load_bytes_with(path, bytes, limits, Hierarchies::AtLoad)
+    }
+
+    /// [`Self::load_bytes_within`], building the silhouette hierarchies when `hierarchies` says (the
+    /// browser's page defers them past its first frame: [`Hierarchies::Deferred`]).
+    pub fn load_bytes_with(
+        path: &Path,
+        bytes: &[u8],
+        limits: &drafter_io::Limits,
+        hierarchies: Hierarchies,
+    ) -> Result<Model, LoadError> {
         // A compressed GLB (EXT_meshopt_compression) is decoded once, and everything below reads
         // the plain bytes; a stream that does not decode is reported by the import.
         let plain = drafter_format::meshopt::decompress_glb(bytes).ok().flatten();
@@ -159,7 +171,7 @@ impl Model {
             Some(_) => read_normal_sets(path, bytes)?,
             None => Vec::new(),
         };
-        let mut model = Model::from_scene_with_normals(&imported.scene, baked.as_ref(), &normal_sets)
+        let mut model = Model::build(&imported.scene, baked.as_ref(), &normal_sets, hierarchies)
             .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
         model.diagnostics = imported.diagnostics;
         if let Some(record) = baked.as_ref().and_then(|b| b.root.textures.as_ref()) {
@@ -184,6 +196,15 @@ impl Model {
         scene: &Scene,
         baked: Option<&BakedFile>,
         normal_sets: &[PrimitiveNormals],
+    ) -> Option<Model> {
+        Self::build(scene, baked, normal_sets, Hierarchies::AtLoad)
+    }
+
+    fn build(
+        scene: &Scene,
+        baked: Option<&BakedFile>,
+        normal_sets: &[PrimitiveNormals],
+        hierarchies: Hierarchies,
     ) -> Option<Model> {
         let bounds = scene.world_bounds();
         if bounds.is_empty() || scene.instanced_triangle_count() == 0 {
@@ -296,7 +317,15 @@ impl Model {
         let materials = material_table(scene);
 
         let lines = baked
-            .map(|b| crate::edges::ModelLines::from_scene(scene, b, &instance_mesh, &instance_world_from_object))
+            .map(|b| {
+                crate::edges::ModelLines::from_scene_with(
+                    scene,
+                    b,
+                    &instance_mesh,
+                    &instance_world_from_object,
+                    hierarchies,
+                )
+            })
             .unwrap_or_default();
         notices.extend(lines.notices.iter().cloned());
 

@@ -194,18 +194,28 @@ fn steep(light_dir: Vec3) -> Vec3 {
 #[derive(Debug)]
 pub struct ShadowPass {
     scene_layout: wgpu::BindGroupLayout,
-    /// Screen-space layers into the mask (stencil: once per pixel, additive).
-    pipeline: wgpu::RenderPipeline,
-    /// The soft shadow's ground layer into the ground map.
-    map_pipeline: wgpu::RenderPipeline,
-    /// The soft shadow's full-screen resolve into the mask.
-    resolve_pipeline: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    resolve_pipeline_layout: wgpu::PipelineLayout,
+    /// Compiled by [`Self::ensure_pipelines`] when a frame first draws a shadow (the page's default
+    /// is none: three pipeline links a first frame does not need).
+    pipelines: Option<ShadowPipelines>,
     layers: wgpu::Buffer,
     layers_bind_group: wgpu::BindGroup,
     stride: u64,
     ground_map: crate::targets::Target,
     resolve_uniforms: wgpu::Buffer,
     resolve_bind_group: wgpu::BindGroup,
+}
+
+#[derive(Debug)]
+struct ShadowPipelines {
+    /// Screen-space layers into the mask (stencil: once per pixel, additive).
+    pipeline: wgpu::RenderPipeline,
+    /// The soft shadow's ground layer into the ground map.
+    map_pipeline: wgpu::RenderPipeline,
+    /// The soft shadow's full-screen resolve into the mask.
+    resolve_pipeline: wgpu::RenderPipeline,
 }
 
 /// Each layer's stencil test: a pixel counts once per layer (the first fragment there increments).
@@ -288,53 +298,6 @@ impl ShadowPass {
             bind_group_layouts: &[None, None, Some(&resolve_layout)],
             immediate_size: 0,
         });
-        let layer_pipeline = |label: &str, format, blend, depth_stencil| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(crate::passes::gbuffer::vertex_layout())],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil,
-                multisample: wgpu::MultisampleState::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let pipeline = layer_pipeline(
-            "shadow layer pipeline",
-            SHADOW_MASK_FORMAT,
-            Some(ADDITIVE),
-            Some(wgpu::DepthStencilState {
-                format: SHADOW_STENCIL_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: wgpu::StencilState { front: ONCE, back: ONCE, read_mask: 0xff, write_mask: 0xff },
-                bias: wgpu::DepthBiasState::default(),
-            }),
-        );
-        let map_pipeline = layer_pipeline("shadow ground map pipeline", GROUND_MAP_FORMAT, None, None);
-        let resolve_pipeline = fullscreen_pipeline(
-            device,
-            "shadow resolve pipeline",
-            &resolve_pipeline_layout,
-            &module,
-            "fs_resolve",
-            SHADOW_MASK_FORMAT,
-            None,
-            &[],
-        );
-
         let (layers, layers_bind_group, stride) = layer_uniforms(device, &layer_layout);
         let ground_map = crate::targets::Target::new(
             device,
@@ -366,9 +329,10 @@ impl ShadowPass {
         });
         ShadowPass {
             scene_layout,
-            pipeline,
-            map_pipeline,
-            resolve_pipeline,
+            module,
+            layout,
+            resolve_pipeline_layout,
+            pipelines: None,
             layers,
             layers_bind_group,
             stride,
@@ -400,6 +364,61 @@ impl ShadowPass {
         }
     }
 
+    /// Compiles the pipelines the first time a frame draws a shadow.
+    pub fn ensure_pipelines(&mut self, device: &wgpu::Device) {
+        if self.pipelines.is_some() {
+            return;
+        }
+        let layer_pipeline = |label: &str, format, blend, depth_stencil| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&self.layout),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(crate::passes::gbuffer::vertex_layout())],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let pipeline = layer_pipeline(
+            "shadow layer pipeline",
+            SHADOW_MASK_FORMAT,
+            Some(ADDITIVE),
+            Some(wgpu::DepthStencilState {
+                format: SHADOW_STENCIL_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: wgpu::StencilState { front: ONCE, back: ONCE, read_mask: 0xff, write_mask: 0xff },
+                bias: wgpu::DepthBiasState::default(),
+            }),
+        );
+        let map_pipeline = layer_pipeline("shadow ground map pipeline", GROUND_MAP_FORMAT, None, None);
+        let resolve_pipeline = fullscreen_pipeline(
+            device,
+            "shadow resolve pipeline",
+            &self.resolve_pipeline_layout,
+            &self.module,
+            "fs_resolve",
+            SHADOW_MASK_FORMAT,
+            None,
+            &[],
+        );
+
+        self.pipelines = Some(ShadowPipelines { pipeline, map_pipeline, resolve_pipeline });
+    }
+
     fn draw_batches(&self, pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, layer: usize) {
         pass.set_bind_group(0, &scene.shadow_bind_group, &[]);
         pass.set_bind_group(1, &self.layers_bind_group, &[(layer as u64 * self.stride) as u32]);
@@ -413,6 +432,7 @@ impl ShadowPass {
     /// Writes the mask of `plan` (as prepared): screen-space layers one render pass each (stencil
     /// cleared), or the soft shadow's ground map and resolve.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets, scene: &SceneGpu, plan: &ShadowPlan) {
+        let Some(pipelines) = &self.pipelines else { return };
         encoder.push_debug_group(LABEL);
         if plan.resolve.is_some() {
             {
@@ -424,7 +444,7 @@ impl ShadowPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&self.map_pipeline);
+                pass.set_pipeline(&pipelines.map_pipeline);
                 self.draw_batches(&mut pass, scene, 0);
             }
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -435,7 +455,7 @@ impl ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.resolve_pipeline);
+            pass.set_pipeline(&pipelines.resolve_pipeline);
             pass.set_bind_group(2, &self.resolve_bind_group, &[]);
             pass.draw(0..3, 0..1);
         } else {
@@ -459,7 +479,7 @@ impl ShadowPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(&pipelines.pipeline);
                 pass.set_stencil_reference(0);
                 self.draw_batches(&mut pass, scene, k);
             }

@@ -20,7 +20,12 @@ pub const LABEL: &str = "upscale";
 #[derive(Debug)]
 pub struct UpscalePass {
     layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+    /// Compiled by [`Self::ensure_pipeline`] at the first interactive frame (a still view never
+    /// needs it).
+    pipeline: Option<wgpu::RenderPipeline>,
     sampler: wgpu::Sampler,
 }
 
@@ -37,8 +42,6 @@ impl UpscalePass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline =
-            fullscreen_pipeline(device, "upscale pipeline", &pipeline_layout, &module, "fs_main", format, None, &[]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("upscale sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -47,7 +50,23 @@ impl UpscalePass {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             ..Default::default()
         });
-        UpscalePass { layout, pipeline, sampler }
+        UpscalePass { layout, module, pipeline_layout, format, pipeline: None, sampler }
+    }
+
+    /// Compiles the pipeline the first time an interactive frame is drawn.
+    pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
+        if self.pipeline.is_none() {
+            self.pipeline = Some(fullscreen_pipeline(
+                device,
+                "upscale pipeline",
+                &self.pipeline_layout,
+                &self.module,
+                "fs_main",
+                self.format,
+                None,
+                &[],
+            ));
+        }
     }
 
     /// The bind group reading `source` (the reduced frame's display output).
@@ -63,6 +82,7 @@ impl UpscalePass {
     }
 
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, bind_group: &wgpu::BindGroup, output: &wgpu::TextureView) {
+        let Some(pipeline) = &self.pipeline else { return };
         encoder.push_debug_group(LABEL);
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -73,7 +93,7 @@ impl UpscalePass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
