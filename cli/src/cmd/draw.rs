@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use drafter_draw::{self as drawing, DrawOptions, Fill, Hidden, LineStyle};
-use drafter_scene::{LoadError, Model, View};
+use drafter_scene::{Hierarchies, LoadError, Model, View};
 
 use crate::cmd::out;
 use crate::cmd::render::{parse_size, parse_view};
@@ -145,13 +145,13 @@ pub(crate) fn load(path: &Path, max_triangles: u64) -> Result<(Model, bool)> {
         other => anyhow::Error::from(BadInput(other.to_string())),
     };
     if is_baked(path, &bytes) {
-        return Ok((Model::load_bytes_within(path, &bytes, &limits).map_err(bad)?, false));
+        return Ok((Model::load_bytes_with(path, &bytes, &limits, Hierarchies::Never).map_err(bad)?, false));
     }
     let config = drafter_bake::BakeConfig::default();
     let baked = drafter_catalog::job::bake_bytes(path, bytes, &config, &limits, &mut |_| {})?;
     // The default container is one self-contained .glb, named as `drafter bake` would name it.
     let name = path.with_extension("baked.glb");
-    Ok((Model::load_bytes_within(&name, &baked.written.main, &limits).map_err(bad)?, true))
+    Ok((Model::load_bytes_with(&name, &baked.written.main, &limits, Hierarchies::Never).map_err(bad)?, true))
 }
 
 /// Whether `bytes` carry `DRAFTER_illustration` data (a compressed GLB decoded first, as the model

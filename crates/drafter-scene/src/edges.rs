@@ -105,6 +105,9 @@ pub enum Hierarchies {
     /// 1.1 s in the browser, where one query by brute force is a few milliseconds), so the page
     /// shows its first frame first and builds them after it.
     Deferred,
+    /// Never: brute force answers every query. For a few views (a drawing, a sheet) one pass over
+    /// the candidates costs less than checking the stored hierarchies.
+    Never,
 }
 
 /// The edges of one mesh and the instances that draw it.
@@ -231,6 +234,10 @@ impl ModelLines {
                 baked.mesh_silhouettes.iter().find(|(mm, _)| *mm as usize == m).and_then(|(_, s)| match hierarchies {
                     Hierarchies::AtLoad => load_silhouettes(m, s, &position, &mut notices),
                     Hierarchies::Deferred => load_silhouettes_deferred(m, s, &position, &mut notices),
+                    Hierarchies::Never => load_silhouettes_deferred(m, s, &position, &mut notices).map(|mut lines| {
+                        lines.pending = None;
+                        lines
+                    }),
                 });
             if hard.is_empty() && silhouettes.is_none() {
                 continue;
