@@ -79,7 +79,9 @@ pub enum Hidden {
 /// What a drawing shows of tangent edges (the borders between the input's faces that meet below
 /// the crease angle: a fillet meeting a plane), after FreeCAD TechDraw's "smooth lines". Wherever
 /// a tangent edge is this view's outline (its two faces turn opposite ways to the viewer) it is
-/// drawn as a silhouette, whatever this says.
+/// drawn as a silhouette, whatever this says. Where a tangent edge is hidden it is not drawn at
+/// all (hidden smooth lines are left out in ISO 128 practice, by TechDraw's default and by
+/// OpenCascade's exporter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Smooth {
     /// Left out.
@@ -713,10 +715,13 @@ pub fn draw_clipped(
                 pieces.push(Piece { a: at(lo), b: at(hi), class: edge.class, visible, part: edge.part });
             }
         };
+        // Hidden tangent edges are not drawn, whatever `smooth` says: ISO 128 drafting and
+        // TechDraw's default leave hidden smooth lines out, and so does OpenCascade's exporter.
+        let hidden_drawn = options.hidden != Hidden::None && edge.class != LineClass::Tangent;
         let mut from = 0.0;
         for &(lo, hi) in &edge.hidden {
             push(from, lo, true);
-            if options.hidden != Hidden::None {
+            if hidden_drawn {
                 push(lo, hi, false);
             }
             from = hi;

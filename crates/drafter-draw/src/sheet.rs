@@ -824,10 +824,12 @@ fn frame_lines(sheet: &Sheet) -> Vec<FrameLine> {
     let (w, h) = sheet.mm;
     let b = &sheet.border;
     let mut out = vec![line(BORDER_WIDTH_MM, rectangle(b))];
-    // The section view's name above it (ISO 128-40 letters it A–A).
+    // The section view's name above it (ISO 128-40 letters it A–A), and its cutting plane where
+    // another view sees it edge-on.
     for view in sheet.views.iter().filter(|v| v.kind == ViewKind::Section) {
         text(&mut out, "SECTION A-A", DVec2::new(view.rect.min.x, view.rect.min.y - 2.0), 3.5);
     }
+    out.extend(cutting_plane_marks(sheet));
     // ISO 5457 centring marks: from the border 5 mm outwards, at the middle of each side.
     for (from, to) in [
         (DVec2::new(w / 2.0, b.min.y), DVec2::new(w / 2.0, b.min.y - 5.0)),
@@ -875,6 +877,56 @@ fn frame_lines(sheet: &Sheet) -> Vec<FrameLine> {
             text(&mut out, words, DVec2::new(x + 2.0 + 22.0, t.max.y - 3.0 - 3.5 + 1.25), label);
         }
         x += widths[k];
+    }
+    out
+}
+
+/// The cutting plane of the section view, in every orthographic view that sees it edge-on (ISO
+/// 128-44): a narrow chain line across the view, 2 mm past its box, wide for 5 mm at each end,
+/// with an arrow at each end pointing the way the section looks (down the plane's normal, its tip
+/// on the line) and the letter A at the arrow's tail.
+fn cutting_plane_marks(sheet: &Sheet) -> Vec<FrameLine> {
+    let mut out = Vec::new();
+    let Some(plane) = sheet.views.iter().find_map(|v| v.clip.as_ref().map(|c| c.plane)) else { return out };
+    for view in sheet.views.iter().filter(|v| !matches!(v.kind, ViewKind::Iso | ViewKind::Section)) {
+        let f = &view.frame;
+        if plane.normal.dot(f.towards).abs() > 1e-9 {
+            continue;
+        }
+        // The trace a x + b y = d in the view's axes, then on the sheet (y down).
+        let (a, b) = (plane.normal.dot(f.right), plane.normal.dot(f.up));
+        let foot = DVec2::new(a, b) * (plane.offset / (a * a + b * b));
+        let start = view.origin + view.mm_per_world * DVec2::new(foot.x, -foot.y);
+        let along = DVec2::new(-b, -a).normalize();
+        let looking = DVec2::new(-a, b).normalize();
+        // Clip the line to the view's box grown by 2 mm (slabs).
+        let r = view.rect.grown(2.0);
+        let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+        for (p, d, lo, hi) in [(start.x, along.x, r.min.x, r.max.x), (start.y, along.y, r.min.y, r.max.y)] {
+            if d.abs() < 1e-12 {
+                if p < lo || p > hi {
+                    t0 = f64::INFINITY;
+                }
+                continue;
+            }
+            let (u, v) = ((lo - p) / d, (hi - p) / d);
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+        }
+        if t0 >= t1 {
+            continue;
+        }
+        let (e0, e1) = (start + along * t0, start + along * t1);
+        out.push(FrameLine { width: 0.25, dashes: vec![6.0, 1.0, 0.5, 1.0], points: vec![e0, e1] });
+        for (end, inward) in [(e0, along), (e1, -along)] {
+            out.push(line(BORDER_WIDTH_MM, vec![end, end + inward * 5.0]));
+            let tail = end - looking * 8.0;
+            let side = looking.perp() * 0.9;
+            out.push(line(0.35, vec![tail, end]));
+            out.push(line(0.35, vec![end - looking * 2.5 + side, end, end - looking * 2.5 - side]));
+            let letter = tail - looking * 2.5;
+            text(&mut out, "A", letter + DVec2::new(-1.05, 1.75), 3.5);
+        }
     }
     out
 }

@@ -365,3 +365,21 @@ fn a_section_view_hatches_its_cut_and_hides_exactly_what_brute_force_hides() {
     assert!(compared > 1000 && hidden_points > 100, "{compared} {hidden_points}");
     assert_eq!(disagreements, 0);
 }
+
+#[test]
+fn a_section_across_an_axis_is_marked_where_views_see_its_plane_edge_on() {
+    let model = common::sample();
+    let (lo, hi) = world_box(&model);
+    let plane = section::Plane { normal: DVec3::X, offset: (lo.x + hi.x) * 0.5 };
+    let options = SheetOptions { size: SheetSize::A3, section: Some(plane), ..SheetOptions::default() };
+    let sheet = sheet::draw_sheet(&model, &options).expect("sheet");
+    // x = c is edge-on in the front and top views (right = +x), not in the right view.
+    let chains: Vec<_> = sheet.frame.iter().filter(|l| l.dashes.len() == 4 && l.width == 0.25).collect();
+    assert_eq!(chains.len(), 2, "one chain line in each of front and top");
+    for chain in chains {
+        let x = chain.points[0].x;
+        assert!((chain.points[1].x - x).abs() < 1e-9, "vertical: the trace of x = c");
+        let front = sheet.views.iter().find(|v| v.kind == ViewKind::Front).unwrap();
+        assert!((front.to_sheet(DVec3::new(plane.offset, 0.0, 0.0)).x - x).abs() < 1e-9, "at x = c");
+    }
+}
