@@ -275,6 +275,9 @@ MODELS = {
 # ---------------------------------------------------------------------------------------------
 # Geometry helpers
 
+# The steepest elevation drafter's camera accepts (f32, below 90): a "top" view.
+STEEPEST = 89.99999
+
 
 def y_up(shape):
     """CadQuery's z-up turned to y-up: (x, y, z) -> (x, z, -y), a rotation about x by -90°."""
@@ -486,26 +489,55 @@ def main():
     ap.add_argument("--models", default=",".join(MODELS))
     ap.add_argument("--view", action="append", default=[], metavar="MODEL=AZ,EL",
                     help="draw MODEL from this view instead of its own (repeatable)")
+    ap.add_argument("--views", default="own",
+                    help="own (each model's view), or a list of iso,front,top: iso is the model's own view, "
+                         "front elevation exactly 0, top the steepest elevation the camera accepts (89.99999)")
+    ap.add_argument("--input", choices=("gltf", "stl"), default="gltf",
+                    help="what drafter bakes: OpenCascade's glTF (one primitive per B-rep face, so the bake "
+                         "knows the face borders) or an STL of the same tessellation (no faces)")
+    ap.add_argument("--draw-arg", action="append", default=[], metavar="ARG",
+                    help="one more argument for drafter draw (repeatable), e.g. --draw-arg=--smooth=thin")
     ap.add_argument("--json", default=None, help="write the figures as JSON here")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     width, height = map(int, args.size.split("x"))
     views = {k: tuple(map(float, v.split(","))) for k, v in (o.split("=") for o in args.view)}
     rows = []
+    jobs = []
     for name in args.models.split(","):
-        build, (az, el) = MODELS[name]
-        az, el = views.get(name, (az, el))
-        shape = y_up(build())
-        base = os.path.join(args.out, name if name not in views else f"{name}@{az:g},{el:g}")
+        build, own = MODELS[name]
+        if args.views == "own":
+            jobs.append((name, build, "own", views.get(name, own)))
+        else:
+            named = {"iso": own, "front": (0.0, 0.0), "top": (0.0, STEEPEST)}
+            jobs.extend((name, build, v, named[v]) for v in args.views.split(","))
+    baked = {}
+    for name, build, view_name, (az, el) in jobs:
+        raw = build()
+        shape = y_up(raw)
+        label = name if view_name == "own" and name not in views else f"{name}@{az:.10g},{el:.10g}"
+        base = os.path.join(args.out, label)
+        model = os.path.join(args.out, name)
         d = towards_eye(az, el)
-        # Tessellate and bake.
-        cq.exporters.export(shape, base + ".stl", tolerance=args.tol, angularTolerance=args.ang)
-        run([args.drafter, "bake", "-q", base + ".stl", "-o", base + ".glb"])
-        # drafter draw.
-        ms = []
+        # Tessellate and bake (once per model). OpenCascade's glTF writer turns its z-up into glTF's
+        # y-up with a root node rotation, so the raw shape gives the y-up world drawn here.
+        if name not in baked:
+            if args.input == "gltf":
+                cq.Assembly().add(raw, name=name).save(model + ".in.glb", "GLTF", tolerance=args.tol,
+                                                       angularTolerance=args.ang)
+                run([args.drafter, "bake", "-q", model + ".in.glb", "-o", model + ".glb"])
+            else:
+                cq.exporters.export(shape, model + ".stl", tolerance=args.tol, angularTolerance=args.ang)
+                run([args.drafter, "bake", "-q", model + ".stl", "-o", model + ".glb"])
+            baked[name] = model + ".glb"
+        # drafter draw, timed as its JSON says (the drawing) and as a process (load, draw, write).
+        ms, wall = [], []
         for _ in range(args.repeat):
-            r = run([args.drafter, "draw", base + ".glb", "-o", base + ".drafter.svg", "--ortho",
-                     "--view", f"{az:g},{el:g}", "--size", args.size, "--hidden", "dashed", "--json", "-q"])
+            t0 = time.perf_counter()
+            r = run([args.drafter, "draw", baked[name], "-o", base + ".drafter.svg", "--ortho",
+                     "--view", f"{az:.10g},{el:.10g}", "--size", args.size, "--hidden", "dashed", "--json", "-q",
+                     *args.draw_arg])
+            wall.append(time.perf_counter() - t0)
             info = json.loads(r.stdout)
             ms.append(info["ms"])
         # CadQuery's exporter, timed as a whole.
@@ -543,13 +575,25 @@ def main():
         row = {"model": os.path.basename(base), "view": [az, el], "projectionDir": [round(v, 6) for v in d],
                "triangles": info["triangles"], "scale_px_per_mm": s, "sag_px": args.tol * s,
                "dihedral": dihedral, "exporter_polylines_match": bool(same),
-               "drafter_ms": min(ms), "occ_export_ms": 1e3 * min(ex), "occ_hlr_ms": 1e3 * hlr_s}
+               "drafter_ms": min(ms), "drafter_process_ms": 1e3 * min(wall),
+               "occ_export_ms": 1e3 * min(ex), "occ_hlr_ms": 1e3 * hlr_s, "view_name": view_name}
         for label, tol in (("", 0.5), ("_1px", 1.0), ("_0.25px", 0.25)):
             row["vis_ref_in_ours" + label], row["ref_vis_px"] = share_near(ref_vis_all, t_ours_vis, tol)
             row["vis_common_ref_in_ours" + label], row["ref_vis_common_px"] = share_near(ref_vis_common, t_ours_vis, tol)
             row["vis_ours_in_ref" + label], row["ours_vis_px"] = share_near(ours_vis, t_ref_vis, tol)
             row["hid_ref_in_ours" + label], row["ref_hid_px"] = share_near(ref_hid, t_ours_hid, tol)
             row["hid_ours_in_ref" + label], row["ours_hid_px"] = share_near(ours_hid, t_ref_hid, tol)
+        # Hidden lines of the reference that lie under a visible line of ours are drawn as that
+        # visible line (a visible piece wins over a hidden one on the same pixels): left out here.
+        for label, tol in (("", 0.5), ("_1px", 1.0)):
+            mids, lens = pieces(ref_hid, 0.1)
+            if len(mids):
+                keep = t_ours_vis.dist(mids) > tol
+                near = t_ours_hid.dist(mids[keep]) <= tol
+                total = float(np.sum(lens[keep]))
+                row["hid_ref_in_ours_unmasked" + label] = float(np.sum(lens[keep][near])) / total if total else None
+            else:
+                row["hid_ref_in_ours_unmasked" + label] = None
         row["ref_smooth_px"] = share_near(tr(kinds[("visible", "smooth")]), t_ours_vis)[1] if kinds[("visible", "smooth")] else 0.0
         # Per kind of the reference: share near ours (visible and hidden), and its length.
         row["ref_by_kind"] = {f"{vis}/{kind}": share_near(tr(lines), t_ours_vis if vis == "visible" else t_ours_hid)
@@ -589,6 +633,20 @@ def main():
               f"{pct(r['vis_ref_in_ours'])} / {pct(r['vis_common_ref_in_ours'])} | {pct(r['vis_ours_in_ref'])} | "
               f"{pct(r['hid_ref_in_ours'])} | {pct(r['hid_ours_in_ref'])} | {r['drafter_ms']:.0f} | "
               f"{r['occ_export_ms']:.0f} ({r['occ_hlr_ms']:.0f}) |")
+    # Issue 58's figures: within 1 px, both ways, every view; speed as the median ratio of
+    # OpenCascade's export (in this process) to drafter draw as a process (load, draw, write).
+    def worst(key):
+        values = [(r[key], r["model"]) for r in rows if r.get(key) is not None]
+        return min(values) if values else (None, "")
+    ratio = sorted(r["occ_export_ms"] / r["drafter_process_ms"] for r in rows)
+    ratio_draw = sorted(r["occ_export_ms"] / r["drafter_ms"] for r in rows)
+    print(f"\n{len(rows)} views, within 1 px, the worst view of each figure:")
+    for key in ("vis_ref_in_ours_1px", "vis_ours_in_ref_1px", "hid_ref_in_ours_unmasked_1px", "hid_ours_in_ref_1px"):
+        value, model = worst(key)
+        print(f"  {key}: {pct(value)}% ({model})")
+    if ratio:
+        print(f"  OpenCascade export / drafter draw process: median {np.median(ratio):.1f}x "
+              f"(min {ratio[0]:.1f}x, max {ratio[-1]:.1f}x); / drafter's drawing alone: median {np.median(ratio_draw):.1f}x")
 
 
 if __name__ == "__main__":
