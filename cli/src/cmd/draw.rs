@@ -74,8 +74,6 @@ pub enum HiddenArg {
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum StyleArg {
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum SmoothArg {
     None,
     Thin,
@@ -92,6 +90,8 @@ impl From<SmoothArg> for drawing::Smooth {
     }
 }
 
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum StyleArg {
     Iso128,
     Gooch,
 }
@@ -215,12 +215,12 @@ pub fn run(args: Args) -> Result<()> {
         hidden: args.hidden.into(),
         tolerance_px: args.tolerance,
         fill: args.fill.into(),
+        smooth: args.smooth.into(),
         ..DrawOptions::default()
     };
     let drawing = drawing::draw(&model, &options);
     let style = LineStyle::from(args.style);
     let bytes = match format {
-        smooth: args.smooth.into(),
         Format::Svg => drawing::to_svg(&drawing, options.hidden, style).into_bytes(),
         Format::Pdf => drawing::to_pdf(&drawing, options.hidden, style),
         Format::Dxf => drawing::to_dxf(&drawing, options.hidden, style),

@@ -75,7 +75,6 @@ pub enum Hidden {
     Solid,
 }
 
-/// One view's drawing options.
 /// What a drawing shows of tangent edges (the borders between the input's faces that meet below
 /// the crease angle: a fillet meeting a plane), after FreeCAD TechDraw's "smooth lines". Wherever
 /// a tangent edge is this view's outline (its two faces turn opposite ways to the viewer) it is
@@ -94,6 +93,7 @@ pub enum Smooth {
     Dashed,
 }
 
+/// One view's drawing options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DrawOptions {
     /// Width and height in pixels (the SVG's user units).
@@ -106,9 +106,9 @@ pub struct DrawOptions {
     pub tolerance_px: f64,
     /// Part fills under the lines ([`crate::fills`]).
     pub fill: Fill,
-}
     /// Tangent edges ([`Smooth`]); default [`Smooth::Thin`].
     pub smooth: Smooth,
+}
 
 impl Default for DrawOptions {
     fn default() -> Self {
@@ -120,8 +120,8 @@ impl Default for DrawOptions {
             hidden: Hidden::None,
             tolerance_px: 0.05,
             fill: Fill::None,
-        }
             smooth: Smooth::Thin,
+        }
     }
 }
 
@@ -164,9 +164,9 @@ pub struct Drawing {
     /// Part fills, farthest part first ([`crate::fills`]); empty without `--fill`.
     pub fills: Vec<PartFill>,
     pub strokes: Vec<Stroke>,
-    pub stats: DrawStats,
     /// How the tangent strokes are drawn (what [`DrawOptions::smooth`] said).
     pub smooth: Smooth,
+    pub stats: DrawStats,
 }
 
 /// A projected point: pixels and closeness (see the module docs).
@@ -372,10 +372,10 @@ fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Ed
                     }
                     (class, _) => class,
                 };
-                edges.push(Edge {
                 if class == LineClass::Tangent && smooth == Smooth::None {
                     continue;
                 }
+                edges.push(Edge {
                     a: world.transform_point3(a.as_dvec3()),
                     b: world.transform_point3(b.as_dvec3()),
                     class,
@@ -835,6 +835,7 @@ pub fn class_name(class: LineClass) -> &'static str {
         LineClass::Boundary => "boundary",
         LineClass::PartBorder => "part-border",
         LineClass::NonManifold => "non-manifold",
+        LineClass::Tangent => "tangent",
     }
 }
 
@@ -847,7 +848,6 @@ pub fn to_svg(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let (w, h) = (drawing.width, drawing.height);
-        LineClass::Tangent => "tangent",
     let (page_w, page_h) = (style::short(f64::from(w) * MM_PER_PX), style::short(f64::from(h) * MM_PER_PX));
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
