@@ -266,7 +266,8 @@ fn a_section_sheet_of_the_sample_is_valid_svg_and_dxf() {
     for out in [&svg, &dxf] {
         let run = common::drafter()
             .args(["draw", &sample.display().to_string(), "-o", &out.display().to_string()])
-            .args(["--sheet", "A3", "--section", "0.01,0.02,0,0.25,0.4,1", "--hidden", "dashed"])
+            .args(["--sheet", "A3", "--section", "0.01,0.02,0,0.25,0.4,1", "--uncut", "shaft*,*bolt*"])
+            .args(["--hidden", "dashed"])
             .output()
             .expect("drafter runs");
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));

@@ -61,6 +61,11 @@ pub struct SheetArgs {
     /// closed are left uncut and counted.
     #[arg(long, value_name = "PLANE", allow_hyphen_values = true)]
     pub section: Option<String>,
+    /// Parts the section leaves whole, by name, comma-separated: `*` matches any run of characters,
+    /// case is ignored (ISO 128-50 does not section shafts, bolts, pins or keys:
+    /// --uncut 'shaft*,*bolt*,pin*'). They are drawn in full, in front of the plane too.
+    #[arg(long, value_name = "PATTERNS")]
+    pub uncut: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -131,6 +136,11 @@ fn options(args: &Args) -> Result<(SheetOptions, SheetSize)> {
         title,
         date: s.date.clone(),
         section: s.section.as_deref().map(sheet::section::Plane::parse).transpose().map_err(BadInput)?,
+        uncut: s
+            .uncut
+            .as_deref()
+            .map(|list| list.split(',').map(str::trim).filter(|p| !p.is_empty()).map(str::to_string).collect())
+            .unwrap_or_default(),
         draw: DrawOptions {
             hidden: args.hidden.into(),
             tolerance_px: args.tolerance,

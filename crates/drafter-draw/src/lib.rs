@@ -249,10 +249,12 @@ struct Edge {
 /// Every triangle of every instance in world space, with its part.
 struct Triangles {
     corners: Vec<[DVec3; 3]>,
+    /// Per triangle, its part (a section's uncut parts keep their triangles, [`sheet::section`]).
+    parts: Vec<Option<u32>>,
 }
 
 fn world_triangles(model: &Model) -> Triangles {
-    let mut corners = Vec::new();
+    let (mut corners, mut parts) = (Vec::new(), Vec::new());
     for batch in &model.batches {
         for instance in batch.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
@@ -261,15 +263,16 @@ fn world_triangles(model: &Model) -> Triangles {
                 .iter()
                 .map(|v| world.transform_point3(Vec3::from_array(v.position_in_object).as_dvec3()))
                 .collect();
-            for t in batch.indices.chunks_exact(3) {
+            for (k, t) in batch.indices.chunks_exact(3).enumerate() {
                 let p = |k: usize| points.get(t[k] as usize).copied();
                 if let (Some(a), Some(b), Some(c)) = (p(0), p(1), p(2)) {
                     corners.push([a, b, c]);
+                    parts.push(part_of(model, Some(batch), instance, k));
                 }
             }
         }
     }
-    Triangles { corners }
+    Triangles { corners, parts }
 }
 
 /// The welded connectivity of the mesh an instance draws ([`Topology`], welded exactly: the hard
@@ -633,7 +636,7 @@ pub fn visibility_clipped(
     let mut triangles = world_triangles(model);
     let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth);
     if let Some(clip) = clip {
-        clip.keep_below(&mut triangles.corners, &mut edges);
+        clip.keep_below(&mut triangles, &mut edges);
     }
     let occluders = Occluders::new(&triangles, &projection);
     let mut stats =
@@ -1037,6 +1040,18 @@ pub mod brute {
                     };
                     out.push([p(0), p(1), p(2)]);
                 }
+            }
+        }
+        out
+    }
+
+    /// The part of each triangle of [`world_triangles`], in its order.
+    pub fn world_triangle_parts(model: &Model) -> Vec<Option<u32>> {
+        let mut out = Vec::new();
+        for batch in &model.batches {
+            for instance in batch.instances.clone() {
+                let triangles = batch.indices.len() / 3;
+                out.extend((0..triangles).map(|t| crate::part_of(model, Some(batch), instance, t)));
             }
         }
         out

@@ -353,6 +353,9 @@ pub struct SheetOptions {
     /// A section view A–A through this plane (world units), after the other views; `None` (the
     /// default): none.
     pub section: Option<section::Plane>,
+    /// Parts the section leaves whole, by name: `*` matches any run of characters, case is
+    /// ignored (`shaft*`, `*bolt*`). Default none.
+    pub uncut: Vec<String>,
     /// Each view's hidden lines, tolerance and tangent edges; its size, view, projection and fill
     /// are the sheet's own.
     pub draw: DrawOptions,
@@ -371,6 +374,7 @@ impl Default for SheetOptions {
             title: String::new(),
             date: None,
             section: None,
+            uncut: Vec::new(),
             draw: DrawOptions::default(),
         }
     }
@@ -460,8 +464,10 @@ pub struct PlacedView {
     /// The view's lines in sheet millimetres (y down); `width` and `height` are the sheet's in
     /// pixels, rounded.
     pub drawing: Drawing,
-    /// A section view's cut faces: their outlines (closed, the first point repeated) and hatching,
-    /// sheet millimetres; empty for the other views.
+    /// A section's cut faces: their loops (the first point not repeated), the visible pieces of
+    /// their outlines and hatching (what uncut parts in front of the plane leave), sheet
+    /// millimetres; empty for the other views.
+    pub cut_loops: Vec<Vec<DVec2>>,
     pub cut_outlines: Vec<Vec<DVec2>>,
     pub hatching: Vec<[DVec2; 2]>,
     /// The view's projection onto the sheet's pixels and, for a section, what it cuts away: what
@@ -672,7 +678,20 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
     if options.section.is_some() {
         kinds.push(ViewKind::Section);
     }
-    let cut = options.section.as_ref().map(|plane| section::cut(model, plane));
+    // Parts drawn whole in the section view, by name.
+    let mut uncut: Vec<u32> = model
+        .parts
+        .iter()
+        .filter(|p| options.uncut.iter().any(|pattern| matches_pattern(pattern, &p.name)))
+        .map(|p| p.id)
+        .collect();
+    uncut.sort_unstable();
+    uncut.dedup();
+    let cut = options.section.as_ref().map(|plane| {
+        let mut cut = section::cut(model, plane);
+        cut.faces.retain(|f| f.part.is_none_or(|p| uncut.binary_search(&p).is_err()));
+        cut
+    });
     let layout = Layout::new(&kinds, options.angle, front, up, &points, options.section.as_ref());
     let fit = |scale: Scale| layout.place(scale.ratio() * options.mm_per_unit, &border, &title_block);
     let (scale, rects) = match options.scale {
@@ -706,8 +725,13 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
             let origin = DVec2::new(rect.min.x - s * lo.x, rect.min.y + s * hi.y);
             let projection = view_projection(model, frame, origin, s, (lo.z, hi.z), (w, h));
             let to_sheet = |p: DVec3| origin + s * DVec2::new(frame.right.dot(p), -frame.up.dot(p));
-            let (mut cut_outlines, mut hatching, mut clip) = (Vec::new(), Vec::new(), None);
+            let (mut cut_outlines, mut hatching, mut cut_loops, mut clip) = (Vec::new(), Vec::new(), Vec::new(), None);
             if let (ViewKind::Section, Some(plane), Some(cut)) = (kind, &options.section, &cut) {
+                let plane_closeness =
+                    projection.screen_and_closeness(plane.normal * plane.offset).map_or(0.0, |(_, c)| c);
+                // The uncut parts in front of the plane hide the cut faces' lines behind them.
+                let front = uncut_in_front(model, plane, &uncut, &projection);
+                let visible = |a: DVec2, b: DVec2| visible_pieces(front.as_ref(), plane_closeness, a, b);
                 let mut loops_px = Vec::new();
                 for (k, face) in cut.faces.iter().enumerate() {
                     let loops: Vec<Vec<DVec2>> =
@@ -716,13 +740,19 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
                     let part = face.part.map_or(k, |p| p as usize);
                     let angle = if part % 2 == 0 { 45.0 } else { 135.0 };
                     let spacing = [2.0, 3.0, 2.5][(part / 2) % 3];
-                    hatching.extend(section::hatch(&loops, angle, spacing));
+                    for [a, b] in section::hatch(&loops, angle, spacing) {
+                        hatching.extend(visible(a, b));
+                    }
                     for ring in &loops {
                         loops_px.push(ring.iter().map(|p| *p / MM_PER_PX).collect());
-                        cut_outlines.push(ring.iter().chain(ring.first()).copied().collect());
+                        for (i, a) in ring.iter().enumerate() {
+                            cut_outlines
+                                .extend(visible(*a, ring[(i + 1) % ring.len()]).into_iter().map(|[a, b]| vec![a, b]));
+                        }
                     }
+                    cut_loops.extend(loops);
                 }
-                clip = Some(section::Clip { plane: *plane, cut: loops_px });
+                clip = Some(section::Clip { plane: *plane, cut: loops_px, uncut: uncut.clone(), plane_closeness });
             }
             let mut drawing = crate::draw_clipped(model, &view_options, projection, clip.as_ref());
             for stroke in &mut drawing.strokes {
@@ -732,6 +762,7 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
             }
             PlacedView {
                 kind,
+                cut_loops,
                 frame,
                 rect: *rect,
                 origin,
@@ -760,6 +791,71 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
     };
     sheet.frame = frame_lines(&sheet);
     Ok(sheet)
+}
+
+/// Whether `name` matches `pattern`: `*` any run of characters, case ignored.
+fn matches_pattern(pattern: &str, name: &str) -> bool {
+    let (pattern, name) = (pattern.to_lowercase(), name.to_lowercase());
+    let pieces: Vec<&str> = pattern.split('*').collect();
+    if pieces.len() == 1 {
+        return pattern == name;
+    }
+    let (first, last) = (pieces[0], pieces[pieces.len() - 1]);
+    if name.len() < first.len() + last.len() || !name.starts_with(first) || !name.ends_with(last) {
+        return false;
+    }
+    let mut rest = &name[first.len()..name.len() - last.len()];
+    for piece in &pieces[1..pieces.len() - 1] {
+        match rest.find(piece) {
+            Some(at) => rest = &rest[at + piece.len()..],
+            None => return false,
+        }
+    }
+    true
+}
+
+/// The occluders the uncut parts put in front of a section's plane (their triangles' parts above
+/// it), or `None` when there are none.
+fn uncut_in_front(
+    model: &Model,
+    plane: &section::Plane,
+    uncut: &[u32],
+    projection: &Projection,
+) -> Option<crate::Occluders> {
+    if uncut.is_empty() {
+        return None;
+    }
+    let above = section::Plane { normal: -plane.normal, offset: -plane.offset };
+    let all = crate::world_triangles(model);
+    let mut corners = Vec::new();
+    for (t, part) in all.corners.iter().zip(&all.parts) {
+        if part.is_some_and(|p| uncut.binary_search(&p).is_ok()) {
+            let polygon = section::below(&above, t);
+            for i in 1..polygon.len().saturating_sub(1) {
+                corners.push([polygon[0], polygon[i], polygon[i + 1]]);
+            }
+        }
+    }
+    let parts = vec![None; corners.len()];
+    Some(crate::Occluders::new(&crate::Triangles { corners, parts }, projection))
+}
+
+/// The pieces of the sheet segment `a → b` (millimetres, on the section's plane, of closeness `c`)
+/// that `occluders` leave visible.
+fn visible_pieces(occluders: Option<&crate::Occluders>, c: f64, a: DVec2, b: DVec2) -> Vec<[DVec2; 2]> {
+    let hidden = occluders.map_or_else(Vec::new, |o| {
+        let at = |p: DVec2| crate::Projected { x: p.x / MM_PER_PX, y: p.y / MM_PER_PX, c };
+        o.hidden(at(a), at(b), &mut 0)
+    });
+    let mut pieces = Vec::new();
+    let mut from = 0.0;
+    for (lo, hi) in hidden.into_iter().chain([(1.0, 1.0)]) {
+        if lo > from {
+            pieces.push([a + (b - a) * from, a + (b - a) * lo]);
+        }
+        from = f64::max(from, hi);
+    }
+    pieces
 }
 
 /// The section view's axes: looking down the plane's normal from above it, the model's up (or,

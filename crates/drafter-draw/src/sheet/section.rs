@@ -260,6 +260,11 @@ pub struct Clip {
     pub plane: Plane,
     /// The cut faces' loops on the screen (the view's pixels).
     pub cut: Vec<Vec<DVec2>>,
+    /// Parts drawn whole, not cut (ISO 128-50: shafts, bolts, pins, keys), sorted.
+    pub uncut: Vec<u32>,
+    /// The plane's closeness in the view (it lies across the view direction): the cut faces hide
+    /// only what lies behind it.
+    pub plane_closeness: f64,
 }
 
 impl Default for Plane {
@@ -269,22 +274,32 @@ impl Default for Plane {
 }
 
 impl Clip {
-    /// Cuts `triangles` and `edges` to what lies below the plane (on it counts as below).
-    pub(crate) fn keep_below(&self, triangles: &mut Vec<[DVec3; 3]>, edges: &mut Vec<crate::Edge>) {
+    fn is_uncut(&self, part: Option<u32>) -> bool {
+        part.is_some_and(|p| self.uncut.binary_search(&p).is_ok())
+    }
+
+    /// Cuts `triangles` and `edges` to what lies below the plane (on it counts as below), but for
+    /// the uncut parts'.
+    pub(crate) fn keep_below(&self, triangles: &mut crate::Triangles, edges: &mut Vec<crate::Edge>) {
         let s = |p: DVec3| self.plane.distance(p);
-        let mut kept = Vec::with_capacity(triangles.len());
-        for t in triangles.iter() {
-            if t.iter().all(|p| s(*p) <= 0.0) {
+        let (mut kept, mut parts) = (Vec::with_capacity(triangles.corners.len()), Vec::new());
+        for (t, &part) in triangles.corners.iter().zip(&triangles.parts) {
+            if self.is_uncut(part) || t.iter().all(|p| s(*p) <= 0.0) {
                 kept.push(*t);
+                parts.push(part);
                 continue;
             }
             let polygon = self.below(t);
             for i in 1..polygon.len().saturating_sub(1) {
                 kept.push([polygon[0], polygon[i], polygon[i + 1]]);
+                parts.push(part);
             }
         }
-        *triangles = kept;
+        (triangles.corners, triangles.parts) = (kept, parts);
         edges.retain_mut(|e| {
+            if self.is_uncut(e.part) {
+                return true;
+            }
             let (sa, sb) = (s(e.a), s(e.b));
             match (sa <= 0.0, sb <= 0.0) {
                 (true, true) => true,
@@ -333,10 +348,20 @@ impl Clip {
             return hidden;
         }
         cuts.sort_by(f64::total_cmp);
+        // Only behind the plane (an uncut part's edge may lie in front of it): where the
+        // closeness, affine along the segment, is below the plane's.
+        let limit = self.plane_closeness - 1e-9 * self.plane_closeness.abs();
+        let (behind_from, behind_to) = match (a.c < limit, b.c < limit) {
+            (true, true) => (0.0, 1.0),
+            (false, false) => return hidden,
+            (true, false) => (0.0, (limit - a.c) / (b.c - a.c)),
+            (false, true) => ((limit - a.c) / (b.c - a.c), 1.0),
+        };
         let mut intervals = hidden;
         for w in cuts.windows(2) {
-            if w[1] > w[0] && inside(&self.cut, pa + d * (0.5 * (w[0] + w[1]))) {
-                intervals.push((w[0], w[1]));
+            let (lo, hi) = (w[0].max(behind_from), w[1].min(behind_to));
+            if hi > lo && inside(&self.cut, pa + d * (0.5 * (w[0] + w[1]))) {
+                intervals.push((lo, hi));
             }
         }
         crate::union(&mut intervals)
