@@ -367,7 +367,10 @@ fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Ed
                                 object_from_world.transform_vector3(direction)
                             }
                         };
-                        if normals[0].dot(towards) * normals[1].dot(towards) < 0.0 {
+                        // As the candidates below: a face exactly edge-on counts as facing away
+                        // (a slot's wall seen edge-on, tangent to its round end: the border is the
+                        // end's outline).
+                        if (normals[0].dot(towards) > 0.0) != (normals[1].dot(towards) > 0.0) {
                             LineClass::Silhouette
                         } else {
                             class
