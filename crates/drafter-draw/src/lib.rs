@@ -367,14 +367,16 @@ fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Ed
                                 object_from_world.transform_vector3(direction)
                             }
                         };
-                        // As the candidates below: a face exactly edge-on counts as facing away
-                        // (a slot's wall seen edge-on, tangent to its round end: the border is the
-                        // end's outline).
-                        if (normals[0].dot(towards) > 0.0) != (normals[1].dot(towards) > 0.0) {
-                            LineClass::Silhouette
-                        } else {
-                            class
-                        }
+                        // Faces turned opposite ways, or one face exactly edge-on beside one that
+                        // is not: a face seen edge-on is seen as a line, and both its borders lie
+                        // on the contour (a slot's wall seen edge-on, tangent to its round end).
+                        // Edge-on within the rounding of the camera's f32 matrix (the view
+                        // direction comes out of it about 1e-7 off an axis).
+                        let towards = towards.normalize_or_zero();
+                        let (s0, s1) = (normals[0].dot(towards), normals[1].dot(towards));
+                        let lengths = (normals[0].length(), normals[1].length());
+                        let (e0, e1) = (s0.abs() <= EDGE_ON * lengths.0, s1.abs() <= EDGE_ON * lengths.1);
+                        if (s0 * s1 < 0.0 && !e0 && !e1) || e0 != e1 { LineClass::Silhouette } else { class }
                     }
                     (class, _) => class,
                 };
@@ -431,6 +433,10 @@ fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Ed
     }
     (edges, silhouettes)
 }
+
+/// A face whose unit normal is within this of perpendicular to the view is seen edge-on (for a
+/// crease or tangent edge on the contour, [`view_edges`]).
+const EDGE_ON: f64 = 1e-6;
 
 /// Closeness tolerance: a triangle hides a point when closer by more than this share of the
 /// point's closeness. 1e-7 let a part's face touching another's silhouette within a few `f32`

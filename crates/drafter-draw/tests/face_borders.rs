@@ -260,3 +260,33 @@ fn tangent_edges_are_the_primitive_borders_and_draw_as_smooth_says() {
     assert!(drawing::draw(&plain, &options(view, Smooth::Thin)).strokes.iter().all(|s| s.class != LineClass::Tangent));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_tangent_edge_beside_a_face_seen_edge_on_is_the_outline() {
+    // Seen from +x at elevation exactly 0 the top face y = H is edge-on and the fillet's last
+    // facet faces the viewer: their border is the block's top outline, drawn as a silhouette even
+    // with `--smooth none` (a face seen edge-on is a line, both its borders on the contour).
+    // Without the rule the border stayed a tangent edge and the outline was left out with it (the
+    // plate's slot against OpenCascade, issue 58).
+    let dir = std::env::temp_dir().join(format!("drafter-face-borders-edge-on-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    let model = common::baked(&write_gltf(&dir));
+    let view = (90.0, 0.0);
+    let projection = Projection::new(&model, &options(view, Smooth::None));
+    let drawn = drawing::draw(&model, &options(view, Smooth::None));
+    let line = (W - R, H);
+    // The silhouette strokes' segments lying on the border (a stroke runs on around the block).
+    let outline: f64 = drawn
+        .strokes
+        .iter()
+        .filter(|s| s.class == LineClass::Silhouette && s.visible)
+        .flat_map(|s| s.points.windows(2))
+        .filter(|w| w.iter().all(|&p| distance_to(&projection, p, line) < 0.01))
+        .map(|w| w[0].distance(w[1]))
+        .sum();
+    let ends = [0.0, f64::from(L)]
+        .map(|z| projection.to_screen(DVec3::new(f64::from(line.0), f64::from(line.1), z)).expect("in front"));
+    let full = ends[0].distance(ends[1]);
+    assert!((outline - full).abs() < 0.1, "{view:?}: {outline} px of silhouette along the {full} px border");
+    std::fs::remove_dir_all(&dir).ok();
+}
