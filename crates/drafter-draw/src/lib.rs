@@ -954,17 +954,9 @@ fn svg_dashes(dash: Option<[style::Length; 2]>) -> String {
 /// millimetres at 72/25.4 pt each, y turned up as PDF wants it. Hidden lines first, then each
 /// visible class, silhouettes last, as in the SVG.
 pub fn to_pdf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
-    use pdf_writer::{Content, Finish, Pdf, Rect, Ref};
+    use pdf_writer::Content;
     const POINTS_PER_PIXEL: f32 = 0.75;
-    let (catalog, tree, page, content_id) = (Ref::new(1), Ref::new(2), Ref::new(3), Ref::new(4));
     let (w, h) = (drawing.width as f32 * POINTS_PER_PIXEL, drawing.height as f32 * POINTS_PER_PIXEL);
-    let mut pdf = Pdf::new();
-    pdf.catalog(catalog).pages(tree);
-    pdf.pages(tree).kids([page]).count(1);
-    let mut p = pdf.page(page);
-    p.media_box(Rect::new(0.0, 0.0, w, h)).parent(tree).contents(content_id);
-    p.resources();
-    p.finish();
     let mut content = Content::new();
     // Fills as in the SVG: each region filled and stroked with its grey, half a pixel wide.
     content.set_line_width(0.5 * POINTS_PER_PIXEL);
@@ -1016,6 +1008,24 @@ pub fn to_pdf(drawing: &Drawing, hidden: Hidden, style: LineStyle) -> Vec<u8> {
                 content.stroke();
             }
         }
+    }
+    one_page_pdf((w, h), None, content)
+}
+
+/// A PDF of one page `size` points large drawn by `content`, with `title` in the document's
+/// information: the frame of [`to_pdf`] and of a sheet's PDF ([`sheet`]).
+pub(crate) fn one_page_pdf(size: (f32, f32), title: Option<&str>, content: pdf_writer::Content) -> Vec<u8> {
+    use pdf_writer::{Finish, Pdf, Rect, Ref, TextStr};
+    let (catalog, tree, page, content_id, info) = (Ref::new(1), Ref::new(2), Ref::new(3), Ref::new(4), Ref::new(5));
+    let mut pdf = Pdf::new();
+    pdf.catalog(catalog).pages(tree);
+    pdf.pages(tree).kids([page]).count(1);
+    let mut p = pdf.page(page);
+    p.media_box(Rect::new(0.0, 0.0, size.0, size.1)).parent(tree).contents(content_id);
+    p.resources();
+    p.finish();
+    if let Some(title) = title {
+        pdf.document_info(info).title(TextStr(title));
     }
     pdf.stream(content_id, &content.finish());
     pdf.finish()

@@ -152,18 +152,9 @@ const PT_PER_MM: f32 = 72.0 / 25.4;
 /// The sheet as a one-page PDF (pdf-writer) the size of the sheet: the views' strokes with the
 /// same pens and order as [`to_svg`], then the frame; the title in the document's information.
 pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
+    use pdf_writer::Content;
     use pdf_writer::types::{LineCapStyle, LineJoinStyle};
-    use pdf_writer::{Content, Finish, Pdf, Rect, Ref, TextStr};
-    let (catalog, tree, page, content_id, info) = (Ref::new(1), Ref::new(2), Ref::new(3), Ref::new(4), Ref::new(5));
     let (w, h) = (sheet.mm.0 as f32 * PT_PER_MM, sheet.mm.1 as f32 * PT_PER_MM);
-    let mut pdf = Pdf::new();
-    pdf.catalog(catalog).pages(tree);
-    pdf.pages(tree).kids([page]).count(1);
-    let mut p = pdf.page(page);
-    p.media_box(Rect::new(0.0, 0.0, w, h)).parent(tree).contents(content_id);
-    p.resources();
-    p.finish();
-    pdf.document_info(info).title(TextStr(&sheet.title));
     let mut content = Content::new();
     content.set_line_cap(LineCapStyle::RoundCap);
     content.set_line_join(LineJoinStyle::RoundJoin);
@@ -221,8 +212,7 @@ pub fn to_pdf(sheet: &Sheet, style: LineStyle) -> Vec<u8> {
         path(&mut content, points);
         content.stroke();
     }
-    pdf.stream(content_id, &content.finish());
-    pdf.finish()
+    crate::one_page_pdf((w, h), Some(&sheet.title), content)
 }
 
 /// The sheet as DXF R2000 through [`crate::dxf::to_dxf_with`]: the views' strokes on the layers
