@@ -233,11 +233,8 @@ impl ModelLines {
             let silhouettes =
                 baked.mesh_silhouettes.iter().find(|(mm, _)| *mm as usize == m).and_then(|(_, s)| match hierarchies {
                     Hierarchies::AtLoad => load_silhouettes(m, s, &position, &mut notices),
-                    Hierarchies::Deferred => load_silhouettes_deferred(m, s, &position, &mut notices),
-                    Hierarchies::Never => load_silhouettes_deferred(m, s, &position, &mut notices).map(|mut lines| {
-                        lines.pending = None;
-                        lines
-                    }),
+                    Hierarchies::Deferred => load_silhouettes_deferred(m, s, &position, &mut notices, true),
+                    Hierarchies::Never => load_silhouettes_deferred(m, s, &position, &mut notices, false),
                 });
             if hard.is_empty() && silhouettes.is_none() {
                 continue;
@@ -357,25 +354,30 @@ impl ModelLines {
 }
 
 /// [`load_silhouettes`] without the hierarchies: the candidates by brute force, in the file's
-/// order, and the stored hierarchies kept for [`ModelLines::complete_hierarchies`].
+/// order, and (`keep`) the stored hierarchies kept for [`ModelLines::complete_hierarchies`].
 fn load_silhouettes_deferred(
     m: usize,
     s: &MeshSilhouettes,
     position: &dyn Fn(usize, usize) -> Option<Vec3>,
     notices: &mut Vec<String>,
+    keep: bool,
 ) -> Option<MeshSilhouetteLines> {
     if s.gauss_map.is_none() && s.cone_bvh.is_none() {
         return load_silhouettes(m, s, position, notices);
     }
+    // The candidates alone (the stored hierarchies are not copied for them).
     let candidates = MeshSilhouettes {
-        gauss_map: None,
-        cone_bvh: None,
+        candidate_corners: s.candidate_corners.clone(),
+        candidate_normals: s.candidate_normals.clone(),
         orthographic: drafter_format::OrthographicHierarchy::BruteForce,
         perspective: drafter_format::PerspectiveHierarchy::BruteForce,
-        ..s.clone()
+        gauss_map: None,
+        cone_bvh: None,
     };
     let mut lines = load_silhouettes(m, &candidates, position, notices)?;
-    lines.pending = Some(Box::new(s.clone()));
+    if keep {
+        lines.pending = Some(Box::new(s.clone()));
+    }
     Some(lines)
 }
 
