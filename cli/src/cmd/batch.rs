@@ -84,13 +84,7 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
 
     drafter_catalog::interrupt::set_graceful(true);
     let stop = || drafter_catalog::interrupt::stop_requested().is_some();
-    let shown = if args.quiet {
-        Shown::Nothing
-    } else if std::io::stderr().is_terminal() {
-        Shown::Bar
-    } else {
-        Shown::Lines
-    };
+    let shown = Shown::choose(args.quiet);
     let bar = Bar::new(shown, items);
     let summary = batch::run_discovered(&found, &out_dir, &options, &stop, &bar);
     bar.finish();
@@ -172,7 +166,7 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
 
 /// How a batch shows its progress.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Shown {
+pub(crate) enum Shown {
     /// `--quiet`.
     Nothing,
     /// A progress bar, on a terminal.
@@ -182,9 +176,22 @@ enum Shown {
     Lines,
 }
 
+impl Shown {
+    /// Nothing with `--quiet`, a bar on a terminal, lines elsewhere.
+    pub(crate) fn choose(quiet: bool) -> Shown {
+        if quiet {
+            Shown::Nothing
+        } else if std::io::stderr().is_terminal() {
+            Shown::Bar
+        } else {
+            Shown::Lines
+        }
+    }
+}
+
 /// The batch's progress: on a terminal a bar (files done of all, input bytes done of all, the
 /// ETA, the files being baked); on a pipe a line per file with its notes.
-struct Bar {
+pub(crate) struct Bar {
     bar: Option<indicatif::ProgressBar>,
     lines: bool,
     files: usize,
@@ -192,7 +199,7 @@ struct Bar {
 }
 
 impl Bar {
-    fn new(shown: Shown, items: &[Item]) -> Self {
+    pub(crate) fn new(shown: Shown, items: &[Item]) -> Self {
         let bar = (shown == Shown::Bar).then(|| {
             let bar = indicatif::ProgressBar::new(0);
             let style = indicatif::ProgressStyle::with_template(
@@ -214,7 +221,7 @@ impl Bar {
         }
     }
 
-    fn finish(&self) {
+    pub(crate) fn finish(&self) {
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
@@ -225,11 +232,13 @@ fn name(item: &Item) -> String {
     item.relative_output.with_extension("").display().to_string()
 }
 
-/// A finished file's line on a pipe: `[3/47] gear: baked 1.20 s`, `cached (up to date)`, or
+/// A finished file's line on a pipe: `[3/47] gear: baked 1.20 s` (`drawn` in a catalog of drawings),
+/// `cached (up to date)`, or
 /// `FAILED: why`.
 fn line(done: usize, files: usize, item: &Item, record: &Record) -> String {
     let what = match record.status {
         Status::Baked => format!("baked {:.2} s", record.ms / 1e3),
+        Status::Drawn => format!("drawn {:.2} s", record.ms / 1e3),
         Status::Cached if record.up_to_date => "cached (up to date)".to_owned(),
         Status::Cached => format!("cached {:.2} s", record.ms / 1e3),
         Status::Failed => format!("FAILED: {}", record.error.as_deref().unwrap_or("")),

@@ -31,6 +31,8 @@ use crate::job::{self, Error};
 #[serde(rename_all = "lowercase")]
 pub enum Status {
     Baked,
+    /// Drawn (a catalog of drawings, [`crate::draw`]).
+    Drawn,
     /// Written from the cache.
     Cached,
     Failed,
@@ -85,10 +87,14 @@ pub struct Record {
     /// The file's estimated peak was over the whole memory budget: it ran alone.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub over_budget: bool,
+    /// Every file written for this input when there are several (a drawing in more than one
+    /// format); `output` is the first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<String>,
 }
 
 impl Record {
-    fn new(input: &Path, output: &Path) -> Self {
+    pub(crate) fn new(input: &Path, output: &Path) -> Self {
         Record {
             input: input.display().to_string(),
             output: output.display().to_string(),
@@ -104,10 +110,11 @@ impl Record {
             warning: None,
             notes: Vec::new(),
             over_budget: false,
+            outputs: Vec::new(),
         }
     }
 
-    fn fail(&mut self, e: &Error) {
+    pub(crate) fn fail(&mut self, e: &Error) {
         self.status = Status::Failed;
         self.error = Some(e.to_string().replace('\n', " "));
         self.exit_code = Some(e.exit_code());
@@ -405,6 +412,9 @@ impl Observer for Quiet {}
 pub struct Summary {
     pub files: Vec<Record>,
     pub baked: usize,
+    /// A catalog of drawings ([`crate::draw::run`]): the files drawn (none is baked: `baked` is 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drawn: Option<usize>,
     pub cached: usize,
     pub failed: usize,
     pub skipped: usize,
@@ -432,6 +442,12 @@ pub fn run_discovered(
     observer: &dyn Observer,
 ) -> Summary {
     let mut summary = run(&found.items, out_dir, options, stop, observer);
+    add_unreadable(&mut summary, found, out_dir);
+    summary
+}
+
+/// Each folder of `found` that could not be listed, as one more failed file of `summary`.
+pub(crate) fn add_unreadable(summary: &mut Summary, found: &crate::discover::Discovered, out_dir: &Path) {
     for (folder, why) in &found.unreadable {
         let mut record = Record::new(folder, out_dir);
         record.fail(&Error::Io(format!("{}: cannot list: {why}", folder.display())));
@@ -439,7 +455,6 @@ pub fn run_discovered(
         summary.files.push(record);
         summary.failed += 1;
     }
-    summary
 }
 
 /// Bakes `items` into `out_dir`, `options.workers` files at a time under the memory budget.
@@ -450,18 +465,61 @@ pub fn run(
     stop: &(dyn Fn() -> bool + Sync),
     observer: &dyn Observer,
 ) -> Summary {
+    let bake: &Job<'_> = &|item, admit| {
+        // Every output is named below `out_dir` through `output::confined`, which refuses `..`,
+        // absolute parts and symbolic links on the way: no caller of the batch can write outside it.
+        match crate::output::confined(out_dir, &item.relative_output) {
+            Err(e) => {
+                let mut record = Record::new(&item.input, &out_dir.join(&item.relative_output));
+                record.fail(&e);
+                record
+            }
+            Ok(output) => {
+                bake_file(&item.input, &output, &options.config, &options.limits, options.cache.as_ref(), admit)
+            }
+        }
+    };
+    let scheduling = Scheduling { memory_budget: options.memory_budget, workers: options.workers };
+    let mut summary = run_jobs(items, out_dir, &scheduling, stop, observer, bake);
+    summary.config = crate::cache::canonical_config(&options.config);
+    summary
+}
+
+/// How a batch's files are run side by side, whatever each one's job.
+#[derive(Clone, Copy, Debug)]
+pub struct Scheduling {
+    /// Bytes of estimated peak memory the running files may reserve together.
+    pub memory_budget: u64,
+    /// Files run at once, at most.
+    pub workers: usize,
+}
+
+/// One file's job in a batch: `admit` asks the memory budget for room (`None`: the batch was
+/// stopped while it waited, and the file is skipped).
+pub type Job<'j> = dyn for<'b> Fn(&Item, &dyn Fn(u64) -> Option<Permit<'b>>) -> Record + Sync + 'j;
+
+/// Runs `job` over `items` (a bake, a drawing), `scheduling.workers` files at a time under the
+/// memory budget, largest first; the summary's `config` is left for the caller to fill.
+pub fn run_jobs(
+    items: &[Item],
+    out_dir: &Path,
+    scheduling: &Scheduling,
+    stop: &(dyn Fn() -> bool + Sync),
+    observer: &dyn Observer,
+    job: &Job<'_>,
+) -> Summary {
     let started = Instant::now();
     let sizes: Vec<u64> = items.iter().map(|i| input_size(&i.input)).collect();
     // Largest first; ties in the given order.
     let mut order: Vec<usize> = (0..items.len()).collect();
     order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
     observer.begin(items.len(), sizes.iter().sum());
-    let budget = Budget::new(options.memory_budget.max(1));
+    let budget = Budget::new(scheduling.memory_budget.max(1));
     let next = AtomicUsize::new(0);
     let records: Vec<Mutex<Option<Record>>> = items.iter().map(|_| Mutex::new(None)).collect();
-    // A folder no file can be written in fails every file at once, before any bake.
+    // A folder no file can be written in fails every file at once, before any work.
     let unwritable = crate::output::check_writable(out_dir).err();
-    let workers = options.workers.clamp(1, items.len().max(1));
+    let workers = scheduling.workers.clamp(1, items.len().max(1));
     let work = || {
         loop {
             let k = next.fetch_add(1, Ordering::SeqCst);
@@ -476,24 +534,7 @@ pub fn run(
                 record
             } else {
                 observer.started(item, sizes[index]);
-                // Every output is named below `out_dir` through `output::confined`, which refuses
-                // `..`, absolute parts and symbolic links on the way: no caller of the batch can
-                // write outside it.
-                let record = match crate::output::confined(out_dir, &item.relative_output) {
-                    Err(e) => {
-                        let mut record = Record::new(&item.input, &output);
-                        record.fail(&e);
-                        record
-                    }
-                    Ok(output) => bake_file(
-                        &item.input,
-                        &output,
-                        &options.config,
-                        &options.limits,
-                        options.cache.as_ref(),
-                        &|bytes| budget.admit(bytes, stop),
-                    ),
-                };
+                let record = job(item, &|bytes| budget.admit(bytes, stop));
                 observer.finished(item, sizes[index], &record);
                 record
             };
@@ -530,23 +571,24 @@ pub fn run(
     let count = |s: Status| files.iter().filter(|r| r.status == s).count();
     Summary {
         baked: count(Status::Baked),
+        drawn: None,
         cached: count(Status::Cached),
         failed: count(Status::Failed),
         skipped: count(Status::Skipped),
         wall_ms: started.elapsed().as_secs_f64() * 1e3,
         bytes_total: sizes.iter().sum(),
-        memory_budget: options.memory_budget,
+        memory_budget: scheduling.memory_budget,
         peak_admitted_bytes: budget.peak(),
         workers,
         over_budget: files.iter().filter(|r| r.over_budget).count(),
         build: crate::cache::BUILD_ID.to_owned(),
-        config: crate::cache::canonical_config(&options.config),
+        config: serde_json::Value::Null,
         files,
     }
 }
 
 /// A file's size for ordering and progress: a .gltf's own bytes plus the external buffers it names.
-fn input_size(path: &Path) -> u64 {
+pub(crate) fn input_size(path: &Path) -> u64 {
     let own = std::fs::metadata(path).map_or(0, |m| m.len());
     let is_gltf = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
     if !is_gltf || own > 64 << 20 {

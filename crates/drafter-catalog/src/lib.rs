@@ -8,15 +8,18 @@
 //! - [`estimate`]: a bake's peak memory from the triangles a file lists, before any is read;
 //! - [`batch`]: files side by side under a memory budget, one file's bake through the cache
 //!   ([`batch::bake_file`]), and the batch report;
+//! - [`draw`]: one file's drawing as a catalog, `drafter draw --cache` and Python run it, its
+//!   options as one plain value, its cache key, and a catalog of drawings over the batch's scheduler;
 //! - [`output`]: atomic writes; [`interrupt`]: what a signal does to them;
 //! - [`inspect`]: what `drafter inspect` reports of a file.
 //!
-//! The CLI (`cli/src/cmd/bake.rs`, `batch.rs`, `cache.rs`) and the Python package (`python/`) are
+//! The CLI (`cli/src/cmd/bake.rs`, `batch.rs`, `cache.rs`, `draw_batch.rs`) and the Python package (`python/`) are
 //! thin layers over this crate.
 
 pub mod batch;
 pub mod cache;
 pub mod discover;
+pub mod draw;
 pub mod estimate;
 pub mod inspect;
 pub mod interrupt;
