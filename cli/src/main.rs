@@ -19,10 +19,10 @@ mod gpu_env;
     version,
     about = "Bake CAD assemblies and meshes into assets for technical illustration",
     after_help = "Exit codes: 0 success; 2 bad input (one line naming the file and the place); 3 a file could not be \
-                  read or written (disk full, permission); 4 some inputs of a batch failed (the others were baked, the \
-                  failures are listed); 1 internal error (a bug). Ctrl-C or SIGTERM during a bake exits with 130 or 143 \
-                  and leaves no partial file (a batch finishes the files it started first; a second signal exits at \
-                  once)."
+                  read or written (disk full, permission); 4 some inputs of a batch or a catalog of drawings failed \
+                  (the others were baked or drawn, the failures are listed); 1 internal error (a bug). Ctrl-C or \
+                  SIGTERM during a bake exits with 130 or 143 and leaves no partial file (a batch finishes the files \
+                  it started first; a second signal exits at once)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -39,7 +39,8 @@ enum Command {
     Inspect(cmd::inspect::Args),
     /// Render a model headless to PNG in an illustration style (gradient, cel, gooch, metal, ...).
     Render(cmd::render::Args),
-    /// Draw one view as vector lines (SVG): baked edges and silhouettes, hidden lines exact.
+    /// Draw one view, or a sheet of views (--sheet A3), as vector lines (SVG, PDF, DXF): baked edges
+    /// and silhouettes, hidden lines exact. Several inputs or a folder draw a catalog into -o DIR.
     Draw(cmd::draw::Args),
     /// Measure: `bench FILE` charts every stage's speed against accuracy; `bench render FILE` prints
     /// frame time per style as a ratio to phong.

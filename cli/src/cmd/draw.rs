@@ -2,12 +2,15 @@
 //! [--style iso128|gooch] [--fill none|flat|bands] [--smooth none|thin|dashed] [--tolerance PX] [--json]`: a vector line drawing of one view with exact hidden lines
 //! (drafter-draw, which reads drafter-scene's model and links no GPU code): the baked hard edges and the view's silhouettes, split where they
 //! pass behind a surface, chained into polylines, grouped by visibility and class in SVG.
+//!
+//! Several inputs, a folder, a manifest or `--format` make a catalog: every input drawn into `-o
+//! DIR` (`draw_batch.rs`).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use drafter_draw::{self as drawing, DrawOptions, Fill, Hidden, LineStyle};
-use drafter_scene::{Hierarchies, LoadError, Model, View};
+use drafter_scene::{Model, View};
 
 use crate::cmd::out;
 use crate::cmd::render::{parse_size, parse_view};
@@ -15,12 +18,17 @@ use crate::exit::BadInput;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The model to draw: a baked .glb/.gltf (its edges and silhouette hierarchies), or any model
-    /// drafter reads (.glb/.gltf, .obj, .stl, .off, .ply), which is then baked in memory with the
-    /// default settings first, so it draws the lines its bake would.
-    pub file: PathBuf,
+    /// The models to draw: baked .glb/.gltf files (their edges and silhouette hierarchies), or any
+    /// model drafter reads (.glb/.gltf, .obj, .stl, .off, .ply), which is then baked in memory with
+    /// the default settings first, so it draws the lines its bake would; or folders of them
+    /// (recursively). More than one input, a folder, a manifest or --format make a catalog written
+    /// under `-o DIR`.
+    #[arg(value_name = "INPUT", required = true)]
+    pub inputs: Vec<PathBuf>,
     /// The drawing to write: .svg, .pdf (the same strokes on one page, a pixel as 0.75 pt) or .dxf
     /// (DXF R2000: a polyline per stroke on layers VISIBLE, HIDDEN and TANGENT, in millimetres, y up).
+    /// For a catalog: the output folder, where each input's drawing mirrors its relative path with
+    /// the extension of each --format.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Drawing size in pixels (the SVG's user units), WIDTHxHEIGHT: the same view as `render`. On
@@ -64,6 +72,15 @@ pub struct Args {
     pub max_triangles: u64,
     #[command(flatten)]
     pub sheet: crate::cmd::sheet::SheetArgs,
+    #[command(flatten)]
+    pub catalog: crate::cmd::draw_batch::CatalogArgs,
+}
+
+impl Args {
+    /// The one input of a single drawing.
+    pub fn file(&self) -> &Path {
+        &self.inputs[0]
+    }
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -132,33 +149,13 @@ impl From<HiddenArg> for Hidden {
     }
 }
 
-/// Reads the model to draw. A file without `DRAFTER_illustration` data has no baked edges: it is
-/// baked in memory first, through the one path from a file to its bake (drafter-catalog's
-/// `bake_bytes`, as `drafter bake` runs it, with the default settings), so it draws the lines its
-/// bake would. Import errors keep their exit code; a file that loads but cannot be drawn is bad
-/// input.
+/// Reads the model to draw (`drafter_catalog::draw::load`: a file without `DRAFTER_illustration`
+/// data is baked in memory with the default settings first, so it draws the lines its bake would).
+/// Import errors keep their exit code; a file that loads but cannot be drawn is bad input.
 pub(crate) fn load(path: &Path, max_triangles: u64) -> Result<(Model, bool)> {
     let limits = drafter_io::Limits { max_triangles };
     let bytes = drafter_catalog::job::read_input(path)?;
-    let bad = |e: LoadError| match e {
-        LoadError::Import(e) => anyhow::Error::from(e),
-        other => anyhow::Error::from(BadInput(other.to_string())),
-    };
-    if is_baked(path, &bytes) {
-        return Ok((Model::load_bytes_with(path, &bytes, &limits, Hierarchies::Never).map_err(bad)?, false));
-    }
-    let config = drafter_bake::BakeConfig::default();
-    let baked = drafter_catalog::job::bake_bytes(path, bytes, &config, &limits, &mut |_| {})?;
-    // The default container is one self-contained .glb, named as `drafter bake` would name it.
-    let name = path.with_extension("baked.glb");
-    Ok((Model::load_bytes_with(&name, &baked.written.main, &limits, Hierarchies::Never).map_err(bad)?, true))
-}
-
-/// Whether `bytes` carry `DRAFTER_illustration` data (a compressed GLB decoded first, as the model
-/// loader does). A file whose data does not read counts as baked: loading it reports why.
-fn is_baked(path: &Path, bytes: &[u8]) -> bool {
-    let plain = drafter_format::meshopt::decompress_glb(bytes).ok().flatten();
-    !matches!(drafter_format::read_if_baked(path, plain.as_deref().unwrap_or(bytes)), Ok(None))
+    Ok(drafter_catalog::draw::load(path, bytes, &limits)?)
 }
 
 /// What `-o` writes, by its extension.
@@ -169,6 +166,12 @@ enum Format {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if crate::cmd::draw_batch::is_catalog(&args) {
+        return crate::cmd::draw_batch::run(&args);
+    }
+    if args.catalog.cache.is_some() {
+        return crate::cmd::draw_batch::single(&args);
+    }
     if args.sheet.sheet.is_some() {
         return crate::cmd::sheet::run(args);
     }
@@ -207,7 +210,7 @@ pub fn run(args: Args) -> Result<()> {
     if args.output.is_dir() {
         return Err(BadInput(format!("{}: is a folder", args.output.display())).into());
     }
-    let (model, baked_here) = load(&args.file, args.max_triangles)?;
+    let (model, baked_here) = load(args.file(), args.max_triangles)?;
     let options = DrawOptions {
         size: args.size,
         view,
@@ -247,7 +250,7 @@ pub fn run(args: Args) -> Result<()> {
     if !args.quiet {
         eprintln!(
             "drew {} → {}: {} strokes, {:.0} px visible, {:.0} px hidden, from {} edges ({} silhouettes) over {} triangles in {:.0} ms; {} bytes",
-            args.file.display(),
+            args.file().display(),
             args.output.display(),
             drawing.strokes.len(),
             s.visible_px,
@@ -259,7 +262,10 @@ pub fn run(args: Args) -> Result<()> {
             bytes.len()
         );
         if baked_here {
-            eprintln!("  note: {} has no baked lines: baked in memory with the default settings", args.file.display());
+            eprintln!(
+                "  note: {} has no baked lines: baked in memory with the default settings",
+                args.file().display()
+            );
         }
         for notice in &model.notices {
             eprintln!("  note: {notice}");

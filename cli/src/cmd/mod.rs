@@ -8,6 +8,7 @@ pub mod bench_silhouettes;
 pub mod bench_sweep;
 pub mod cache;
 pub mod draw;
+pub mod draw_batch;
 pub mod inspect;
 pub mod render;
 pub mod sheet;

@@ -6,8 +6,9 @@
 use std::path::Path;
 
 use anyhow::Result;
-use drafter_draw::sheet::{self, Angle, Axis, Scale, SheetOptions, SheetSize, ViewKind};
-use drafter_draw::{DrawOptions, LineStyle};
+use drafter_catalog::draw::Plan;
+use drafter_draw::LineStyle;
+use drafter_draw::sheet::{self, SheetOptions, SheetSize};
 
 use crate::cmd::draw::Args;
 use crate::cmd::out;
@@ -82,73 +83,57 @@ pub enum UnitArg {
     In,
 }
 
-impl UnitArg {
-    fn mm(self) -> f64 {
-        match self {
-            UnitArg::M => 1000.0,
-            UnitArg::Cm => 10.0,
-            UnitArg::Mm => 1.0,
-            UnitArg::In => 25.4,
+impl From<ProjectionArg> for drafter_catalog::draw::Projection {
+    fn from(p: ProjectionArg) -> Self {
+        match p {
+            ProjectionArg::First => Self::First,
+            ProjectionArg::Third => Self::Third,
         }
     }
 }
 
-/// Millimetres per unit of `file`'s coordinates when `--units` does not say: glTF's are metres.
-fn default_mm_per_unit(file: &Path) -> f64 {
-    let extension = file.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match extension.as_deref() {
-        Some("gltf" | "glb") => 1000.0,
-        _ => 1.0,
+impl From<UnitArg> for drafter_catalog::draw::Units {
+    fn from(u: UnitArg) -> Self {
+        match u {
+            UnitArg::M => Self::M,
+            UnitArg::Cm => Self::Cm,
+            UnitArg::Mm => Self::Mm,
+            UnitArg::In => Self::In,
+        }
     }
 }
 
-/// The sheet's options from the command line, every mistake refused by name before any work.
+impl SheetArgs {
+    /// The sheet's options as drafter-catalog's plain value (what a catalog and Python draw with).
+    pub fn spec(&self) -> Option<drafter_catalog::draw::SheetSpec> {
+        let size = self.sheet.clone()?;
+        Some(drafter_catalog::draw::SheetSpec {
+            size,
+            views: vec![self.views.clone()],
+            projection: self.projection.into(),
+            scale: self.scale.clone(),
+            up: self.up.clone(),
+            front: self.front.clone(),
+            units: self.units.map(Into::into),
+            date: self.date.clone(),
+            title: self.title.clone(),
+            section: self.section.clone(),
+            uncut: self.uncut.as_deref().map(|list| list.split(',').map(str::to_string).collect()).unwrap_or_default(),
+        })
+    }
+}
+
+/// The sheet's options from the command line, every mistake refused by name before any work
+/// (`drafter_catalog::draw::DrawSpec::resolve`, as a catalog of sheets and Python resolve them).
 fn options(args: &Args) -> Result<(SheetOptions, SheetSize)> {
-    let s = &args.sheet;
-    let size: SheetSize = s.sheet.as_deref().unwrap_or("A3").parse().map_err(BadInput)?;
-    let views = ViewKind::parse_list(&s.views).map_err(BadInput)?;
-    let scale = s.scale.as_deref().map(str::parse::<Scale>).transpose().map_err(BadInput)?;
-    let axis = |flag: &str, text: &str| text.parse::<Axis>().map_err(|e| BadInput(format!("--{flag} {e}")));
-    let (up, front) = (axis("up", &s.up)?, axis("front", &s.front)?);
-    if up.vector().cross(front.vector()) == glam::DVec3::ZERO {
-        return Err(BadInput(format!("--up {} --front {}: must be two different axes", s.up, s.front)).into());
+    let spec = crate::cmd::draw_batch::spec(args);
+    match spec.resolve(args.file()).map_err(|e| BadInput(e.to_string()))?.plan {
+        Plan::Sheet(options) => {
+            let size = options.size;
+            Ok((*options, size))
+        }
+        Plan::View(_) => Err(BadInput("--sheet: no sheet size given".into()).into()),
     }
-    if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
-        return Err(
-            BadInput(format!("--tolerance {}: must be a finite number of pixels, 0 or more", args.tolerance)).into()
-        );
-    }
-    let title = s.title.clone().unwrap_or_else(|| {
-        let name = args.file.file_stem().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        name.strip_suffix(".baked").map(str::to_string).unwrap_or(name)
-    });
-    let options = SheetOptions {
-        size,
-        views,
-        angle: match s.projection {
-            ProjectionArg::First => Angle::First,
-            ProjectionArg::Third => Angle::Third,
-        },
-        scale,
-        front,
-        up,
-        mm_per_unit: s.units.map_or_else(|| default_mm_per_unit(&args.file), UnitArg::mm),
-        title,
-        date: s.date.clone(),
-        section: s.section.as_deref().map(sheet::section::Plane::parse).transpose().map_err(BadInput)?,
-        uncut: s
-            .uncut
-            .as_deref()
-            .map(|list| list.split(',').map(str::trim).filter(|p| !p.is_empty()).map(str::to_string).collect())
-            .unwrap_or_default(),
-        draw: DrawOptions {
-            hidden: args.hidden.into(),
-            tolerance_px: args.tolerance,
-            smooth: args.smooth.into(),
-            ..DrawOptions::default()
-        },
-    };
-    Ok((options, size))
 }
 
 /// `drafter draw … --sheet SIZE`.
@@ -171,7 +156,7 @@ pub fn run(args: Args) -> Result<()> {
         return Err(BadInput(format!("{}: is a folder", args.output.display())).into());
     }
     let start = std::time::Instant::now();
-    let (model, baked_here) = crate::cmd::draw::load(&args.file, args.max_triangles)?;
+    let (model, baked_here) = crate::cmd::draw::load(args.file(), args.max_triangles)?;
     let loaded = start.elapsed();
     let sheet = sheet::draw_sheet(&model, &options).map_err(|e| BadInput(e.to_string()))?;
     let drawn = start.elapsed() - loaded;
@@ -213,7 +198,7 @@ pub fn run(args: Args) -> Result<()> {
     if !args.quiet {
         eprintln!(
             "drew {} → {}: {} sheet at {}, {} views, {} strokes in {:.0} ms (loading {:.0} ms); {} bytes",
-            args.file.display(),
+            args.file().display(),
             args.output.display(),
             size.name(),
             sheet.scale,
@@ -230,7 +215,10 @@ pub fn run(args: Args) -> Result<()> {
             );
         }
         if baked_here {
-            eprintln!("  note: {} has no baked lines: baked in memory with the default settings", args.file.display());
+            eprintln!(
+                "  note: {} has no baked lines: baked in memory with the default settings",
+                args.file().display()
+            );
         }
         for notice in &model.notices {
             eprintln!("  note: {notice}");
