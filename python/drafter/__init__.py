@@ -9,12 +9,14 @@ drafter-catalog). Every call releases the GIL while it works, so Python threads 
     info = drafter.inspect(glb)                              # what ``drafter inspect --json`` prints
     record = drafter.bake_file("a.obj", "out/a.glb", cache="~/.cache/drafter")
     report = drafter.bake_many("models/", "baked/", cache="/shared/drafter-cache")
+    drafter.draw("gearbox.gltf", "gearbox.pdf", sheet="A3", projection="third", hidden="dashed")
+    report = drafter.draw_many("models/", "sheets/", format=["svg", "pdf"], sheet="A3", cache="/shared/drafter-cache")
 
 Errors raise :class:`InputError` (bad input or options: the CLI's exit code 2), :class:`IoError`
 (a file could not be read or written: 3; also an :class:`OSError`) or :class:`InternalError` (a
 bug: 1), all subclasses of :class:`DrafterError`. A number out of range (``threads=-1``) raises
-:class:`ValueError` before anything runs. ``bake_file`` and ``bake_many`` report a failed file in
-their records instead of raising.
+:class:`ValueError` before anything runs. ``bake_file``, ``bake_many`` and ``draw_many`` report a
+failed file in their records instead of raising.
 
 **Paths.** Wherever a list of paths is asked for (``bake_many``'s inputs and manifests,
 ``discover``), one ``str`` or ``os.PathLike`` is one path, never a sequence of characters.
@@ -50,6 +52,8 @@ __all__ = [
     "cache_evict",
     "cache_stats",
     "discover",
+    "draw",
+    "draw_many",
     "inspect",
 ]
 
@@ -236,6 +240,205 @@ def bake_many(
         _os.fspath(out_dir),
         manifests=_paths(manifests, "manifests"),
         **_config(config),
+        cache=_cache_path(cache),
+        cache_max=_count("cache_max", cache_max, 0),
+        memory=_count("memory", memory),
+        jobs=_count("jobs", jobs, 1, 1 << 16),
+        max_triangles=_count("max_triangles", max_triangles),
+        progress=on_finished,
+    )
+    report = _json.loads(report)
+    if error is not None:
+        error.report = report
+        raise error
+    return report
+
+
+_SHEET_OPTIONS = ("views", "projection", "scale", "up", "front", "units", "date", "title", "section", "uncut")
+
+
+def _names(value: _t.Union[str, _t.Iterable[str]], what: str) -> _t.List[str]:
+    """A list of names: one ``str`` (``"front,top"``, commas allowed) or an iterable of them."""
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, (bytes, bytearray)):
+        raise TypeError(f"{what}: give names as str, not bytes")
+    return [str(v) for v in value]
+
+
+def _pair(value: _t.Any, what: str, kind: type) -> _t.List[_t.Any]:
+    """Two numbers from a pair (``(800, 600)``) or ``"800x600"`` / ``"35,25"`` text."""
+    if isinstance(value, str):
+        parts = value.replace("x", ",").split(",")
+        value = [p.strip() for p in parts]
+    try:
+        first, second = value
+        return [kind(first), kind(second)]
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be two numbers, not {value!r}") from None
+
+
+def _draw_spec(options: _t.Mapping[str, _t.Any]) -> str:
+    """The drawing options as the JSON of drafter-catalog's ``DrawSpec`` (what ``drafter draw``'s
+    flags fill): only the options given, the CLI's defaults for the rest."""
+    spec: _t.Dict[str, _t.Any] = {}
+    for name in ("hidden", "smooth", "style", "fill"):
+        if options.get(name) is not None:
+            spec[name] = str(options[name]).lower()
+    if options.get("tolerance") is not None:
+        spec["tolerance_px"] = float(options["tolerance"])
+    if options.get("size") is not None:
+        spec["size"] = _pair(options["size"], "size", int)
+    if options.get("view") is not None:
+        spec["view"] = _pair(options["view"], "view", float)
+    if options.get("ortho") is not None:
+        spec["orthographic"] = bool(options["ortho"])
+    sheet = options.get("sheet")
+    given = [n for n in _SHEET_OPTIONS if options.get(n) is not None]
+    if sheet is None:
+        if given:
+            raise ValueError(f"{', '.join(given)}: options of a sheet; give sheet='A3' (or A4, A2, A1, A0)")
+    else:
+        for name in ("size", "view", "ortho", "fill"):
+            if options.get(name) is not None:
+                raise ValueError(f"{name}: an option of one view, which a sheet does not read")
+        table: _t.Dict[str, _t.Any] = {"size": str(sheet)}
+        for name in given:
+            value = options[name]
+            if name in ("views", "uncut"):
+                table[name] = _names(value, name)
+            elif name in ("projection", "units"):
+                table[name] = str(value).lower()
+            else:
+                table[name] = str(value)
+        spec["sheet"] = table
+    return _json.dumps(spec)
+
+
+def _raise_failed(record: dict) -> dict:
+    """``record`` if its file was drawn or written from the cache; else its error, raised as the
+    exception of its exit code."""
+    if record.get("status") != "failed":
+        return record
+    message = record.get("error") or record.get("input", "")
+    kind = {2: InputError, 3: IoError}.get(record.get("exit_code"), InternalError)
+    raise kind(message)
+
+
+def draw(
+    input: _PathLike,
+    output: _PathLike,
+    *,
+    sheet: _t.Optional[str] = None,
+    views: _t.Union[None, str, _t.Iterable[str]] = None,
+    projection: _t.Optional[str] = None,
+    scale: _t.Optional[str] = None,
+    up: _t.Optional[str] = None,
+    front: _t.Optional[str] = None,
+    units: _t.Optional[str] = None,
+    date: _t.Optional[str] = None,
+    title: _t.Optional[str] = None,
+    section: _t.Optional[str] = None,
+    uncut: _t.Union[None, str, _t.Iterable[str]] = None,
+    hidden: _t.Optional[str] = None,
+    smooth: _t.Optional[str] = None,
+    style: _t.Optional[str] = None,
+    tolerance: _t.Optional[float] = None,
+    size: _t.Any = None,
+    view: _t.Any = None,
+    ortho: _t.Optional[bool] = None,
+    fill: _t.Optional[str] = None,
+    cache: _t.Optional[_PathLike] = None,
+    cache_max: _t.Optional[int] = None,
+    threads: _t.Optional[int] = None,
+    max_triangles: _t.Optional[int] = None,
+) -> dict:
+    """``drafter draw INPUT -o OUTPUT [options]`` in this process: the same bytes. ``output`` ends
+    in ``.svg``, ``.pdf`` or ``.dxf``; a model without baked lines is baked in memory first.
+
+    One view (``size=(800, 600)``, ``view=(azimuth, elevation)`` in degrees, ``ortho``, ``fill``
+    ``"none"|"flat"|"bands"``), or with ``sheet="A3"`` (A4 to A0) the standard views on a drawing
+    sheet: ``views`` (``["front", "top", "right", "iso"]`` or ``"front,top"``), ``projection``
+    (``"first"``, ``"third"``), ``scale`` (``"1:2"``), ``up`` and ``front`` (``"y"``, ``"-z"``, ...),
+    ``units`` (``"m"``, ``"cm"``, ``"mm"``, ``"in"``), ``date``, ``title``, ``section``
+    (``"x=10"``), ``uncut`` (``["shaft*", "*bolt*"]``). Both: ``hidden``
+    (``"none"|"dashed"|"solid"``), ``smooth`` (``"none"|"thin"|"dashed"``), ``style``
+    (``"iso128"|"gooch"``), ``tolerance`` (pixels). Options left ``None`` take the CLI's defaults.
+
+    With ``cache`` (a folder), a drawing made before with the same input, options and build is
+    written from it. Returns the file's record (``status``: ``"drawn"`` or ``"cached"``, ``cache``,
+    ``ms``, ``bytes_out``, ``notes``, ...); a failure raises :class:`InputError`, :class:`IoError`
+    or :class:`InternalError`.
+    """
+    spec = _draw_spec(locals())
+    record = _drafter.draw_file(
+        _os.fspath(input),
+        _os.fspath(output),
+        spec_json=spec,
+        cache=_cache_path(cache),
+        cache_max=_count("cache_max", cache_max, 0),
+        threads=_count("threads", threads, 1, 1024),
+        max_triangles=_count("max_triangles", max_triangles),
+    )
+    return _raise_failed(_json.loads(record))
+
+
+def draw_many(
+    inputs: _t.Union[_PathLike, _t.Iterable[_PathLike]],
+    out_dir: _PathLike,
+    *,
+    format: _t.Union[str, _t.Iterable[str]] = "svg",
+    manifests: _t.Union[_PathLike, _t.Iterable[_PathLike]] = (),
+    sheet: _t.Optional[str] = None,
+    views: _t.Union[None, str, _t.Iterable[str]] = None,
+    projection: _t.Optional[str] = None,
+    scale: _t.Optional[str] = None,
+    up: _t.Optional[str] = None,
+    front: _t.Optional[str] = None,
+    units: _t.Optional[str] = None,
+    date: _t.Optional[str] = None,
+    title: _t.Optional[str] = None,
+    section: _t.Optional[str] = None,
+    uncut: _t.Union[None, str, _t.Iterable[str]] = None,
+    hidden: _t.Optional[str] = None,
+    smooth: _t.Optional[str] = None,
+    style: _t.Optional[str] = None,
+    tolerance: _t.Optional[float] = None,
+    size: _t.Any = None,
+    view: _t.Any = None,
+    ortho: _t.Optional[bool] = None,
+    fill: _t.Optional[str] = None,
+    cache: _t.Optional[_PathLike] = None,
+    cache_max: _t.Optional[int] = None,
+    memory: _t.Optional[int] = None,
+    jobs: _t.Optional[int] = None,
+    max_triangles: _t.Optional[int] = None,
+    progress: _t.Optional[_Progress] = None,
+) -> dict:
+    """``drafter draw INPUTS... -o OUT_DIR --format ...`` in this process: a catalog of drawings.
+    Each input (files, folders recursively, manifests, as :func:`bake_many` takes them) is drawn
+    once with the options of :func:`draw` and written in each ``format`` (``"svg"``, ``"pdf"``,
+    ``"dxf"``, or a list of them) as ``OUT_DIR/<its relative path>.<format>``; nothing is written
+    outside ``out_dir`` and the cache. With ``cache``, a rerun writes the drawings from the cache
+    without loading a model. Returns the report (``files``, ``drawn``, ``cached``, ``failed``,
+    ``wall_ms``, ...); failed files are in it, not raised. ``progress`` and Ctrl-C behave as in
+    :func:`bake_many`.
+    """
+    spec = _draw_spec(locals())
+    on_finished = None
+    if progress is not None:
+        if not callable(progress):
+            raise TypeError(f"progress must be callable, not {type(progress).__name__}")
+
+        def on_finished(record: str, done: int, total: int) -> None:
+            progress(_json.loads(record), done, total)
+
+    report, error = _drafter.draw_many(
+        _paths(inputs, "inputs"),
+        _os.fspath(out_dir),
+        manifests=_paths(manifests, "manifests"),
+        formats=_names(format, "format"),
+        spec_json=spec,
         cache=_cache_path(cache),
         cache_max=_count("cache_max", cache_max, 0),
         memory=_count("memory", memory),

@@ -45,6 +45,30 @@ def bake_many(
     max_triangles: Optional[int] = None,
     progress: Optional[Callable[[str, int, int], Any]] = None,
 ) -> Tuple[str, Optional[BaseException]]: ...
+def draw_file(
+    input: str,
+    output: str,
+    *,
+    spec_json: Optional[str] = None,
+    cache: Optional[str] = None,
+    cache_max: Optional[int] = None,
+    threads: Optional[int] = None,
+    max_triangles: Optional[int] = None,
+) -> str: ...
+def draw_many(
+    inputs: List[str],
+    out_dir: str,
+    *,
+    manifests: List[str] = ...,
+    formats: List[str] = ...,
+    spec_json: Optional[str] = None,
+    cache: Optional[str] = None,
+    cache_max: Optional[int] = None,
+    memory: Optional[int] = None,
+    jobs: Optional[int] = None,
+    max_triangles: Optional[int] = None,
+    progress: Optional[Callable[[str, int, int], Any]] = None,
+) -> Tuple[str, Optional[BaseException]]: ...
 def discover(inputs: List[str], manifests: List[str] = ..., skip: Optional[str] = None) -> List[Tuple[str, str]]: ...
 def inspect(
     *, path: Optional[str] = None, data: Optional[bytes] = None, name: Optional[str] = None, max_triangles: Optional[int] = None

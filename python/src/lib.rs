@@ -3,7 +3,10 @@
 //! byte. Every call releases the GIL while it works; `threads=N` runs it on a pool of its own.
 //! The Python-facing API (argument normalisation, docs, type hints) is `drafter/__init__.py`.
 //!
-//! `bake_many` runs the batch on a thread of its own while the calling thread, the GIL released,
+//! `draw_file` and `draw_many` are `drafter draw`'s one drawing through the cache and its
+//! catalogs (drafter-catalog's `draw`), the options as the JSON of its `DrawSpec`.
+//!
+//! `bake_many` and `draw_many` run the batch on a thread of its own while the calling thread, the GIL released,
 //! looks for Python's signals every [`SIGNAL_POLL`]: a Ctrl-C stops the batch at the next file as
 //! the CLI's first Ctrl-C does, and the caller gets the partial report with the
 //! `KeyboardInterrupt`. The progress callback takes the GIL only while it runs.
@@ -224,6 +227,12 @@ struct Progress<'a> {
     error: Mutex<Option<PyErr>>,
 }
 
+impl<'a> Progress<'a> {
+    fn new(callback: Option<Py<PyAny>>, stop: &'a AtomicBool) -> Self {
+        Progress { callback, total: AtomicUsize::new(0), done: AtomicUsize::new(0), stop, error: Mutex::new(None) }
+    }
+}
+
 impl batch::Observer for Progress<'_> {
     fn begin(&self, files: usize, _bytes: u64) {
         self.total.store(files, Ordering::SeqCst);
@@ -280,28 +289,41 @@ fn bake_many(
         workers: jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)).max(1),
     };
     let stop = AtomicBool::new(false);
-    let observer = Progress {
-        callback: progress,
-        total: AtomicUsize::new(0),
-        done: AtomicUsize::new(0),
-        stop: &stop,
-        error: Mutex::new(None),
-    };
-    let outcome = py.detach(|| {
-        std::fs::create_dir_all(&out_dir)
+    let observer = Progress::new(progress, &stop);
+    let summary = run_batch(py, &out_dir, &stop, &observer, options.cache.as_ref(), &|stop, observer| {
+        batch::run_discovered(&found, &out_dir, &options, stop, observer)
+    });
+    finish_batch(py, summary, &observer)
+}
+
+/// A batch to run: given its stop request and its observer, it returns the report.
+type BatchRun<'a> = dyn Fn(&(dyn Fn() -> bool + Sync), &dyn batch::Observer) -> batch::Summary + Sync + 'a;
+
+/// Runs `batch` on a thread of its own while the calling thread, the GIL released, looks for
+/// Python's signals: a Ctrl-C sets `stop` as the CLI's first Ctrl-C does. Returns the summary and
+/// the `KeyboardInterrupt`, if one came; the cache is kept within its bound afterwards.
+fn run_batch(
+    py: Python<'_>,
+    out_dir: &Path,
+    stop: &AtomicBool,
+    observer: &Progress<'_>,
+    cache: Option<&Cache>,
+    batch: &BatchRun<'_>,
+) -> Result<(batch::Summary, Option<PyErr>), drafter_catalog::Error> {
+    py.detach(|| {
+        std::fs::create_dir_all(out_dir)
             .map_err(|e| drafter_catalog::Error::Io(format!("{}: cannot create: {e}", out_dir.display())))?;
         let caller = std::thread::current();
         let (summary, interrupt) = std::thread::scope(|scope| {
-            let batch = scope.spawn(|| {
-                let summary =
-                    batch::run_discovered(&found, &out_dir, &options, &|| stop.load(Ordering::SeqCst), &observer);
+            let worker = scope.spawn(|| {
+                let summary = batch(&|| stop.load(Ordering::SeqCst), observer);
                 caller.unpark();
                 summary
             });
             // The signal handlers of Python run on the main thread only when it asks
             // (`PyErr_CheckSignals`); a worker's own check would never see them.
             let mut interrupt = None;
-            while !batch.is_finished() {
+            while !worker.is_finished() {
                 std::thread::park_timeout(SIGNAL_POLL);
                 if interrupt.is_none()
                     && let Err(e) = Python::attach(|py| py.check_signals())
@@ -310,18 +332,128 @@ fn bake_many(
                     interrupt = Some(e);
                 }
             }
-            let summary = batch.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            let summary = worker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             (summary, interrupt)
         });
-        if let Some(cache) = &options.cache {
+        if let Some(cache) = cache {
             cache.evict();
         }
         Ok((summary, interrupt))
-    });
-    let (summary, interrupt) = outcome.map_err(|e: drafter_catalog::Error| to_py(&e))?;
+    })
+}
+
+/// The report as JSON text and the exception that stopped the batch, if one did (a
+/// `KeyboardInterrupt`, or what the progress callback raised).
+fn finish_batch(
+    py: Python<'_>,
+    outcome: Result<(batch::Summary, Option<PyErr>), drafter_catalog::Error>,
+    observer: &Progress<'_>,
+) -> PyResult<(String, Option<Py<PyAny>>)> {
+    let (summary, interrupt) = outcome.map_err(|e| to_py(&e))?;
     let report = serde_json::to_string(&summary).map_err(|e| InternalError::new_err(e.to_string()))?;
     let error = interrupt.or_else(|| observer.error.lock().unwrap_or_else(|e| e.into_inner()).take());
     Ok((report, error.map(|e| e.into_value(py).into_any())))
+}
+
+/// A drawing's options from the JSON of `drafter_catalog::draw::DrawSpec` (the defaults when
+/// `None`), checked for `input`.
+fn draw_spec(spec_json: Option<&str>) -> PyResult<drafter_catalog::draw::DrawSpec> {
+    spec_json
+        .map(|json| serde_json::from_str(json).map_err(|e| InputError::new_err(format!("drawing options: {e}"))))
+        .transpose()
+        .map(Option::unwrap_or_default)
+}
+
+/// Draws `input` into `output` (.svg, .pdf or .dxf) atomically, through the cache when given, as
+/// `drafter draw INPUT -o OUTPUT [--cache DIR]` does with the options of `spec_json`; returns the
+/// file's record (JSON text). A failure is in the record.
+#[pyfunction]
+#[pyo3(signature = (input, output, *, spec_json=None, cache=None, cache_max=None, threads=None, max_triangles=None))]
+#[allow(clippy::too_many_arguments)]
+fn draw_file(
+    py: Python<'_>,
+    input: PathBuf,
+    output: PathBuf,
+    spec_json: Option<&str>,
+    cache: Option<PathBuf>,
+    cache_max: Option<u64>,
+    threads: Option<usize>,
+    max_triangles: Option<u64>,
+) -> PyResult<String> {
+    let spec = draw_spec(spec_json)?;
+    let limits = limits(max_triangles);
+    let cache = open_cache(cache.as_deref(), cache_max)?;
+    let record = py.detach(|| {
+        on_threads(threads, || {
+            let Some(format) = drafter_catalog::draw::Format::of_path(&output) else {
+                let why = format!("{}: output must end in .svg, .pdf or .dxf", output.display());
+                return refused(&input, &output, &drafter_catalog::Error::Input(why));
+            };
+            let resolved = match spec.resolve(&input) {
+                Ok(resolved) => resolved,
+                Err(e) => return refused(&input, &output, &e),
+            };
+            if let Some(folder) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
+                let _ = std::fs::create_dir_all(folder);
+            }
+            let admit = |bytes| Some(Permit::unbounded(bytes));
+            let outputs = [(format, output.clone())];
+            let record = drafter_catalog::draw::draw_file(&input, &outputs, &resolved, &limits, cache.as_ref(), &admit);
+            if let Some(cache) = cache.as_ref().filter(|c| c.max_bytes.is_some()) {
+                cache.evict();
+            }
+            serde_json::to_value(&record)
+                .unwrap_or_else(|e| refused(&input, &output, &drafter_catalog::Error::Io(e.to_string())))
+        })
+    })?;
+    Ok(record.to_string())
+}
+
+/// Draws many inputs (files, folders, manifests) into `out_dir` in each of `formats` as `drafter
+/// draw INPUTS... -o DIR --format ...` does; returns the report as JSON text and the exception that
+/// stopped the catalog, if one did, as `bake_many`.
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, *, manifests=Vec::new(), formats=Vec::new(), spec_json=None, cache=None, cache_max=None, memory=None, jobs=None, max_triangles=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn draw_many(
+    py: Python<'_>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    manifests: Vec<PathBuf>,
+    formats: Vec<String>,
+    spec_json: Option<&str>,
+    cache: Option<PathBuf>,
+    cache_max: Option<u64>,
+    memory: Option<u64>,
+    jobs: Option<usize>,
+    max_triangles: Option<u64>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(String, Option<Py<PyAny>>)> {
+    let spec = draw_spec(spec_json)?;
+    // The options checked once, before any file, as the CLI does.
+    spec.resolve(inputs.first().map_or(Path::new(""), PathBuf::as_path)).map_err(|e| to_py(&e))?;
+    let formats = match formats.is_empty() {
+        true => vec![drafter_catalog::draw::Format::Svg],
+        false => drafter_catalog::draw::Format::parse_list(&formats.join(",")).map_err(InputError::new_err)?,
+    };
+    let found = drafter_catalog::discover::discover_all(&inputs, &manifests, Some(&out_dir))
+        .map_err(|e| InputError::new_err(e.to_string()))?;
+    let options = drafter_catalog::draw::Options {
+        spec,
+        formats,
+        limits: limits(max_triangles),
+        cache: open_cache(cache.as_deref(), cache_max)?,
+        scheduling: batch::Scheduling {
+            memory_budget: memory.unwrap_or_else(batch::default_memory_budget),
+            workers: jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)).max(1),
+        },
+    };
+    let stop = AtomicBool::new(false);
+    let observer = Progress::new(progress, &stop);
+    let summary = run_batch(py, &out_dir, &stop, &observer, options.cache.as_ref(), &|stop, observer| {
+        drafter_catalog::draw::run(&found, &out_dir, &options, stop, observer)
+    });
+    finish_batch(py, summary, &observer)
 }
 
 /// The files a batch of `inputs` and `manifests` holds: (input, output path relative to the output
@@ -375,6 +507,8 @@ fn _drafter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bake, m)?)?;
     m.add_function(wrap_pyfunction!(bake_file, m)?)?;
     m.add_function(wrap_pyfunction!(bake_many, m)?)?;
+    m.add_function(wrap_pyfunction!(draw_file, m)?)?;
+    m.add_function(wrap_pyfunction!(draw_many, m)?)?;
     m.add_function(wrap_pyfunction!(discover, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(cache, m)?)?;
