@@ -138,8 +138,11 @@ pub struct Stroke {
 /// What [`draw`] did, for reports and benchmarks.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct DrawStats {
-    /// Triangles in the occlusion BVH (every instance's).
+    /// Triangles of every instance.
     pub triangles: usize,
+    /// Of which hide something in this view: the rest are back faces of closed bodies (their
+    /// front faces hide all they would) or have no area on the screen.
+    pub occluders: usize,
     /// Edges considered: hard edges of every instance plus this view's silhouettes.
     pub edges: usize,
     /// Of which silhouettes.
@@ -251,11 +254,23 @@ struct Triangles {
     corners: Vec<[DVec3; 3]>,
     /// Per triangle, its part (a section's uncut parts keep their triangles, [`sheet::section`]).
     parts: Vec<Option<u32>>,
+    /// Per triangle of a closed body, the sign (+1 or −1) that turns the normal of its world
+    /// corners' winding, `(b − a) × (c − a)`, outward; 0 for a triangle of an open surface or one
+    /// that must hide from either side ([`world_triangles_facing`]).
+    outward: Vec<i8>,
 }
 
 fn world_triangles(model: &Model) -> Triangles {
-    let (mut corners, mut parts) = (Vec::new(), Vec::new());
-    for batch in &model.batches {
+    world_triangles_facing(model, &[], None)
+}
+
+/// [`world_triangles`], with the outward sign of the triangles of closed bodies from `faces` (one
+/// per batch, in order; none known where it is shorter). An instance whose box holds `eye` (a
+/// perspective view from inside it) keeps 0: its far side faces the eye.
+fn world_triangles_facing(model: &Model, faces: &[MeshFaces], eye: Option<DVec3>) -> Triangles {
+    let (mut corners, mut parts, mut outward) = (Vec::new(), Vec::new(), Vec::new());
+    for (b, batch) in model.batches.iter().enumerate() {
+        let sides = faces.get(b).map(|f| f.outward.as_slice()).unwrap_or(&[]);
         for instance in batch.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
             let points: Vec<DVec3> = batch
@@ -263,34 +278,48 @@ fn world_triangles(model: &Model) -> Triangles {
                 .iter()
                 .map(|v| world.transform_point3(Vec3::from_array(v.position_in_object).as_dvec3()))
                 .collect();
+            // A mirroring instance turns every winding the other way.
+            let mirror: i8 = if world.determinant() < 0.0 { -1 } else { 1 };
+            let inside = eye.is_some_and(|eye| {
+                let (lo, hi) =
+                    points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+                let pad = (hi - lo).max_element() * 1e-6;
+                eye.cmpge(lo - pad).all() && eye.cmple(hi + pad).all()
+            });
             for (k, t) in batch.indices.chunks_exact(3).enumerate() {
                 let p = |k: usize| points.get(t[k] as usize).copied();
                 if let (Some(a), Some(b), Some(c)) = (p(0), p(1), p(2)) {
                     corners.push([a, b, c]);
                     parts.push(part_of(model, Some(batch), instance, k));
+                    let side = if inside { 0 } else { sides.get(k).copied().unwrap_or(0) };
+                    outward.push(side * mirror);
                 }
             }
         }
     }
-    Triangles { corners, parts }
+    Triangles { corners, parts, outward }
 }
 
-/// The welded connectivity of the mesh an instance draws ([`Topology`], welded exactly: the hard
-/// edges' and candidates' end points are the file's `f32`s) and the normal of each of its faces.
+/// The welded connectivity of a batch's mesh ([`Topology`], welded exactly: the hard edges' and
+/// candidates' end points are the file's `f32`s), the normal of each of its faces, and which of
+/// them bound closed bodies.
 struct MeshFaces {
     topology: Topology,
     /// Per triangle, its normal (f64, unnormalised) from the file's positions.
     normals: Vec<DVec3>,
+    /// Per triangle, the sign that turns its normal outward where its component is a closed body
+    /// ([`sheet::section::closed_components`]), else 0.
+    outward: Vec<i8>,
 }
 
 impl MeshFaces {
-    /// The faces of the batch that draws `instance` (the mesh's triangles in its order).
-    fn of_instance(model: &Model, instance: u32) -> MeshFaces {
-        let Some(batch) = batch_of(model, instance) else {
-            return MeshFaces { topology: Topology::default(), normals: Vec::new() };
-        };
+    /// The faces of `batch` (the mesh's triangles in its order).
+    fn of_batch(batch: &drafter_scene::model::Batch) -> MeshFaces {
         let positions: Vec<Vec3> = batch.vertices.iter().map(|v| Vec3::from_array(v.position_in_object)).collect();
         let triangles: Vec<[u32; 3]> = batch.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        if triangles.iter().flatten().any(|&v| v as usize >= positions.len()) {
+            return MeshFaces { topology: Topology::default(), normals: Vec::new(), outward: Vec::new() };
+        }
         let normals = triangles
             .iter()
             .map(|t| {
@@ -298,7 +327,11 @@ impl MeshFaces {
                 (p[1] - p[0]).cross(p[2] - p[0])
             })
             .collect();
-        MeshFaces { topology: Topology::from_triangles(&positions, &triangles, Weld::Exact), normals }
+        let topology = Topology::from_triangles(&positions, &triangles, Weld::Exact);
+        let welded: Vec<DVec3> = topology.welded_positions.iter().map(|p| p.as_dvec3()).collect();
+        let sides = sheet::section::closed_components(&topology, &welded);
+        let outward = topology.face_component.iter().map(|&c| sides.get(c as usize).copied().unwrap_or(0)).collect();
+        MeshFaces { topology, normals, outward }
     }
 
     /// The normals of the two faces at the edge of corner `3·t + k` (v_k → v_(k+1) of triangle t),
@@ -320,6 +353,11 @@ fn batch_of(model: &Model, instance: u32) -> Option<&drafter_scene::model::Batch
     model.batches.iter().find(|b| b.instances.contains(&instance))
 }
 
+/// The faces of every batch of `model`, in order.
+fn faces_of_batches(model: &Model) -> Vec<MeshFaces> {
+    model.batches.par_iter().map(MeshFaces::of_batch).collect()
+}
+
 /// The part of mesh triangle `t` drawn by `instance` through `batch`.
 pub(crate) fn part_of(
     model: &Model,
@@ -339,10 +377,18 @@ pub(crate) fn part_of(
 
 /// The edges of `model` for a view from `projection`: hard edges of every instance and the
 /// view's silhouettes, in world space.
-fn view_edges(model: &Model, projection: &Projection, smooth: Smooth) -> (Vec<Edge>, usize) {
+fn view_edges(model: &Model, projection: &Projection, smooth: Smooth, batches: &[MeshFaces]) -> (Vec<Edge>, usize) {
     let mut edges = Vec::new();
-    let faces_of: Vec<MeshFaces> =
-        model.lines.meshes.par_iter().map(|mesh| MeshFaces::of_instance(model, mesh.instances.start)).collect();
+    let empty = MeshFaces { topology: Topology::default(), normals: Vec::new(), outward: Vec::new() };
+    let faces_of: Vec<&MeshFaces> = model
+        .lines
+        .meshes
+        .iter()
+        .map(|mesh| {
+            let batch = model.batches.iter().position(|b| b.instances.contains(&mesh.instances.start));
+            batch.and_then(|b| batches.get(b)).unwrap_or(&empty)
+        })
+        .collect();
     for (mesh, faces) in model.lines.meshes.iter().zip(&faces_of) {
         for instance in mesh.instances.clone() {
             let Some(world) = model.instance_world_from_object.get(instance as usize) else { continue };
@@ -498,13 +544,18 @@ fn clip_positive(f0: f64, f1: f64, lo: &mut f64, hi: &mut f64) -> bool {
     *hi > *lo
 }
 
-/// The union of `intervals` (sorted in place), merged.
+/// Intervals of an edge's parameter this close are one: two triangles sharing a side hide the
+/// stretches on either side of where the edge crosses it, and the two ends computed from each
+/// triangle's own corners can miss each other by a rounding.
+const SAME_U: f64 = 1e-9;
+
+/// The union of `intervals` (sorted in place), merged ([`SAME_U`]).
 fn union(intervals: &mut [(f64, f64)]) -> Vec<(f64, f64)> {
     intervals.sort_by(|x, y| x.0.total_cmp(&y.0));
     let mut out: Vec<(f64, f64)> = Vec::new();
     for &(lo, hi) in intervals.iter() {
         match out.last_mut() {
-            Some(last) if lo <= last.1 => last.1 = last.1.max(hi),
+            Some(last) if lo <= last.1 + SAME_U => last.1 = last.1.max(hi),
             _ => out.push((lo, hi)),
         }
     }
@@ -522,10 +573,22 @@ impl Occluders {
         let projected: Vec<[Projected; 3]> = triangles
             .corners
             .par_iter()
-            .filter_map(|t| Some([projection.project(t[0])?, projection.project(t[1])?, projection.project(t[2])?]))
+            .zip(&triangles.outward)
+            .filter_map(|(t, &outward)| {
+                let p = [projection.project(t[0])?, projection.project(t[1])?, projection.project(t[2])?];
+                // A triangle of no area on the screen hides nothing ([`hidden_interval`]), nor does
+                // a closed body's back face (its front faces hide all it would).
+                let area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+                (area != 0.0 && area.is_finite() && f64::from(outward) * area * FRONT >= 0.0).then_some(p)
+            })
             .collect();
-        let boxes: Vec<Aabb> = projected.iter().map(padded_box).collect();
-        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::very_fast_build() };
+        // The BVH holds runs of GROUP triangles in the mesh's order (a tessellation lists
+        // neighbours together), not single triangles: a quarter of the boxes to build over.
+        let boxes: Vec<Aabb> = projected
+            .par_chunks(GROUP)
+            .map(|run| run.iter().map(padded_box).reduce(|a, b| a.union(&b)).unwrap_or_default())
+            .collect();
+        let params = BvhBuildParams { max_prims_per_leaf: 2, ..BvhBuildParams::very_fast_build() };
         let bvh = build_bvh2(&boxes, params, &mut Duration::default());
         Occluders { projected, bvh }
     }
@@ -546,24 +609,97 @@ impl Occluders {
             let lo = glam::Vec3A::new(pa.x.min(pb.x) as f32, pa.y.min(pb.y) as f32, pa.c.min(pb.c) as f32);
             let hi = glam::Vec3A::new(pa.x.max(pb.x) as f32, pa.y.max(pb.y) as f32, f32::MAX);
             let query = Aabb { min: lo - pad(lo), max: hi + pad(hi) };
-            self.bvh.aabb_traverse(query, |bvh, node| {
-                let node = &bvh.nodes[node as usize];
-                let first = node.first_index as usize;
-                for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+            // How far from the piece's start the intervals found so far hide it without a gap,
+            // and those beyond: once the whole piece is hidden, no other triangle can change it.
+            let (mut reach, mut beyond) = (0.0f64, Vec::<(f64, f64)>::new());
+            let total = self.projected.len() as u32;
+            let mut visit = |first: usize, count: usize| {
+                let runs = &self.bvh.primitive_indices[first..first + count];
+                for p in runs.iter().flat_map(|&run| GROUP as u32 * run..(GROUP as u32 * (run + 1)).min(total)) {
                     *tested += 1;
-                    if let Some((lo, hi)) = hidden_interval(pa, pb, &self.projected[p as usize]) {
-                        intervals.push((u0 + lo * (u1 - u0), u0 + hi * (u1 - u0)));
-                        // One triangle hides the whole piece: nothing else can change it.
-                        if lo <= 0.0 && hi >= 1.0 {
-                            return false;
-                        }
+                    let t = &self.projected[p as usize];
+                    if !overlaps(t, &query) {
+                        continue;
+                    }
+                    let Some((lo, hi)) = hidden_interval(pa, pb, t) else { continue };
+                    intervals.push((u0 + lo * (u1 - u0), u0 + hi * (u1 - u0)));
+                    if lo > reach {
+                        beyond.push((lo, hi));
+                        continue;
+                    }
+                    reach = reach.max(hi);
+                    while let Some(k) = beyond.iter().position(|&(lo, _)| lo <= reach) {
+                        reach = reach.max(beyond.swap_remove(k).1);
+                    }
+                    if reach >= 1.0 {
+                        return false;
                     }
                 }
                 true
-            });
+            };
+            self.traverse_nearest_first(&query, &mut visit);
         }
         union(&mut intervals)
     }
+}
+
+/// The sign of the screen area (x right, y down) of a triangle whose winding's normal points
+/// towards the eye: the projection keeps orientation (w > 0 at every kept corner) and the screen's
+/// y runs down, so a counter-clockwise front face turns clockwise.
+const FRONT: f64 = -1.0;
+
+impl Occluders {
+    /// Visits the leaves of the BVH whose boxes meet `query`, the nearer child of each node first
+    /// (by the closeness its box reaches), until `visit` says stop: a triangle near the eye that
+    /// hides a whole piece is then met early. obvhs's own traversal visits children in a fixed
+    /// order, so this is written here.
+    fn traverse_nearest_first(&self, query: &Aabb, visit: &mut impl FnMut(usize, usize) -> bool) {
+        let nodes = &self.bvh.nodes;
+        let Some(root) = nodes.first() else { return };
+        if !root.aabb().intersect_aabb(query) {
+            return;
+        }
+        if root.is_leaf() {
+            visit(root.first_index as usize, root.prim_count as usize);
+            return;
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(root.first_index);
+        while let Some(first) = stack.pop() {
+            let (a, b) = (&nodes[first as usize], &nodes[first as usize + 1]);
+            // Nearer (larger closeness) first: pushed last.
+            let (near, far) = if a.aabb().max.z >= b.aabb().max.z { (a, b) } else { (b, a) };
+            let mut deferred = None;
+            for (k, node) in [near, far].into_iter().enumerate() {
+                if !node.aabb().intersect_aabb(query) {
+                    continue;
+                }
+                if node.is_leaf() {
+                    if !visit(node.first_index as usize, node.prim_count as usize) {
+                        return;
+                    }
+                } else if k == 0 {
+                    deferred = Some(node.first_index);
+                } else {
+                    stack.push(node.first_index);
+                }
+            }
+            if let Some(first) = deferred {
+                stack.push(first);
+            }
+        }
+    }
+}
+
+/// Triangles per BVH primitive ([`Occluders::new`]).
+const GROUP: usize = 4;
+
+/// Whether the screen box of `t` meets the query box (x, y; closeness from below): the test a
+/// BVH leaf of single triangles makes, for the triangles of a run.
+#[inline]
+fn overlaps(t: &[Projected; 3], query: &Aabb) -> bool {
+    let b = padded_box(t);
+    b.intersect_aabb(query)
 }
 
 /// The longest stretch of an edge one BVH query covers, in pixels.
@@ -641,15 +777,49 @@ pub fn visibility_clipped(
     projection: Projection,
     clip: Option<&sheet::section::Clip>,
 ) -> Visibility {
+    visibility_from(model, options, projection, clip, true)
+}
+
+/// [`visibility_in`] with every triangle an occluder, the back faces of closed bodies too: what
+/// leaving them out must not change (the tests compare the two).
+#[doc(hidden)]
+pub fn visibility_every_face(model: &Model, options: &DrawOptions, projection: Projection) -> Visibility {
+    visibility_from(model, options, projection, None, false)
+}
+
+fn visibility_from(
+    model: &Model,
+    options: &DrawOptions,
+    projection: Projection,
+    clip: Option<&sheet::section::Clip>,
+    front_faces_only: bool,
+) -> Visibility {
     let start = Instant::now();
-    let mut triangles = world_triangles(model);
-    let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth);
+    let faces = faces_of_batches(model);
+    // Back faces of closed bodies hide nothing their front faces do not (a line of sight into a
+    // body enters it through a front face first), so they are left out of the occluders; not
+    // with a section, whose cut opens the bodies.
+    let eye = match projection.view {
+        drafter_scene::edges::WorldView::Perspective { eye } => Some(eye),
+        drafter_scene::edges::WorldView::Orthographic { .. } => None,
+    };
+    let mut triangles = if clip.is_none() && front_faces_only {
+        world_triangles_facing(model, &faces, eye)
+    } else {
+        world_triangles(model)
+    };
+    let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth, &faces);
     if let Some(clip) = clip {
         clip.keep_below(&mut triangles, &mut edges);
     }
     let occluders = Occluders::new(&triangles, &projection);
-    let mut stats =
-        DrawStats { triangles: triangles.corners.len(), edges: edges.len(), silhouettes, ..Default::default() };
+    let mut stats = DrawStats {
+        triangles: triangles.corners.len(),
+        occluders: occluders.projected.len(),
+        edges: edges.len(),
+        silhouettes,
+        ..Default::default()
+    };
     // An edge listed twice in 3D (the same class between the same world points: a border of two
     // parts, coincident instances) is decided once: its copies hide and are hidden alike. Edges
     // that only meet on the screen are each decided on their own; where their pieces overlap,

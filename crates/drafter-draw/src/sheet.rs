@@ -836,8 +836,8 @@ fn uncut_in_front(
             }
         }
     }
-    let parts = vec![None; corners.len()];
-    Some(crate::Occluders::new(&crate::Triangles { corners, parts }, projection))
+    let (parts, outward) = (vec![None; corners.len()], vec![0; corners.len()]);
+    Some(crate::Occluders::new(&crate::Triangles { corners, parts, outward }, projection))
 }
 
 /// The pieces of the sheet segment `a → b` (millimetres, on the section's plane, of closeness `c`)

@@ -289,3 +289,66 @@ fn axis_views_draw_every_visible_line_visible_and_once() {
         }
     }
 }
+
+/// The hidden intervals of `edge`, in pixels along it.
+fn hidden_px(edge: &drawing::EdgeVisibility) -> Vec<(f64, f64)> {
+    let length = edge.screen[0].distance(edge.screen[1]);
+    edge.hidden.iter().map(|&(lo, hi)| (lo * length, hi * length)).collect()
+}
+
+/// The length covered by exactly one of two sorted, disjoint interval lists.
+fn symmetric_difference(x: &[(f64, f64)], y: &[(f64, f64)]) -> f64 {
+    let mut cuts: Vec<f64> = x.iter().chain(y).flat_map(|&(lo, hi)| [lo, hi]).collect();
+    cuts.sort_by(f64::total_cmp);
+    let inside = |list: &[(f64, f64)], t: f64| list.iter().any(|&(lo, hi)| lo <= t && t <= hi);
+    cuts.windows(2)
+        .filter(|w| {
+            let middle = 0.5 * (w[0] + w[1]);
+            inside(x, middle) != inside(y, middle)
+        })
+        .map(|w| w[1] - w[0])
+        .sum()
+}
+
+#[test]
+fn leaving_out_the_back_faces_of_closed_bodies_hides_the_same() {
+    let models = [
+        ("sample", common::sample()),
+        ("RodAssembly", common::baked(&common::corpus_path("gltf/RodAssembly/rod.glb"))),
+        ("fandisk", common::baked(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"))),
+    ];
+    for (name, model) in &models {
+        for (view, orthographic) in
+            [((35.0, 25.0), false), ((0.0, 0.0), true), ((0.0, 89.99999), true), ((200.0, -20.0), false)]
+        {
+            let options = options(view, orthographic);
+            let projection = drawing::Projection::new(model, &options);
+            let fast = drawing::visibility_in(model, &options, projection);
+            let every = drawing::visibility_every_face(model, &options, projection);
+            assert_eq!(fast.edges.len(), every.edges.len());
+            let (mut differ, mut hidden) = (0, 0.0);
+            for (a, b) in fast.edges.iter().zip(&every.edges) {
+                let (x, y) = (hidden_px(a), hidden_px(b));
+                hidden += x.iter().map(|(lo, hi)| hi - lo).sum::<f64>();
+                // Equal up to roundings: the intervals may split differently where two front
+                // faces meet instead of one back face spanning the seam, and an interval of no
+                // length may come or go.
+                let same = symmetric_difference(&x, &y) < 1e-6;
+                if !same && differ < 6 {
+                    eprintln!("  {:?} {:?} fast {x:?} every {y:?}", a.class, a.screen);
+                }
+                differ += usize::from(!same);
+            }
+            eprintln!(
+                "{name} {view:?} ortho {orthographic}: {} of {} triangles hide, {hidden:.0} px hidden, {differ} edges differ",
+                fast.stats.occluders, fast.stats.triangles
+            );
+            assert_eq!(differ, 0, "{name} {view:?}: edges whose hidden parts changed");
+            assert!(hidden > 100.0, "{name} {view:?}: the view hides something");
+            if *name == "sample" {
+                // Its parts are closed bodies: about half their faces turn away.
+                assert!(fast.stats.occluders * 10 < every.stats.occluders * 7, "{name}: back faces left out");
+            }
+        }
+    }
+}

@@ -296,6 +296,8 @@ impl Clip {
             }
         }
         (triangles.corners, triangles.parts) = (kept, parts);
+        // The cut opens the bodies: every remaining face hides from either side.
+        triangles.outward = vec![0; triangles.corners.len()];
         edges.retain_mut(|e| {
             if self.is_uncut(e.part) {
                 return true;
