@@ -268,7 +268,9 @@ fn world_triangles(model: &Model) -> Triangles {
 /// per batch, in order; none known where it is shorter). An instance whose box holds `eye` (a
 /// perspective view from inside it) keeps 0: its far side faces the eye.
 fn world_triangles_facing(model: &Model, faces: &[MeshFaces], eye: Option<DVec3>) -> Triangles {
-    let (mut corners, mut parts, mut outward) = (Vec::new(), Vec::new(), Vec::new());
+    let count: usize = model.batches.iter().map(|b| b.indices.len() / 3 * b.instances.len()).sum();
+    let (mut corners, mut parts, mut outward) =
+        (Vec::with_capacity(count), Vec::with_capacity(count), Vec::with_capacity(count));
     for (b, batch) in model.batches.iter().enumerate() {
         let sides = faces.get(b).map(|f| f.outward.as_slice()).unwrap_or(&[]);
         for instance in batch.instances.clone() {
@@ -565,6 +567,8 @@ fn union(intervals: &mut [(f64, f64)]) -> Vec<(f64, f64)> {
 /// The occlusion structure: projected triangles and a BVH over their boxes.
 struct Occluders {
     projected: Vec<[Projected; 3]>,
+    /// Per triangle, its screen box ([`padded_box`]), tested before the triangle itself.
+    boxes: Vec<Aabb>,
     bvh: obvhs::bvh2::Bvh2,
 }
 
@@ -584,13 +588,14 @@ impl Occluders {
             .collect();
         // The BVH holds runs of GROUP triangles in the mesh's order (a tessellation lists
         // neighbours together), not single triangles: a quarter of the boxes to build over.
-        let boxes: Vec<Aabb> = projected
+        let boxes: Vec<Aabb> = projected.par_iter().map(padded_box).collect();
+        let runs: Vec<Aabb> = boxes
             .par_chunks(GROUP)
-            .map(|run| run.iter().map(padded_box).reduce(|a, b| a.union(&b)).unwrap_or_default())
+            .map(|run| run.iter().copied().reduce(|a, b| a.union(&b)).unwrap_or_default())
             .collect();
         let params = BvhBuildParams { max_prims_per_leaf: 2, ..BvhBuildParams::very_fast_build() };
-        let bvh = build_bvh2(&boxes, params, &mut Duration::default());
-        Occluders { projected, bvh }
+        let bvh = build_bvh2(&runs, params, &mut Duration::default());
+        Occluders { projected, boxes, bvh }
     }
 
     /// The hidden intervals of the projected segment `a → b`.
@@ -617,11 +622,11 @@ impl Occluders {
                 let runs = &self.bvh.primitive_indices[first..first + count];
                 for p in runs.iter().flat_map(|&run| GROUP as u32 * run..(GROUP as u32 * (run + 1)).min(total)) {
                     *tested += 1;
-                    let t = &self.projected[p as usize];
-                    if !overlaps(t, &query) {
+                    // The test a BVH leaf of single triangles makes, for the triangles of a run.
+                    if !self.boxes[p as usize].intersect_aabb(&query) {
                         continue;
                     }
-                    let Some((lo, hi)) = hidden_interval(pa, pb, t) else { continue };
+                    let Some((lo, hi)) = hidden_interval(pa, pb, &self.projected[p as usize]) else { continue };
                     intervals.push((u0 + lo * (u1 - u0), u0 + hi * (u1 - u0)));
                     if lo > reach {
                         beyond.push((lo, hi));
@@ -693,14 +698,6 @@ impl Occluders {
 
 /// Triangles per BVH primitive ([`Occluders::new`]).
 const GROUP: usize = 4;
-
-/// Whether the screen box of `t` meets the query box (x, y; closeness from below): the test a
-/// BVH leaf of single triangles makes, for the triangles of a run.
-#[inline]
-fn overlaps(t: &[Projected; 3], query: &Aabb) -> bool {
-    let b = padded_box(t);
-    b.intersect_aabb(query)
-}
 
 /// The longest stretch of an edge one BVH query covers, in pixels.
 const QUERY_PIECE_PX: f64 = 24.0;
@@ -777,25 +774,39 @@ pub fn visibility_clipped(
     projection: Projection,
     clip: Option<&sheet::section::Clip>,
 ) -> Visibility {
-    visibility_from(model, options, projection, clip, true)
+    visibility_from(model, &ModelFaces::of(model), options, projection, clip, true)
 }
 
 /// [`visibility_in`] with every triangle an occluder, the back faces of closed bodies too: what
 /// leaving them out must not change (the tests compare the two).
 #[doc(hidden)]
 pub fn visibility_every_face(model: &Model, options: &DrawOptions, projection: Projection) -> Visibility {
-    visibility_from(model, options, projection, None, false)
+    visibility_from(model, &ModelFaces::of(model), options, projection, None, false)
+}
+
+/// What the views of one model share: the welded faces of every batch and, once an orthographic
+/// view asks for them, the world triangles with their closed bodies' outward signs (a parallel
+/// view has no eye inside a body). Computed once for the views of a sheet.
+pub(crate) struct ModelFaces {
+    batches: Vec<MeshFaces>,
+    orthographic: std::sync::OnceLock<Triangles>,
+}
+
+impl ModelFaces {
+    pub(crate) fn of(model: &Model) -> ModelFaces {
+        ModelFaces { batches: faces_of_batches(model), orthographic: std::sync::OnceLock::new() }
+    }
 }
 
 fn visibility_from(
     model: &Model,
+    faces: &ModelFaces,
     options: &DrawOptions,
     projection: Projection,
     clip: Option<&sheet::section::Clip>,
     front_faces_only: bool,
 ) -> Visibility {
     let start = Instant::now();
-    let faces = faces_of_batches(model);
     // Back faces of closed bodies hide nothing their front faces do not (a line of sight into a
     // body enters it through a front face first), so they are left out of the occluders; not
     // with a section, whose cut opens the bodies.
@@ -803,16 +814,27 @@ fn visibility_from(
         drafter_scene::edges::WorldView::Perspective { eye } => Some(eye),
         drafter_scene::edges::WorldView::Orthographic { .. } => None,
     };
-    let mut triangles = if clip.is_none() && front_faces_only {
-        world_triangles_facing(model, &faces, eye)
-    } else {
-        world_triangles(model)
+    let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth, &faces.batches);
+    let owned;
+    let triangles: &Triangles = match (clip, front_faces_only, eye) {
+        // Every orthographic view of a sheet takes the same world triangles.
+        (None, true, None) => faces.orthographic.get_or_init(|| world_triangles_facing(model, &faces.batches, None)),
+        (None, true, Some(eye)) => {
+            owned = world_triangles_facing(model, &faces.batches, Some(eye));
+            &owned
+        }
+        (Some(clip), _, _) => {
+            let mut cut = world_triangles(model);
+            clip.keep_below(&mut cut, &mut edges);
+            owned = cut;
+            &owned
+        }
+        (None, false, _) => {
+            owned = world_triangles(model);
+            &owned
+        }
     };
-    let (mut edges, silhouettes) = view_edges(model, &projection, options.smooth, &faces);
-    if let Some(clip) = clip {
-        clip.keep_below(&mut triangles, &mut edges);
-    }
-    let occluders = Occluders::new(&triangles, &projection);
+    let occluders = Occluders::new(triangles, &projection);
     let mut stats = DrawStats {
         triangles: triangles.corners.len(),
         occluders: occluders.projected.len(),
@@ -880,8 +902,19 @@ pub fn draw_clipped(
     projection: Projection,
     clip: Option<&sheet::section::Clip>,
 ) -> Drawing {
+    draw_with_faces(model, &ModelFaces::of(model), options, projection, clip)
+}
+
+/// [`draw_clipped`] with the model's faces computed once for several views ([`sheet`]).
+pub(crate) fn draw_with_faces(
+    model: &Model,
+    faces: &ModelFaces,
+    options: &DrawOptions,
+    projection: Projection,
+    clip: Option<&sheet::section::Clip>,
+) -> Drawing {
     let start = Instant::now();
-    let Visibility { edges, mut stats, projection } = visibility_clipped(model, options, projection, clip);
+    let Visibility { edges, mut stats, projection } = visibility_from(model, faces, options, projection, clip, true);
     let fills = crate::fills::fills(model, &projection, options.fill);
     let tolerance = options.tolerance_px.max(0.0);
     let mut pieces = Vec::new();

@@ -715,6 +715,7 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
         fill: Fill::None,
         ..options.draw
     };
+    let faces = crate::ModelFaces::of(model);
     let views: Vec<PlacedView> = layout
         .views
         .par_iter()
@@ -754,7 +755,7 @@ pub fn draw_sheet(model: &Model, options: &SheetOptions) -> Result<Sheet, SheetE
                 }
                 clip = Some(section::Clip { plane: *plane, cut: loops_px, uncut: uncut.clone(), plane_closeness });
             }
-            let mut drawing = crate::draw_clipped(model, &view_options, projection, clip.as_ref());
+            let mut drawing = crate::draw_with_faces(model, &faces, &view_options, projection, clip.as_ref());
             for stroke in &mut drawing.strokes {
                 for p in &mut stroke.points {
                     *p *= MM_PER_PX;
