@@ -4,13 +4,14 @@
 //! version and the commit it was built from), the extension's format version, the input's file name
 //! (the output records it), the effective configuration in a canonical form, the digest of the
 //! input's bytes, and the URI and digest of every external file a glTF input names (buffers and
-//! images, resolved by drafter-io's confined rule). The configuration's canonical form
-//! ([`canonical_config`]) is its serde serialization as JSON with the keys sorted, tagged with
-//! [`CONFIG_FORM`]: derived, so it lists every field of every stage's options with floats in their
-//! shortest round-trip form, and an option added later can never be left out of the key; unlike
-//! `Debug` text, the form is a documented serialization that a compiler or a dependency's update
-//! does not change. A bake is byte-identical at any thread count (an invariant of drafter-bake), so
-//! the key decides the bytes.
+//! images, resolved by drafter-format's confined URI rule, `drafter_format::uri`); for an OBJ, the
+//! name of every material library it names with its digest (or its absence). The configuration's
+//! canonical form ([`canonical_config`]) is its serde serialization as JSON with the keys sorted,
+//! tagged with [`CONFIG_FORM`]: derived, so it lists every field of every stage's options with
+//! floats in their shortest round-trip form, and an option added later can never be left out of
+//! the key; unlike `Debug` text, the form is a documented serialization that a compiler or a
+//! dependency's update does not change. A bake is byte-identical at any thread count (an invariant
+//! of drafter-bake), so the key decides the bytes.
 //!
 //! **Entries.** One file per key, `entries/KK/KEY` (KK its first two hex digits): a header (magic,
 //! layout version, payload count, then per payload its length and BLAKE3 digest) and the payloads

@@ -57,8 +57,9 @@
 //!   [`crate::style::METAL_STRIPE_SCALE`], repeat; highlights from the map by the eye-space normal.
 //!   Colour `tint·mix(0.4, 1, band)·(0.75 + 0.25·max(n·l, 0)) + highlight`: the spec's
 //!   `base·band + highlight` with the band lifted so no streak is black and a little diffuse light
-//!   so flat faces read apart. Procedural: the viewer's 32-entry table by the angle around the axis
-//!   and six of the icosahedron's lights, Blinn–Phong.
+//!   so flat faces read apart. Procedural: the bake's default band table
+//!   ([`crate::style::metal_table`], [`crate::style::METAL_TABLE_LEN`] = 16 entries) by the angle
+//!   around the axis and six of the icosahedron's lights, Blinn–Phong.
 //!
 //! # Specialised pipelines
 //! One fragment shader holds every style, but a frame usually draws one or two of them: the scene's
