@@ -13,7 +13,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use drafter_viewer::Image;
+use drafter_viewer::{Image, Style};
 use serde_json::Value;
 
 /// A pixel differs when some channel is more than this many levels (of 255) from the native render.
@@ -21,8 +21,6 @@ const LEVELS: u8 = 24;
 /// The fraction of pixels that may differ by more than [`LEVELS`] (edges of triangles and lines that
 /// two rasterisers place half a pixel apart; docs/web.md "How close").
 const FRACTION: f64 = 0.005;
-
-const STYLES: [&str; 7] = ["gradient", "cel", "gooch", "goochel", "phong", "metal", "hatch"];
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -93,7 +91,7 @@ fn compare_styles(name: &str, file: &Path, flags: &[&str]) {
 fn compare_styles_on(backend: &str, name: &str, file: &Path, flags: &[&str]) {
     let dir = common::scratch(&format!("web-{name}"));
     let shots = dir.join("page");
-    let styles = STYLES.join(",");
+    let styles = Style::ALL.map(Style::name).join(",");
     let mut args = vec!["--out", shots.to_str().expect("utf-8"), "--styles", &styles, "--backend", backend];
     args.extend(flags);
     let json = web("shots", file, &args);
@@ -102,7 +100,7 @@ fn compare_styles_on(backend: &str, name: &str, file: &Path, flags: &[&str]) {
     assert!(json["backend"].as_str().is_some_and(|b| b.contains(expected)), "{name}: not on {backend}: {json}");
     let mut report = Vec::new();
     let mut worst = 0.0f64;
-    for style in STYLES {
+    for style in Style::ALL.map(Style::name) {
         let native_flags: Vec<&str> = flags.iter().copied().filter(|f| *f != "--capture").collect();
         let native = render(file, style, &native_flags, &dir.join(format!("native-{style}.png")));
         let page = Image::from_png(&std::fs::read(shots.join(format!("{style}.png"))).expect("shot")).expect("PNG");

@@ -6,8 +6,8 @@
 //! too), re-exported here.
 
 pub use drafter_scene::style::{
-    DEFAULT_AZIMUTH_DEG, DEFAULT_ELEVATION_DEG, DEFAULT_FOV_Y_DEG, HATCH_SHARPNESS, METAL_TABLE_LEN, Style,
-    UnknownStyle, View, metal_table, shader_index, transfer_index, transfer_tables,
+    DEFAULT_AZIMUTH_DEG, DEFAULT_CEL_STEPS, DEFAULT_ELEVATION_DEG, DEFAULT_FOV_Y_DEG, HATCH_SHARPNESS, METAL_TABLE_LEN,
+    Style, UnknownStyle, View, metal_table, shader_index, transfer_index, transfer_tables,
 };
 
 /// The drop shadow under the model (Gooch et al. 1999, §5.3).
@@ -41,8 +41,6 @@ impl ShadowMode {
 
 /// Default of [`RenderOptions::size`].
 pub const DEFAULT_SIZE: (u32, u32) = (800, 600);
-/// Default of [`RenderOptions::cel_steps`].
-pub const DEFAULT_CEL_STEPS: u32 = 3;
 /// Splash-back α of Gooch et al. 1999, §3.2.
 pub const SPLASH_BACK_ALPHA: f32 = 0.76;
 /// Splash-back β of Gooch et al. 1999, §3.2.

@@ -73,9 +73,6 @@ use serde::Deserialize;
 
 use crate::BakeError;
 
-/// Shading style hints a part may carry (the viewer's styles).
-pub const STYLES: [&str; 7] = ["gradient", "cel", "gooch", "goochel", "phong", "metal", "hatch"];
-
 /// Every option of a bake, one struct per stage.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct BakeConfig {
@@ -211,7 +208,7 @@ pub struct TexturesStage {
     /// Styles a viewer may apply to the whole scene; the lookups they read are baked (`gradient`:
     /// γ atlas, `cel`: cel atlas, `gooch`: cool-to-warm map, `goochel`: both, `hatch`: hatching,
     /// `metal`: metal bands and highlights, `phong`: none). Part style hints and metal parts add to
-    /// them. Default [`DEFAULT_TEXTURE_STYLES`]; each one of [`STYLES`].
+    /// them. Default [`DEFAULT_TEXTURE_STYLES`]; each one of [`PartStyle::ALL`].
     pub styles: Vec<String>,
     /// A part without a style hint whose material's metallic factor is at least this is metal and
     /// gets the metal textures baked. Default [`DEFAULT_METALLIC_THRESHOLD`] (0.5); range [0, ∞),
@@ -247,8 +244,9 @@ impl TexturesStage {
     /// Checks every option against its documented range; errors name the key.
     pub fn validate(&self) -> Result<(), String> {
         for style in &self.styles {
-            if !STYLES.contains(&style.as_str()) {
-                return Err(format!("textures.styles: {style:?} is not one of {}", STYLES.join(", ")));
+            if style.parse::<PartStyle>().is_err() {
+                let names = PartStyle::ALL.map(PartStyle::name).join(", ");
+                return Err(format!("textures.styles: {style:?} is not one of {names}"));
             }
         }
         if !(self.metallic_threshold.is_finite() && self.metallic_threshold >= 0.0) {

@@ -43,7 +43,7 @@ use serde::Serialize;
 
 pub use config::{
     BakeConfig, Compression, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage,
-    PartOverride, PartSelector, STYLES, TexturesStage,
+    PartOverride, PartSelector, TexturesStage,
 };
 pub use split::SplitSummary;
 pub use textures::{TextureReport, TexturesSummary};

@@ -308,7 +308,7 @@ impl std::fmt::Display for PartStyle {
 
 /// A style name that is not one of [`PartStyle::ALL`].
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown style {0:?}: expected one of gradient, cel, gooch, goochel, phong, metal, hatch")]
+#[error("unknown style {0:?}: expected one of {names}", names = PartStyle::ALL.map(PartStyle::name).join(", "))]
 pub struct UnknownStyle(pub String);
 
 impl std::str::FromStr for PartStyle {

@@ -22,6 +22,10 @@ pub fn shader_index(style: Style) -> u32 {
     }
 }
 
+/// Default steps of cel and Goochel shading (the viewer's `RenderOptions::cel_steps`): the bake's
+/// default cel table's, so that a default frame finds its row in a baked cel atlas.
+pub use drafter_textures::cel::DEFAULT_CEL_STEPS;
+
 /// Default of [`View::azimuth_deg`].
 pub const DEFAULT_AZIMUTH_DEG: f32 = 35.0;
 /// Default of [`View::elevation_deg`].
