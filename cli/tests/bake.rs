@@ -25,9 +25,7 @@ fn corpus_models() -> Vec<PathBuf> {
                 if p.file_name().is_some_and(|n| n != "draco") {
                     walk(&p, out);
                 }
-            } else if let Some(ext) = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase())
-                && ["gltf", "glb", "obj", "stl", "off", "ply"].contains(&ext.as_str())
-            {
+            } else if drafter_io::has_input_extension(&p) {
                 out.push(p);
             }
         }

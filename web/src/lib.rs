@@ -19,10 +19,6 @@ use drafter_viewer::edges::Hierarchies;
 use drafter_viewer::{Enhancements, Gpu, Model, RenderOptions, Renderer, ShadowMode, Style};
 use wasm_bindgen::prelude::*;
 
-/// The most triangles the page loads by default (the page's `max-triangles` parameter changes
-/// it): a tab's memory, not the renderer, is the limit (the dragon's 871k load in a few seconds).
-pub const DEFAULT_MAX_TRIANGLES: u64 = 5_000_000;
-
 /// Reports panics on the console (the page shows the last console error too).
 #[wasm_bindgen(start)]
 pub fn start() {

@@ -22,8 +22,10 @@ use crate::exit::{BadInput, MissingPage};
 /// The files of a built page, all needed.
 pub const PAGE_FILES: [&str; 4] = ["index.html", "drafter-viewer.js", "drafter_web.js", "drafter_web_bg.wasm"];
 
-/// The most triangles the page loads by default (`drafter-web`'s `DEFAULT_MAX_TRIANGLES`, which
-/// the page's `max-triangles` parameter changes).
+/// The most triangles the page loads by default (its `max-triangles` attribute changes it), which
+/// `drafter web` holds the model to before writing the folder: a tab's memory, not the renderer, is
+/// the limit. The page's script cannot import it and states it as `DEFAULT_MAX_TRIANGLES`; a test
+/// below holds the two equal.
 pub const PAGE_MAX_TRIANGLES: u64 = 5_000_000;
 
 #[derive(Debug, clap::Args)]
@@ -141,6 +143,48 @@ mod tests {
         assert_eq!(model_name(Path::new("out/a b.glb")), "model.glb");
         assert_eq!(model_name(Path::new("out/x\"y.glb")), "model.glb");
         assert_eq!(model_name(Path::new(".hidden.glb")), "model.glb");
+    }
+
+    /// The value of the page script's top-level `const NAME = VALUE;`.
+    fn page_constant(name: &str) -> &'static str {
+        let script = include_str!("../../../web/page/drafter-viewer.js");
+        let start = format!("\nconst {name} = ");
+        let at = script.find(&start).unwrap_or_else(|| panic!("drafter-viewer.js has no top-level const {name}"));
+        let value = &script[at + start.len()..];
+        value[..value.find(";\n").unwrap_or_else(|| panic!("const {name} ends with ;"))].trim()
+    }
+
+    /// The strings of a one-line JS array of quoted strings.
+    fn page_strings(name: &str) -> Vec<&'static str> {
+        let value = page_constant(name);
+        let items =
+            value.strip_prefix('[').and_then(|v| v.strip_suffix(']')).unwrap_or_else(|| panic!("{name}: {value}"));
+        items
+            .split(',')
+            .map(|item| {
+                let item = item.trim();
+                item.strip_prefix('\'').and_then(|i| i.strip_suffix('\'')).unwrap_or_else(|| panic!("{name}: {item}"))
+            })
+            .collect()
+    }
+
+    /// The page's script states what it cannot import from the Rust side; each value must be the
+    /// Rust one, so that a change on either side fails here rather than in a browser.
+    #[test]
+    fn the_page_script_states_the_rust_values() {
+        let limit: u64 = page_constant("DEFAULT_MAX_TRIANGLES").replace('_', "").parse().expect("a number");
+        assert_eq!(limit, PAGE_MAX_TRIANGLES, "the page's DEFAULT_MAX_TRIANGLES");
+        // The styles in the viewer's order, as the toolbar lists them and the keys 1-7 number them.
+        let styles: Vec<&str> = drafter_viewer::Style::ALL.iter().map(|s| s.name()).collect();
+        assert_eq!(page_strings("STYLES"), styles, "the page's STYLES");
+        let shadows: Vec<&str> = drafter_viewer::ShadowMode::ALL.iter().map(|s| s.name()).collect();
+        assert_eq!(page_strings("SHADOWS"), shadows, "the page's SHADOWS");
+        // The files a drop loads: any format the importers read (the page imports with drafter-io).
+        let mut dropped = page_strings("MODEL_EXTENSIONS");
+        dropped.sort_unstable();
+        let mut read: Vec<&str> = drafter_io::EXTENSIONS.iter().map(|(x, _)| *x).collect();
+        read.sort_unstable();
+        assert_eq!(dropped, read, "the page's MODEL_EXTENSIONS");
     }
 
     #[test]

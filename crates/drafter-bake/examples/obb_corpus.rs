@@ -35,9 +35,7 @@ fn models(dir: &Path, out: &mut Vec<PathBuf>) {
             if p.file_name().is_some_and(|n| n != "draco") {
                 models(&p, out);
             }
-        } else if p.extension().is_some_and(|e| {
-            ["gltf", "glb", "obj", "stl", "off", "ply"].contains(&e.to_string_lossy().to_ascii_lowercase().as_str())
-        }) {
+        } else if drafter_io::has_input_extension(&p) {
             out.push(p);
         }
     }

@@ -3,9 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-/// Extensions of the formats drafter reads (compared without case: CAD tools write `.STL`).
-pub const EXTENSIONS: [&str; 6] = ["gltf", "glb", "obj", "stl", "off", "ply"];
-
 /// One input of a batch and where its output goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Item {
@@ -183,8 +180,9 @@ fn walk(folder: &Path, skip: Option<&Path>, out: &mut Vec<PathBuf>, unreadable: 
     }
 }
 
+/// Whether a folder's file is baked: its extension is one of the importers' (`drafter_io::EXTENSIONS`).
 pub fn is_supported(path: &Path) -> bool {
-    path.extension().is_some_and(|e| EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)))
+    drafter_io::has_input_extension(path)
 }
 
 #[cfg(test)]

@@ -32,6 +32,23 @@ pub struct Imported {
     pub diagnostics: Vec<Diagnostic>,
 }
 
+/// The file extensions of the formats drafter reads, each with the format it names, compared
+/// without case (CAD tools write `.STL`). The content decides first ([`detect_format`]); the
+/// extension decides for a file without a known signature, and a folder's files are chosen by it.
+pub const EXTENSIONS: [(&str, SourceFormat); 6] = [
+    ("gltf", SourceFormat::Gltf),
+    ("glb", SourceFormat::Glb),
+    ("obj", SourceFormat::Obj),
+    ("stl", SourceFormat::Stl),
+    ("off", SourceFormat::Off),
+    ("ply", SourceFormat::Ply),
+];
+
+/// Whether `path`'s extension is one of [`EXTENSIONS`].
+pub fn has_input_extension(path: &Path) -> bool {
+    path.extension().is_some_and(|e| EXTENSIONS.iter().any(|(x, _)| e.eq_ignore_ascii_case(x)))
+}
+
 /// The most triangles an import takes by default ([`Limits::max_triangles`]): about 9 GB at the
 /// peak of a bake (the dragon's bake peaks at 0.44 KB a triangle).
 pub const DEFAULT_MAX_TRIANGLES: u64 = 20_000_000;
@@ -137,15 +154,10 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<SourceFormat, ImportEr
     if text_start.starts_with(b"solid") {
         return Ok(SourceFormat::Stl);
     }
-    match extension.as_str() {
-        "gltf" => Ok(SourceFormat::Gltf),
-        "glb" => Ok(SourceFormat::Glb),
-        "obj" => Ok(SourceFormat::Obj),
-        "stl" => Ok(SourceFormat::Stl),
-        "off" => Ok(SourceFormat::Off),
-        "ply" => Ok(SourceFormat::Ply),
-        "" => Err(unsupported("no extension and no known signature")),
-        other => Err(unsupported(&format!("extension .{other} and no known signature"))),
+    match EXTENSIONS.iter().find(|(x, _)| *x == extension) {
+        Some(&(_, format)) => Ok(format),
+        None if extension.is_empty() => Err(unsupported("no extension and no known signature")),
+        None => Err(unsupported(&format!("extension .{extension} and no known signature"))),
     }
 }
 
