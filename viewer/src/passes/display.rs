@@ -17,10 +17,14 @@ pub const LABEL: &str = "display";
 
 /// Outline colour: black, as every convention draws silhouettes and part borders.
 pub const LINE_COLOR: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
-/// Creases on the Gooch styles: white (Gooch et al. 1999, §3.1, Fig. 9).
-pub const CREASE_WHITE: [f32; 4] = [1.0, 1.0, 1.0, 0.9];
-/// Creases on the other styles: dark grey, lighter than outlines ([IFH03]-style edge enhancement).
-pub const CREASE_DARK: [f32; 4] = [0.1, 0.1, 0.1, 0.6];
+/// Image-space creases (pixels where the G-buffer normal turns, found here) on the Gooch styles:
+/// white (Gooch et al. 1999, §3.1, Fig. 9). Mixed into whole pixels with no coverage, so the alpha
+/// is the line's only softening; the baked crease lines of the lines pass have their own colours
+/// ([`crate::passes::lines::BAKED_CREASE_WHITE`]).
+pub const IMAGE_SPACE_CREASE_WHITE: [f32; 4] = [1.0, 1.0, 1.0, 0.9];
+/// Image-space creases on the other styles: dark grey, lighter than outlines ([IFH03]-style edge
+/// enhancement).
+pub const IMAGE_SPACE_CREASE_DARK: [f32; 4] = [0.1, 0.1, 0.1, 0.6];
 /// Selection tint (orange, 45 %).
 pub const HIGHLIGHT_COLOR: [f32; 4] = [1.0, 0.55, 0.1, 0.45];
 
@@ -46,7 +50,7 @@ pub fn uniforms(options: &RenderOptions, scene_radius: f32, orthographic: bool) 
         background: [options.background[0], options.background[1], options.background[2], 1.0],
         shadow_color: [options.shadow_color[0], options.shadow_color[1], options.shadow_color[2], 1.0],
         line_color: LINE_COLOR,
-        crease_color: if gooch { CREASE_WHITE } else { CREASE_DARK },
+        crease_color: if gooch { IMAGE_SPACE_CREASE_WHITE } else { IMAGE_SPACE_CREASE_DARK },
         highlight_color: HIGHLIGHT_COLOR,
         selected: options.selected_part.map_or(0, |p| p.saturating_add(1)),
         flags,

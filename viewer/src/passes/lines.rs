@@ -62,10 +62,13 @@ pub const DEPTH_TOLERANCE_PIXELS: f32 = 2.0;
 pub const CONTOUR_DEPTH_JUMP: f32 = 0.1;
 /// Outline colour: black.
 pub const OUTLINE_COLOR: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
-/// Creases on the Gooch styles: white (Gooch et al. 1999, Fig. 9).
-pub const CREASE_WHITE: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
-/// Creases on the other styles: dark grey.
-pub const CREASE_DARK: [f32; 4] = [0.15, 0.15, 0.15, 0.85];
+/// Baked crease lines (the file's crease and tangent edges, drawn as quads here) on the Gooch
+/// styles: white (Gooch et al. 1999, Fig. 9). The shader multiplies the alpha by the capsule's
+/// anti-aliased coverage; the display pass's image-space creases have their own colours
+/// ([`crate::passes::display::IMAGE_SPACE_CREASE_WHITE`]).
+pub const BAKED_CREASE_WHITE: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
+/// Baked crease lines on the other styles: dark grey.
+pub const BAKED_CREASE_DARK: [f32; 4] = [0.15, 0.15, 0.15, 0.85];
 
 /// The line the renderer reports when `--lines` has nothing to draw.
 pub fn notice(lines: &ModelLines) -> Option<&'static str> {
@@ -81,7 +84,7 @@ pub fn uniforms(options: &RenderOptions, camera: &crate::Camera, target_height: 
     LinesUniforms {
         clip_from_view: camera.clip_from_view.to_cols_array_2d(),
         outline_color: OUTLINE_COLOR,
-        crease_color: if gooch { CREASE_WHITE } else { CREASE_DARK },
+        crease_color: if gooch { BAKED_CREASE_WHITE } else { BAKED_CREASE_DARK },
         half_widths: [
             OUTLINE_WIDTH_PX * 0.5 * scale,
             CREASE_WIDTH_PX * 0.5 * scale,
