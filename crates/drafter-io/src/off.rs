@@ -399,6 +399,43 @@ pub(crate) mod testing {
     /// tests of other modules run in parallel threads and their arenas count too.
     #[cfg(target_os = "linux")]
     pub(crate) const PEAK_LIMIT: u64 = 2 << 30;
+
+    /// What a reader owes any input, garbage included: a mesh whose every index names one of its
+    /// vertices and that holds no more than the bytes can back (every vertex and triangle takes at
+    /// least one byte in each format), or an error with a message at a place inside the input.
+    /// Returns whether the input was read.
+    pub(crate) fn check_outcome(bytes: &[u8], result: &Result<crate::raw::RawMesh, crate::error::ParseError>) -> bool {
+        use crate::error::Place;
+        match result {
+            Ok(mesh) => {
+                let vertices = mesh.positions.len();
+                assert!(vertices <= bytes.len(), "{vertices} vertices from {} bytes", bytes.len());
+                assert!(
+                    mesh.triangles.len() <= bytes.len(),
+                    "{} triangles from {} bytes",
+                    mesh.triangles.len(),
+                    bytes.len()
+                );
+                let outside = mesh.triangles.iter().flatten().find(|&&i| i as usize >= vertices);
+                assert!(outside.is_none(), "index {outside:?} of {vertices} vertices from {bytes:?}");
+                if let Some(normals) = &mesh.normals {
+                    assert_eq!(normals.len(), vertices, "one normal per vertex");
+                }
+                true
+            }
+            Err(e) => {
+                assert!(!e.message.trim().is_empty(), "an error without a message at {}", e.place);
+                let lines = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
+                match e.place {
+                    Place::Line(line) => assert!((1..=lines).contains(&line), "{e} of {lines} lines"),
+                    Place::Byte(offset) => assert!(offset <= bytes.len() as u64, "{e} of {} bytes", bytes.len()),
+                    Place::File => {}
+                    Place::Json(_) => panic!("{e}: a JSON place from a mesh reader"),
+                }
+                false
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -575,11 +612,14 @@ OFF
     fn garbage_never_panics() {
         let mut rng = drafter_core::rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
         let alphabet = b"OFF 0123456789-.#\n e";
+        let mut outcomes = [0; 2];
         for _ in 0..2000 {
             let len = rng.below(64) as usize;
             let bytes: Vec<u8> = (0..len).map(|_| alphabet[rng.below(alphabet.len() as u64) as usize]).collect();
-            let _ = read(&bytes);
+            let read_ok = testing::check_outcome(&bytes, &read(&bytes));
+            outcomes[usize::from(read_ok)] += 1;
         }
+        assert!(outcomes[0] > 0, "none of the garbage was refused ({} read)", outcomes[1]);
     }
 
     #[test]

@@ -434,16 +434,20 @@ endsolid two facets\r
             b"endfacet ",
             b"endsolid\n",
         ];
+        let mut outcomes = [0; 2];
         for _ in 0..2000 {
             let mut bytes = Vec::new();
             for _ in 0..next() % 40 {
                 bytes.extend_from_slice(words[(next() % words.len() as u64) as usize]);
             }
-            let _ = read(&bytes);
+            let read_ok = testing::check_outcome(&bytes, &read(&bytes));
+            outcomes[usize::from(read_ok)] += 1;
             let binary_len = (next() % 300) as usize;
             let binary: Vec<u8> = (0..binary_len).map(|_| next() as u8).collect();
-            let _ = read(&binary);
+            let read_ok = testing::check_outcome(&binary, &read(&binary));
+            outcomes[usize::from(read_ok)] += 1;
         }
+        assert!(outcomes[0] > 0, "none of the garbage was refused ({} read)", outcomes[1]);
     }
 
     #[test]
