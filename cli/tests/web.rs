@@ -10,6 +10,7 @@
 
 mod common;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -117,11 +118,20 @@ fn compare_styles_on(backend: &str, name: &str, file: &Path, flags: &[&str]) {
     assert!(worst <= FRACTION, "{name} {flags:?}: the page differs from drafter render: {}", report.join("; "));
 }
 
+/// `input` baked once per test process: the tests run in parallel, and each baking into the same
+/// scratch folder (emptied first) would pull the file from under another's browser.
 fn baked(name: &str, input: &Path) -> PathBuf {
-    let dir = common::scratch(&format!("web-bake-{name}"));
-    let out = dir.join(format!("{name}.glb"));
-    common::bake(input, &out, &[]);
-    out
+    static BAKED: std::sync::Mutex<BTreeMap<String, PathBuf>> = std::sync::Mutex::new(BTreeMap::new());
+    let mut baked = BAKED.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    baked
+        .entry(name.to_owned())
+        .or_insert_with(|| {
+            let dir = common::scratch(&format!("web-bake-{name}"));
+            let out = dir.join(format!("{name}.glb"));
+            common::bake(input, &out, &[]);
+            out
+        })
+        .clone()
 }
 
 fn sample() -> PathBuf {
