@@ -6,6 +6,9 @@
 
 mod common;
 
+#[path = "../../crates/drafter-draw/tests/fixtures/block.rs"]
+mod block;
+
 use std::process::Command;
 
 #[test]
@@ -288,4 +291,73 @@ fn chromium_draws_the_svg_where_drafter_render_draws_its_lines() {
     // facing test and not by the raster's depth-jump threshold (docs/drawing.md).
     assert!(raster_in_page >= 0.97, "{raster_in_page}");
     assert!(page_in_raster >= 0.88, "{page_in_raster}");
+}
+
+/// The class groups of an SVG's visible or hidden group: (class, the group's attributes, its paths).
+fn class_groups(svg: &str, id: &str) -> Vec<(String, String, usize)> {
+    let Some(start) = svg.find(&format!(r#"<g id="{id}""#)) else { return Vec::new() };
+    let body = &svg[start..];
+    let end = body.find("\n</g>\n<g id=").or_else(|| body.find("\n</g>\n</svg>")).unwrap_or(body.len());
+    let mut groups = Vec::new();
+    for chunk in body[..end].split(r#"<g class=""#).skip(1) {
+        let (class, rest) = chunk.split_once('"').expect("class attribute");
+        let attributes = rest[..rest.find('>').expect("group tag")].to_owned();
+        groups.push((class.to_owned(), attributes, chunk.matches("<path").count()));
+    }
+    groups
+}
+
+/// `--smooth`: a block with a rounded edge, exported one glTF primitive per CAD face, has two
+/// tangent edges (plane to fillet); they are the `tangent` class drawn thin by default, dashed with
+/// `--smooth dashed`, left out with `--smooth none`, and every other line is the same in all three.
+/// A mistyped value is refused by name, with the accepted ones (exit 2, no file).
+#[test]
+fn smooth_draws_the_tangent_edges_thin_dashed_or_not_at_all() {
+    let dir = common::scratch("draw-smooth");
+    let gltf = block::write_gltf(&dir);
+    let draw = |smooth: &str| {
+        let svg = dir.join(format!("{smooth}.svg"));
+        let run = common::run(&[
+            "draw",
+            gltf.to_str().unwrap(),
+            "-o",
+            svg.to_str().unwrap(),
+            "--view",
+            "30,35",
+            "--smooth",
+            smooth,
+        ]);
+        assert!(run.status.success(), "--smooth {smooth}: {}", String::from_utf8_lossy(&run.stderr));
+        std::fs::read_to_string(&svg).unwrap()
+    };
+    let (thin, dashed, none) = (draw("thin"), draw("dashed"), draw("none"));
+    let default = {
+        let svg = dir.join("default.svg");
+        let run = common::run(&["draw", gltf.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--view", "30,35"]);
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        std::fs::read_to_string(&svg).unwrap()
+    };
+    assert_eq!(default, thin, "thin is the default");
+    let tangent = |svg: &str| class_groups(svg, "visible").into_iter().find(|(class, ..)| class == "tangent");
+    let (_, thin_attributes, thin_paths) = tangent(&thin).expect("--smooth thin draws a tangent group");
+    let (_, dashed_attributes, dashed_paths) = tangent(&dashed).expect("--smooth dashed draws a tangent group");
+    assert_eq!(thin_paths, 2, "the two borders of the fillet: {thin}");
+    assert_eq!(dashed_paths, 2);
+    assert!(!thin_attributes.contains("dasharray"), "thin is solid: {thin_attributes}");
+    assert!(dashed_attributes.contains("stroke-dasharray"), "dashed: {dashed_attributes}");
+    assert!(tangent(&none).is_none() && !none.contains(r#"class="tangent""#), "--smooth none: {none}");
+    // Every other class is drawn alike.
+    let others = |svg: &str| {
+        class_groups(svg, "visible").into_iter().filter(|(class, ..)| class != "tangent").collect::<Vec<_>>()
+    };
+    assert!(!others(&thin).is_empty());
+    assert_eq!(others(&thin), others(&dashed));
+    assert_eq!(others(&thin), others(&none));
+
+    let wrong = dir.join("wrong.svg");
+    let run = common::run(&["draw", gltf.to_str().unwrap(), "-o", wrong.to_str().unwrap(), "--smooth", "dotted"]);
+    assert_eq!(run.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("dotted") && stderr.contains("thin") && stderr.contains("dashed"), "{stderr}");
+    assert!(!wrong.exists());
 }

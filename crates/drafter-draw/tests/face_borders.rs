@@ -8,7 +8,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use drafter_draw::{self as drawing, DrawOptions, Hidden, LineStyle, Projection, Smooth};
 use drafter_scene::Model;
@@ -16,112 +16,10 @@ use drafter_scene::edges::LineClass;
 use drafter_scene::style::View;
 use glam::{DVec2, DVec3, Vec3};
 
-/// Block width, height, depth (along z) and fillet radius; the fillet rounds the edge at x = W,
-/// y = H in `FACETS` facets; the top face is split at x = `SEAM`.
-const W: f32 = 2.0;
-const H: f32 = 1.0;
-const L: f32 = 1.5;
-const R: f32 = 0.4;
-const FACETS: usize = 4;
-const SEAM: f32 = (W - R) / 2.0;
+#[path = "fixtures/block.rs"]
+mod block;
 
-/// The block's faces as (triangles in positions), one list per CAD face.
-fn faces() -> Vec<Vec<[Vec3; 3]>> {
-    // The profile in (x, y), counter-clockwise, and the face of each of its segments.
-    let mut profile = vec![(0.0f32, 0.0f32), (W, 0.0), (W, H - R)];
-    let mut face_of = vec![0usize, 1];
-    for k in 1..=FACETS {
-        let a = std::f32::consts::FRAC_PI_2 * k as f32 / FACETS as f32;
-        profile.push(if k == FACETS { (W - R, H) } else { (W - R + R * a.cos(), H - R + R * a.sin()) });
-        face_of.push(2);
-    }
-    profile.extend([(SEAM, H), (0.0, H)]);
-    face_of.extend([3, 4, 5]);
-    let mut faces: Vec<Vec<[Vec3; 3]>> = vec![Vec::new(); 8];
-    let n = profile.len();
-    for i in 0..n {
-        let ((x0, y0), (x1, y1)) = (profile[i], profile[(i + 1) % n]);
-        let (a, b, c, d) = (Vec3::new(x0, y0, 0.0), Vec3::new(x1, y1, 0.0), Vec3::new(x1, y1, L), Vec3::new(x0, y0, L));
-        faces[face_of[i]].extend([[a, b, c], [a, c, d]]);
-    }
-    // Caps: fans from the profile's first point, +z at z = L and −z at z = 0.
-    for k in 1..n - 1 {
-        let p = |i: usize, z: f32| Vec3::new(profile[i].0, profile[i].1, z);
-        faces[6].push([p(0, L), p(k, L), p(k + 1, L)]);
-        faces[7].push([p(0, 0.0), p(k + 1, 0.0), p(k, 0.0)]);
-    }
-    faces
-}
-
-/// The block as a glTF (and its .bin) in `dir`: one mesh, a primitive per face.
-fn write_gltf(dir: &Path) -> PathBuf {
-    let (mut bin, mut views, mut accessors, mut primitives) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for face in faces() {
-        let positions: Vec<Vec3> = face.iter().flatten().copied().collect();
-        let (lo, hi) = positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
-        let offset = bin.len();
-        for p in &positions {
-            for v in p.to_array() {
-                bin.extend_from_slice(&v.to_le_bytes());
-            }
-        }
-        views.push(format!(r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#, bin.len() - offset));
-        accessors.push(format!(
-            r#"{{"bufferView":{},"componentType":5126,"count":{},"type":"VEC3","min":[{},{},{}],"max":[{},{},{}]}}"#,
-            views.len() - 1,
-            positions.len(),
-            lo.x,
-            lo.y,
-            lo.z,
-            hi.x,
-            hi.y,
-            hi.z
-        ));
-        let offset = bin.len();
-        for i in 0..positions.len() as u32 {
-            bin.extend_from_slice(&i.to_le_bytes());
-        }
-        views.push(format!(r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#, bin.len() - offset));
-        accessors.push(format!(
-            r#"{{"bufferView":{},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
-            views.len() - 1,
-            positions.len()
-        ));
-        primitives.push(format!(
-            r#"{{"attributes":{{"POSITION":{}}},"indices":{}}}"#,
-            accessors.len() - 2,
-            accessors.len() - 1
-        ));
-    }
-    let json = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"name":"block"}}],"meshes":[{{"primitives":[{}]}}],"buffers":[{{"byteLength":{},"uri":"block.bin"}}],"bufferViews":[{}],"accessors":[{}]}}"#,
-        primitives.join(","),
-        bin.len(),
-        views.join(","),
-        accessors.join(",")
-    );
-    std::fs::write(dir.join("block.bin"), &bin).expect("write bin");
-    let path = dir.join("block.gltf");
-    std::fs::write(&path, json).expect("write gltf");
-    path
-}
-
-/// The same triangles as one ASCII STL solid.
-fn write_stl(dir: &Path) -> PathBuf {
-    let mut text = String::from("solid block\n");
-    for t in faces().iter().flatten() {
-        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
-        text += &format!("facet normal {} {} {}\nouter loop\n", n.x, n.y, n.z);
-        for p in t {
-            text += &format!("vertex {} {} {}\n", p.x, p.y, p.z);
-        }
-        text += "endloop\nendfacet\n";
-    }
-    text += "endsolid block\n";
-    let path = dir.join("block.stl");
-    std::fs::write(&path, text).expect("write stl");
-    path
-}
+use block::{H, L, R, SEAM, W, write_gltf, write_stl};
 
 fn scratch() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("drafter-face-borders-{}", std::process::id()));
