@@ -39,6 +39,7 @@ use drafter_core::gradient::{DEFAULT_FADE_STEP, DEFAULT_POWER, DEFAULT_QUANTIZAT
 use drafter_core::{Aabb, Diagnostic, Scene};
 use drafter_format::{BakedFile, FormatError, PartRecord, PrimitiveNormals};
 use glam::{DMat3, DMat4, DVec3, DVec4};
+use rayon::prelude::*;
 
 use crate::edges::Hierarchies;
 use crate::layout::{InstanceGpu, MaterialGpu, NO_STYLE, NOT_FLAT, PartGpu, Vertex};
@@ -238,12 +239,18 @@ impl Model {
         let mut hull_candidates = Vec::new();
         let mut faults = RecordFaults::default();
 
-        for (mesh_index, mesh) in scene.meshes.iter().enumerate() {
+        // Each mesh's hull sample on its own: independent, so on the thread pool (in mesh order).
+        let supports: Vec<Vec<DVec3>> = scene
+            .meshes
+            .par_iter()
+            .map(|mesh| {
+                crate::camera::hull_sample(&mesh.positions).into_iter().map(|i| mesh.positions[i].as_dvec3()).collect()
+            })
+            .collect();
+        for (mesh_index, (mesh, support)) in scene.meshes.iter().zip(supports).enumerate() {
             let labels = &triangle_labels[mesh_index];
             let label_count = labels.iter().copied().max().map_or(1, |m| m + 1);
             let first_instance = instances.len() as u32;
-            let support: Vec<DVec3> =
-                crate::camera::hull_sample(&mesh.positions).into_iter().map(|i| mesh.positions[i].as_dvec3()).collect();
             for instance in scene.instances.iter().filter(|i| i.mesh.index() == mesh_index) {
                 let label_base = label_to_part.len() as u32;
                 let records = instance.node.and_then(|n| node_parts.get(&n.0).copied()).filter(|r| !r.is_empty());
