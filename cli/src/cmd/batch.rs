@@ -148,20 +148,20 @@ pub fn run(args: &Args, config: BakeConfig) -> Result<()> {
         return Err(Interrupted(signal).into());
     }
     if !failures.is_empty() {
-        let done = summary.baked + summary.cached;
-        let rest = match done {
-            0 => "none was baked".to_owned(),
-            n if n + failures.len() == summary.files.len() => "the others were baked".to_owned(),
-            n => format!("{n} were baked"),
-        };
-        return Err(SomeFailed(format!(
-            "{} of {} inputs failed (listed above); {rest}",
-            failures.len(),
-            summary.files.len()
-        ))
-        .into());
+        return Err(some_failed(failures.len(), summary.files.len(), summary.baked + summary.cached, "baked").into());
     }
     Ok(())
+}
+
+/// A batch's error when `failed` of its `files` failed and `done` were made (`made`: "baked",
+/// "drawn"): exit code 4, the failures listed above it.
+pub fn some_failed(failed: usize, files: usize, done: usize, made: &str) -> SomeFailed {
+    let rest = match done {
+        0 => format!("none was {made}"),
+        n if n + failed == files => format!("the others were {made}"),
+        n => format!("{n} were {made}"),
+    };
+    SomeFailed(format!("{failed} of {files} inputs failed (listed above); {rest}"))
 }
 
 /// How a batch shows its progress.

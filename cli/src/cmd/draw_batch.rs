@@ -12,7 +12,7 @@ use drafter_catalog::batch::{self, CacheUse, Permit, Record, Status};
 use drafter_catalog::cache::Cache;
 use drafter_catalog::draw::{self, DrawSpec, Format};
 
-use crate::cmd::batch::{Bar, Interrupted, Shown, SomeFailed};
+use crate::cmd::batch::{Bar, Interrupted, Shown, some_failed};
 use crate::cmd::draw::Args;
 use crate::cmd::out;
 use crate::exit::{BadInput, IoFailure};
@@ -281,18 +281,7 @@ pub fn run(args: &Args) -> Result<()> {
         return Err(Interrupted(signal).into());
     }
     if !failures.is_empty() {
-        let done = drawn + summary.cached;
-        let rest = match done {
-            0 => "none was drawn".to_owned(),
-            n if n + failures.len() == summary.files.len() => "the others were drawn".to_owned(),
-            n => format!("{n} were drawn"),
-        };
-        return Err(SomeFailed(format!(
-            "{} of {} inputs failed (listed above); {rest}",
-            failures.len(),
-            summary.files.len()
-        ))
-        .into());
+        return Err(some_failed(failures.len(), summary.files.len(), drawn + summary.cached, "drawn").into());
     }
     Ok(())
 }
