@@ -158,6 +158,20 @@ fn a_catalog_of_sheets_draws_the_good_files_confined_and_a_rerun_is_all_cache_hi
     ]);
     assert_eq!(code, Some(0));
     assert_eq!(report(&root.join("r3.json"))["drawn"].as_u64(), Some(1));
+
+    // A manifest alone names the inputs (as `drafter bake --manifest` takes it): from the cache,
+    // the same bytes.
+    let out4 = root.join("out4");
+    let mut args: Vec<OsString> = vec!["--manifest".into(), lists.join("more.txt").into()];
+    args.extend(sheet.iter().map(OsString::from));
+    args.extend(["--format".into(), "svg".into(), "-o".into(), out4.clone().into()]);
+    args.extend(["--cache".into(), cache.clone().into(), "-q".into()]);
+    let (code, stderr) = draw(args);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        std::fs::read(out4.join("elsewhere/shaft.svg")).unwrap()
+            == std::fs::read(out.join("elsewhere/shaft.svg")).unwrap()
+    );
 }
 
 #[test]

@@ -23,7 +23,7 @@ pub struct Args {
     /// the default settings first, so it draws the lines its bake would; or folders of them
     /// (recursively). More than one input, a folder, a manifest or --format make a catalog written
     /// under `-o DIR`.
-    #[arg(value_name = "INPUT", required = true)]
+    #[arg(value_name = "INPUT", required_unless_present = "manifest")]
     pub inputs: Vec<PathBuf>,
     /// The drawing to write: .svg, .pdf (the same strokes on one page, a pixel as 0.75 pt) or .dxf
     /// (DXF R2000: a polyline per stroke on layers VISIBLE, HIDDEN and TANGENT, in millimetres, y up).
@@ -77,9 +77,10 @@ pub struct Args {
 }
 
 impl Args {
-    /// The one input of a single drawing.
+    /// The one input of a single drawing (a catalog named only by manifests has none: its
+    /// options are then checked against an empty name, which only titles and default units read).
     pub fn file(&self) -> &Path {
-        &self.inputs[0]
+        self.inputs.first().map_or(Path::new(""), PathBuf::as_path)
     }
 }
 
