@@ -256,7 +256,7 @@ fn single(args: &Args, mut config: BakeConfig) -> Result<()> {
 
     progress.step(1, "importing");
     let limits = drafter_io::Limits { max_triangles: args.max_triangles };
-    let mut on_stage = |i: usize| progress.step(2 + i, drafter_bake::STAGE_NAMES[i]);
+    let mut on_stage = |stage: drafter_bake::Stage| progress.step(2 + stage.index(), stage.name());
     let baked = drafter_catalog::bake_bytes(&input_path, bytes, &config, &limits, &mut on_stage)?;
 
     // Every file the command writes is staged first and renamed into place together, so a failure
@@ -437,7 +437,7 @@ fn check_output(
 struct Progress(Option<indicatif::ProgressBar>);
 
 /// Steps the bar counts: reading and importing, then drafter-bake's stages.
-const PROGRESS_STEPS: usize = 2 + drafter_bake::STAGE_NAMES.len() - 1;
+const PROGRESS_STEPS: usize = 2 + drafter_bake::Stage::ALL.len() - 1;
 
 impl Progress {
     fn new(enabled: bool) -> Self {

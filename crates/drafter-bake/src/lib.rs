@@ -157,17 +157,72 @@ pub struct StageTiming {
     pub ms: f64,
 }
 
-/// The stages of a bake in the order they run, as [`bake_observed`] announces them.
-pub const STAGE_NAMES: [&str; 8] = ["topology", "segment", "bounds", "normals", "lines", "textures", "write", "done"];
+/// The stages of a bake in the order they run, as [`bake_observed`] announces them; `Done` is
+/// announced when the bake has finished.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    Topology,
+    Segment,
+    Bounds,
+    Normals,
+    Lines,
+    Textures,
+    Write,
+    Done,
+}
+
+impl Stage {
+    /// Every stage, in the order a bake announces them.
+    pub const ALL: [Stage; 8] = [
+        Stage::Topology,
+        Stage::Segment,
+        Stage::Bounds,
+        Stage::Normals,
+        Stage::Lines,
+        Stage::Textures,
+        Stage::Write,
+        Stage::Done,
+    ];
+
+    /// The stage's name in progress lines and the report's timings.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Stage::Topology => "topology",
+            Stage::Segment => "segment",
+            Stage::Bounds => "bounds",
+            Stage::Normals => "normals",
+            Stage::Lines => "lines",
+            Stage::Textures => "textures",
+            Stage::Write => "write",
+            Stage::Done => "done",
+        }
+    }
+
+    /// The stage's place in [`Stage::ALL`].
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// The names of [`Stage::ALL`], in order.
+pub const STAGE_NAMES: [&str; 8] = {
+    let mut names = [""; 8];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = Stage::ALL[i].name();
+        i += 1;
+    }
+    names
+};
 
 /// Runs every stage on `scene` and writes the extended glTF in memory.
 pub fn bake(scene: &Scene, config: &BakeConfig) -> Result<Baked, BakeError> {
     bake_observed(scene, config, &mut |_| {})
 }
 
-/// [`bake`], calling `on_stage(i)` as stage [`STAGE_NAMES`]`[i]` starts (and with the last index
-/// when the bake is done), so a caller can show progress. The observer cannot change the output.
-pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMut(usize)) -> Result<Baked, BakeError> {
+/// [`bake`], calling `on_stage(stage)` as each [`Stage`] starts (and with [`Stage::Done`] when the
+/// bake is done), so a caller can show progress. The observer cannot change the output.
+pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMut(Stage)) -> Result<Baked, BakeError> {
     if scene.instanced_triangle_count() == 0 {
         return Err(BakeError::Input("the scene has no triangles to bake".into()));
     }
@@ -182,28 +237,28 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     };
     let mut stages = Vec::new();
     let mut timed =
-        |name: &'static str, time: Duration| stages.push(StageTiming { name, ms: time.as_secs_f64() * 1e3 });
-    let mut begin = |name: &str| {
-        on_stage(STAGE_NAMES.iter().position(|&n| n == name).unwrap_or(0));
+        |stage: Stage, time: Duration| stages.push(StageTiming { name: stage.name(), ms: time.as_secs_f64() * 1e3 });
+    let mut begin = |stage: Stage| {
+        on_stage(stage);
         Instant::now()
     };
 
     // Welded topology of every mesh used by an instance, built once and shared by the stages.
-    let start = begin("topology");
+    let start = begin(Stage::Topology);
     let mut topologies = build_topologies(scene, config.segment.weld);
-    timed("topology", start.elapsed());
+    timed(Stage::Topology, start.elapsed());
 
-    let start = begin("segment");
+    let start = begin(Stage::Segment);
     let (parts, mut diagnostics) = drafter_segment::segment_with_topologies(scene, &topologies, &config.segment);
     // Meshes that repeat an earlier one's geometry and parts share its normals and lines.
     let canonical = canonical_meshes(scene, &parts);
-    timed("segment", start.elapsed());
+    timed(Stage::Segment, start.elapsed());
 
     // Bounds and normals read only the scene, the topologies and the parts: they run side by side.
     // Bounds is one task per part, so a single-part mesh (the dragon: 87 ms of hull and search) ran
     // on one core while the other waited; beside the normals' many small tasks it no longer does.
     // Their timings overlap in the report.
-    begin("bounds");
+    begin(Stage::Bounds);
     let bounds_start = Instant::now();
     let (records, normals_result) = rayon::join(
         || bound_parts(scene, &parts, config).map(|records| (records, bounds_start.elapsed())),
@@ -224,14 +279,14 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         written_scene,
     } = normals;
     diagnostics.extend(normal_diagnostics);
-    timed("bounds", bounds_time);
-    timed("normals", normals_time);
+    timed(Stage::Bounds, bounds_time);
+    timed(Stage::Normals, normals_time);
     // The lines stage is where a bake's memory peaks: it starts from what is live (`heap.rs`), unless
     // the process keeps freed memory for reuse.
     heap::release_free_memory();
-    begin("normals");
+    begin(Stage::Normals);
 
-    let start = begin("lines");
+    let start = begin(Stage::Lines);
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
         let (edges, silhouettes, summary, line_diagnostics) =
             compute_lines(&written_scene, &splits, topologies, &parts, &canonical, &vertex_data, &config.lines);
@@ -240,9 +295,9 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     } else {
         (vec![Vec::new(); scene.meshes.len()], vec![None; scene.meshes.len()], None)
     };
-    timed("lines", start.elapsed());
+    timed(Stage::Lines, start.elapsed());
 
-    let start = begin("textures");
+    let start = begin(Stage::Textures);
     let metal_parts = textures::metal_parts(scene, &parts, &records, config.textures.metallic_threshold);
     let request = textures::request(&records, &metal_parts, &config.textures);
     let baked_textures = if request.is_empty() {
@@ -250,9 +305,9 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     } else {
         Some(textures::bake_memoized(&request, metal_parts, config.textures.metallic_threshold)?)
     };
-    timed("textures", start.elapsed());
+    timed(Stage::Textures, start.elapsed());
 
-    let start = begin("write");
+    let start = begin(Stage::Write);
     let root = root_record(scene, config, parts.len() as u32);
     let (instance_parts, mesh_labels) = part_records_and_labels(scene, &parts, &records);
     let (textures_summary, embedded) = match baked_textures {
@@ -286,7 +341,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     let sections = written.sections;
     let mut written = written;
     let compression = compress(config, &mut written)?;
-    timed("write", start.elapsed());
+    timed(Stage::Write, start.elapsed());
     let output_bytes = (written.main.len() + written.bin.as_ref().map_or(0, Vec::len)) as u64;
     diagnostics.sort_by_key(|d| d.kind);
     let report = BakeReport {
@@ -303,7 +358,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         textures: textures_summary,
         diagnostics,
     };
-    begin("done");
+    begin(Stage::Done);
     Ok(Baked { written, report, textures: texture_images })
 }
 
@@ -1158,6 +1213,26 @@ mod tests {
             ..Default::default()
         }];
         Mesh { name: format!("tetrahedron {material}"), positions, triangles, groups, ..Default::default() }
+    }
+
+    /// A bake announces every stage once, in the order of `Stage::ALL`, and times each but `Done`
+    /// under its name.
+    #[test]
+    fn a_bake_announces_its_stages_in_order() {
+        let mut scene = Scene::new(SourceFormat::Obj);
+        scene.meshes = vec![tetrahedron(0, 1.0)];
+        scene.instances.push(Instance {
+            name: "i".into(),
+            mesh: MeshId(0),
+            node: None,
+            world_from_object: DMat4::IDENTITY,
+        });
+        let mut seen = Vec::new();
+        let baked = bake_observed(&scene, &BakeConfig::default(), &mut |stage| seen.push(stage)).expect("a bake");
+        assert_eq!(seen, Stage::ALL);
+        let timed: Vec<&str> = baked.report.stages.iter().map(|t| t.name).collect();
+        assert_eq!(timed, STAGE_NAMES[..STAGE_NAMES.len() - 1]);
+        assert!(Stage::ALL.iter().enumerate().all(|(i, s)| s.index() == i && STAGE_NAMES[i] == s.name()));
     }
 
     /// A mesh repeats the first used mesh with its geometry and parts, whatever its name and

@@ -78,7 +78,7 @@ pub fn read_input(path: &Path) -> Result<Vec<u8>, Error> {
 
 /// Bakes `bytes`, read from `path` (which names the file in errors and in the output's provenance,
 /// and resolves a glTF's external buffers and images), with `config` (whose `input` is replaced by
-/// the file's) within `limits`. `on_stage(i)` is called as stage `drafter_bake::STAGE_NAMES[i]`
+/// the file's) within `limits`. `on_stage(stage)` is called as each `drafter_bake::Stage`
 /// starts. The caller's `bytes` are dropped after the import: the scene keeps what the writer
 /// needs, and the bake's memory peaks later.
 pub fn bake_bytes(
@@ -86,7 +86,7 @@ pub fn bake_bytes(
     bytes: Vec<u8>,
     config: &BakeConfig,
     limits: &drafter_io::Limits,
-    on_stage: &mut dyn FnMut(usize),
+    on_stage: &mut dyn FnMut(drafter_bake::Stage),
 ) -> Result<Baked, Error> {
     // The input's digest (for the provenance) beside the import: 9 ms of one core on the dragon.
     let (imported, digest) =
