@@ -54,8 +54,7 @@ pub fn prefetch<T>(item: &T) {
 
 /// `len` copies of `value`, written on the thread pool. For arrays of tens of megabytes whose
 /// elements are all overwritten later, but whose first writes must come first: the first touch of
-/// each page costs more than the write itself, and `vec![value; len]` does all of it on one core
-/// (a 73 MB scratch array took 50 ms that way on the dragon).
+/// each page costs more than the write itself, and `vec![value; len]` does all of it on one core.
 pub fn filled_in_parallel<T: Copy + Send + Sync>(len: usize, value: T) -> Vec<T> {
     use rayon::prelude::*;
     let mut items = Vec::new();

@@ -43,8 +43,8 @@ pub fn snorm8_encode_direction(input: Vec3) -> [i8; 3] {
     let n = input.as_dvec3().normalize();
     let s = n * 127.0;
     // Floor and ceiling through a truncating conversion (|s| ≤ 127 plus rounding): the baseline
-    // x86-64 target has no rounding instruction, and the library calls held a sixth of this
-    // function's samples in a profile of the dragon's bake. Only the sign of a zero can differ
+    // x86-64 target has no rounding instruction, and the library calls were a large share of this
+    // function's time in profiles of a bake. Only the sign of a zero can differ
     // from `f64::floor`, which no product, sum or cast below sees.
     let floor_ceil = |x: f64| {
         let t = x as i64 as f64;
@@ -53,9 +53,8 @@ pub fn snorm8_encode_direction(input: Vec3) -> [i8; 3] {
     let [(lx, hx), (ly, hy), (lz, hz)] = [s.x, s.y, s.z].map(floor_ceil);
     let (lo, hi) = (glam::DVec3::new(lx, ly, lz), glam::DVec3::new(hx, hy, hz));
     // All eight points are scored without skipping any (a point too long or short scores −∞),
-    // and the first of the largest cosines wins: 114 ns a call against 140 ns for a loop that
-    // skipped them, and 176 ns before the integer length test (a million random directions,
-    // one thread of this 2-core machine). Equal to the rule as stated (test
+    // and the first of the largest cosines wins: a loop without branches to mispredict is faster
+    // than one that skips the points out of range. Equal to the rule as stated (test
     // `the_direction_encoder_is_its_rule`).
     #[cfg(target_arch = "x86_64")]
     #[allow(unsafe_code)]
@@ -102,9 +101,9 @@ fn lattice_cosines(lo: glam::DVec3, hi: glam::DVec3, n: glam::DVec3) -> [f64; 8]
 /// [`lattice_cosines`] with AVX, points 0–3 and 4–7 in one vector each: the same operations per
 /// lane in the same order (glam's dot product `(x·x' + y·y') + z·z'`, the clamp as a maximum then
 /// a minimum, no fused multiply-add), so the same bits; the 8 square roots and divisions take 2
-/// instructions each. The encoder runs once per face of every silhouette candidate (the dragon's
-/// 871k faces) and was about half of the edge encoding's time (docs/bench.md); this cut the
-/// dragon's lines stage by about 30 ms.
+/// instructions each. The encoder runs once per face of every silhouette candidate, and its byte
+/// rounding is a large share of the edge encoding's time
+/// (docs/bench.md#where-the-dragons-lines-stage-goes).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[allow(unsafe_code)]

@@ -271,7 +271,7 @@ const SNAP_SAMPLE: usize = 4096;
 /// vertices), times 64, is used instead. A finer grid never merges what a coarser one kept apart, so
 /// this can only leave float noise on the outliers themselves unwelded. One
 /// vertex moved to 1e19 would otherwise make the grid 1e10 wide and weld the whole model into a
-/// point, and every later stage would pay for that collapse (issue 21, class 3). For a model
+/// point, and every later stage would pay for that collapse. For a model
 /// without such outliers the core spans more than 1/64 of the box and nothing changes.
 fn snap_scale(positions: &[Vec3]) -> f64 {
     robust_diagonal(positions)
@@ -371,11 +371,10 @@ type Entry<K> = (u32, u64, K);
 /// vertex order within a bucket), then each bucket finds, for each of its vertices, the first
 /// earlier vertex with an equal key, over a table of its own that stays in cache; a last pass in
 /// vertex order numbers the clusters ([`number_clusters`]). The serial pass probes one table of
-/// twice the vertex count at random, which misses the cache more as the mesh grows (about a third
-/// of the dragon's serial topology time in a profile; with this, the dragon's topology stage went
-/// from 113–136 to 102–110 ms at two threads, docs/bench.md "Scaling"). It holds each vertex's
-/// hash and key twice while it sorts (80 bytes a vertex with the snapped key, against the serial
-/// table's 8 to 16): 35 MB on the dragon, far below the peak of the later lines stage (380 MB).
+/// twice the vertex count at random, which misses the cache more as the mesh grows; here every
+/// probe stays in a bucket's small table (docs/bench.md#scaling). It holds each vertex's hash and
+/// key twice while it sorts (80 bytes a vertex with the snapped key, against the serial table's 8
+/// to 16), which stays far below the peak of the later lines stage.
 fn weld_partitioned<K: Copy + PartialEq + Send + Sync>(
     positions: &[Vec3],
     key_of: &(impl Fn(Vec3) -> K + Sync),
@@ -656,9 +655,9 @@ fn build_adjacency(faces: &[[u32; 3]], corner_counts: Vec<u32>, collapsed_faces:
 
 /// How many vertices ahead the walk of [`build_adjacency`] prefetches the faces (and their edge
 /// slots) around a vertex. Where the vertex order scatters a vertex's faces over the face array
-/// (the scaling benchmark's subdivision order), every face read missed the cache: at 2.18M
-/// triangles the walk took 380 ms in that order against 174 ms in first-use order, and 195–216
-/// against 145–173 ms with this (8 ahead gave the same); the dragon's walk 85–92 → 82–83 ms.
+/// (the scaling benchmark's subdivision order), every face read would miss the cache; fetched this
+/// far ahead, the reads have arrived by the time the walk needs them, and in first-use order the
+/// prefetches cost next to nothing (docs/bench.md#scaling). Half the distance did as well.
 const WALK_PREFETCH_AHEAD: usize = 16;
 
 /// Room for the keys of a vertex with fewer than `SMALL_KEYS / 2` faces (two keys per face and a
