@@ -75,8 +75,8 @@ fn for_each_link(topo: &Topology, pairing: FanPairing, link: impl Fn(u32, u32) +
                     2 => link(faces[0], faces[1]),
                     _ => {
                         // A face repeated in the same orientation is the same surface twice: the copies
-                        // join the first and the fan is paired without them (2,000 copies of one face
-                        // would otherwise make 2,000 one-triangle parts, issue 21 class 3).
+                        // join the first and the fan is paired without them (otherwise every copy would
+                        // be a one-triangle part, and the merge of small parts quadratic in the copies).
                         let distinct = distinct_faces(topo, faces, &link);
                         let pairing = match distinct.len() {
                             1 => {
@@ -230,7 +230,7 @@ fn radial_pairs(
     Pairing::Full
 }
 
-/// Pairs what can be paired in a fan that does not alternate (issue 17): an odd count, or a
+/// Pairs what can be paired in a fan that does not alternate: an odd count, or a
 /// closing face missing, where a part whose surface is cracked (a T-junction seam, its faces
 /// meeting the edge on one side only) touches a closed solid along one of the solid's edges.
 ///

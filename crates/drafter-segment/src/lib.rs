@@ -27,7 +27,7 @@
 //!   each other are reordered to keep the alternation (coincident faces where two solids touch
 //!   along a face, zero-thickness sheets). Inside-out vertex-connected components (negative
 //!   signed volume) are read reversed. A fan that cannot be made to alternate (odd count, open
-//!   surfaces, overlapping solids) is paired **in part** (issue 17): in the same order (closing
+//!   surfaces, overlapping solids) is paired **in part**: in the same order (closing
 //!   faces first among equal angles), an opening face is linked to the next face around the edge
 //!   when that one closes, since the wedge between them holds no other face and so is one
 //!   solid's; faces left over are free edges of their parts. This is the case of a part with a
@@ -92,12 +92,11 @@
 //! mistake costs: a part is at least `1 / (1 + f)` its core component plus what came through
 //! shared vertices. Merging happens only inside one mesh's segmentation, never across instances.
 //!
-//! Measured with the defaults, each glTF assembly merged into one mesh (`tests/real_models.rs`,
-//! `examples/segment_bench.rs`): ≥ 99.8% of triangles in parts that are ≥ 99% one original
-//! instance (100% for six of the seven); parts per original instance 1.0 (RodAssembly), 1.2
-//! (2CylinderEngine), 1.3 (FM1Satellite, ReciprocatingSaw), 1.5 (Buggy), 2.2 (CycloidalDrive,
-//! GearboxAssy: meshes that hold several separate solids, such as a bearing and its balls).
-//! Single meshes: motor.stl 17 solids, crank.off 1, bearing.stl 1.
+//! `tests/real_models.rs` holds the defaults to their purpose on every glTF assembly of
+//! ../shared/models merged into one mesh: at least 99% of triangles in parts that are at least
+//! 99% one original instance. More parts than instances come from meshes that hold several
+//! separate solids, such as a bearing and its balls. The figures per assembly, with the command
+//! that prints them: docs/bench.md#segmentation-where-parts-touch.
 //!
 //! # Cracks
 //!
@@ -119,23 +118,19 @@
 //! Gluing is a statement about geometry, not about the file: open surfaces of two *different*
 //! parts whose rims seal each other are glued too, and nothing in a merged mesh tells them from
 //! the pieces of one cracked part. On the merged ReciprocatingSaw (every instance in world
-//! space) open bodies of consecutive nodes meet rim to rim within 1e-6 of the diagonal, and a
-//! tolerance of 1e-6 glued them across nodes (98.4% of triangles in parts that are one node);
-//! 2CylinderEngine's cracks need 1e-5 to close all. The default, 1e-7 (the rounding of f32
+//! space) open bodies of consecutive nodes meet rim to rim within 1e-6 of the diagonal, so a
+//! tolerance of 1e-6 glues them across nodes, while 2CylinderEngine's cracks need 1e-5 to close
+//! all. The default, 1e-7 (the rounding of f32
 //! coordinates near the origin), glues no two nodes of any merged assembly here. Glued pieces are
 //! counted in a diagnostic ([`DiagnosticKind::GluedCrack`]).
 //!
-//! Measured (`tests/contacts.rs` over `drafter_bench::assemblies`: generated clamped gaskets,
+//! `tests/contacts.rs` runs this over `drafter_bench::assemblies` (generated clamped gaskets,
 //! washers under screw heads, pins pressed into holes, stacked plates, covers over casings with a
-//! gasket, each with matching, non-matching and cracked tessellation): every part recovered,
-//! 100% of triangles in a matching part, on all 21 (20 before gluing: the pin cracked all the
-//! way round came out as two parts). On each glTF assembly of ../shared/models merged into one
-//! unwelded mesh, against its solids (an instance whose mesh holds several separate closed
-//! bodies counts as that many parts, `drafter_bench::assemblies::flatten_solids`): 100% on
-//! CycloidalDrive, GearboxAssy and RodAssembly, 2CylinderEngine 86.8% → 94.1% with gluing,
-//! ReciprocatingSaw 96.8%, FM1Satellite 90.3% (open pieces that float off their part), Buggy
-//! 87.1% (hundreds of open pieces that share no vertex with their part and seal against it, if
-//! at all, only at 1e-4 of the diagonal).
+//! gasket, each with matching, non-matching and cracked tessellation) and requires every part
+//! recovered on all of them; without gluing, a pin cracked all the way round comes out as two
+//! parts. On the glTF assemblies of ../shared/models merged into one unwelded mesh, what stays
+//! apart is open pieces that share no vertex with their part and seal against it, if at all, only
+//! at 1e-4 of the diagonal, or float off it (docs/bench.md#segmentation-where-parts-touch).
 //!
 //! # Determinism
 //!
@@ -162,9 +157,10 @@
 //!
 //! # Cost
 //!
-//! Linear apart from the weld inside [`Topology::build`], which dominates. On the 871k-triangle
-//! dragon (one thread, CPU time): building the topology 123 ms, [`segment_with_topologies`] with
-//! it given 31 ms (edge links, union-find, labels); two threads halve the link pass. A pipeline
+//! Linear apart from the weld inside [`Topology::build`], which dominates: with the topology
+//! given, [`segment_with_topologies`] (edge links, union-find, labels) costs a fraction of
+//! building it, and the link pass runs on the thread pool (`examples/segment_bench.rs` times the
+//! two against each other). A pipeline
 //! that builds the topologies for other stages anyway should pass them. Merging costs a pass
 //! over the triangles against a grid of the small parts' boundary vertices, only when small parts
 //! exist; `Nodes` (and `Auto` on a scene with several instances) costs nothing per triangle.
@@ -257,8 +253,8 @@ impl std::str::FromStr for SegmentMode {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FanPairing {
-    /// Pair only fans that alternate completely; any other fan links nothing (the rule before
-    /// issue 17, kept for comparison: `drafter bench` charts both).
+    /// Pair only fans that alternate completely; any other fan links nothing (the earlier rule,
+    /// kept for comparison: `drafter bench` charts both).
     Whole,
     /// Also pair, in part, fans that do not alternate; the faces left over are free edges.
     #[default]
@@ -433,8 +429,8 @@ fn segment_mesh(
     };
     // The fractions below are of the robust diagonal: one stray vertex must not make every free
     // edge "near" (stitch), nor every part "small" and every probe "touching" every triangle (merge:
-    // a vertex moved to 4.29e9 in a 17,000-triangle OBJ of 3,000 components took 3.6 s and 1.2 GB
-    // of contact pairs; drafter-fuzz, issue 47's campaign).
+    // the contact pairs would grow with the product of probes and triangles;
+    // `tests/regressions/obj/separate-triangles-one-far-vertex.obj`).
     let diagonal = drafter_core::robust_diagonal(&mesh.positions);
     let mut glued = 0;
     if merge && options.stitch_fraction > 0.0 && labelling.count > 1 {

@@ -294,8 +294,8 @@ fn probe_contacts(topo: &Topology, labels: &[u32], probes: &[(u32, u32)], tol: f
         // Each fold's pairs are sorted and deduplicated whenever they have doubled since the last
         // time (from 2^20 on): every triangle of a label near a probe finds it again, and a dense
         // cluster (probes within the tolerance of thousands of triangles of a few hundred labels)
-        // held one pair per probe and triangle, 1.07 GB for a 600 KB OFF (drafter-fuzz, issue 47's
-        // campaign).
+        // would otherwise hold one pair per probe and triangle, gigabytes for an input of a few
+        // hundred kilobytes (`tests/regressions/obj/dense-cluster-of-strips.obj`).
         let spatial: Vec<(u32, u32)> = (0..labels.len())
             .into_par_iter()
             .with_min_len(4096)

@@ -1,4 +1,4 @@
-//! Gluing the open pieces of one part across cracks (issue 17). The rule is in the crate docs
+//! Gluing the open pieces of one part across cracks. The rule is in the crate docs
 //! ("Cracks"); this is how it is computed.
 //!
 //! A *free segment* is an edge of a face that no other face of its label shares (a boundary edge,

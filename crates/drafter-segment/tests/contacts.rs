@@ -1,7 +1,7 @@
-//! Issue 17: parts that touch (clamped, pressed, stacked) recovered from one merged, unwelded
+//! Parts that touch (clamped, pressed, stacked) recovered from one merged, unwelded
 //! mesh. The generated family is `drafter_bench::assemblies`; the real assemblies are every glTF
 //! assembly of ../shared/models flattened into one triangle soup (the true part of a triangle is
-//! its instance). The issue's bar: at least 99% of triangles in a part that matches one original
+//! its instance). The bar: at least 99% of triangles in a part that matches one original
 //! part (`assemblies::accuracy`), and the right part count. Figures are printed; run with
 //! `--nocapture` to see them.
 //!

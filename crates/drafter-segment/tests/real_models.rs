@@ -1,6 +1,6 @@
 //! Segmentation of real models from ../shared/models (third-party data, see its README).
 //!
-//! The "Done means": a glTF assembly merged into one single-mesh scene (every instance's
+//! The purpose of `Auto`: a glTF assembly merged into one single-mesh scene (every instance's
 //! triangles in world space, as an STL export of the assembly would be) comes back from `Auto` as
 //! its parts: at least 99% of triangles land in a part whose triangles all come from one original
 //! instance. Figures are printed; run with `--nocapture` to see them.

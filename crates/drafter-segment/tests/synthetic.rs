@@ -119,7 +119,7 @@ fn cubes_sharing_an_edge_are_paired_into_two_solids() {
 #[test]
 fn a_face_repeated_in_the_same_orientation_joins_its_solid() {
     // A face written 50 more times, same vertices in the same order: the same surface, not 50
-    // one-triangle parts (issue 21: 10,000 copies made the merge quadratic).
+    // one-triangle parts (with many copies, the merge of small parts would be quadratic).
     let mut mesh = Mesh::default();
     add_box(&mut mesh, Vec3::ZERO, Vec3::ONE, 1);
     let first = mesh.triangles[0];
@@ -522,7 +522,7 @@ fn thousands_of_open_slivers_through_one_point_are_not_searched_pairwise() {
 fn one_long_free_edge_among_tiny_ones_does_not_blow_up_the_grid() {
     // Found by the fuzz campaign: 300 separate triangles a nanometre wide near the origin and one
     // large triangle. The grid cell follows the tiny edges; the large triangle's edges must still
-    // touch a bounded number of cells (they once asked for 8 GB).
+    // touch a bounded number of cells, or the grid would ask for gigabytes.
     let mut mesh = Mesh::default();
     for i in 0..300u32 {
         let o = Vec3::new(i as f32 * 3e-9, 0.0, 0.0);
