@@ -44,22 +44,23 @@
 //! [`ObbOptions::optimal_budget`]: a hull with more faces than the budget affords is searched over its
 //! largest faces only, and when the edge configurations would take more steps than the budget they are
 //! skipped ([`Coverage::OverBudget`]) and the refinement from the best face-flush boxes stands in. On the
-//! 664 parts of ../shared/models the edge configurations improved on faces + refinement by 4e-6 on
-//! average and by 1.1e-3 at most, so the budget is a cheap trade (6 parts hit it). Edges between
-//! coplanar hull triangles are not creases and never enter cases 2–3 (such contacts are face contacts,
-//! case 1). Against trimesh 5.2.0's `oriented_bounds` on the same 658 solid parts: never larger (largest
-//! ratio 1 + 1e-9, rounding), smaller on 104 parts, by up to 19% (spot.obj).
+//! parts of ../shared/models the edge configurations improve on faces + refinement by a tiny fraction of
+//! the volume, and few parts hit the budget, so it is a cheap trade. Edges between coplanar hull
+//! triangles are not creases and never enter cases 2–3 (such contacts are face contacts, case 1).
+//! Against trimesh's `oriented_bounds` on the same points it is never larger, and smaller on many parts
+//! (docs/bench.md#oriented-boxes-over-the-corpus).
 //!
 //! # Default
 //! The same machinery with fixed small effort: the PCA and hull-covariance frames, the exact rectangle
 //! under their six axes and under the [`ObbOptions::default_face_normals`] largest distinct hull faces,
-//! then the pattern search (from 0.05 rad down to 2e-5 rad) from the two best. Measured against
-//! `Optimal` on the 661 solid parts of ../shared/models: mean volume ratio 1.000005, worst 1.0014, in
-//! about 2.4 ms per part on average (hull included; 2 shared cores); see `examples/obb_bench.rs`.
+//! then the pattern search (from 0.05 rad down to 2e-5 rad) from the two best. Its volume against
+//! `Optimal` over the parts of ../shared/models is in docs/bench.md#oriented-boxes-over-the-corpus;
+//! `examples/obb_bench.rs` times both.
 //!
 //! DiTO (Larsson & Källberg 2011, "Fast computation of tight-fitting oriented bounding boxes") was not
 //! needed: its strength is speed without a hull, but the hull is needed anyway for `Default`'s
-//! exact rectangles, and on these parts `Default` is within 0.14% of `Optimal` at a few milliseconds.
+//! exact rectangles, and on these parts `Default` is already within a fraction of a percent of
+//! `Optimal` at a small part of its cost.
 //!
 //! # Precision, degenerate input, determinism
 //! * All computation is in f64 relative to the centre of the points' axis-aligned box, so a part far from
@@ -292,7 +293,7 @@ pub fn oriented_box_with_stats(points: &[DVec3], options: &ObbOptions) -> Result
             ObbMethod::Hull => hull_covariance_axes(&hull),
             // Tiny hulls: the exhaustive search costs about what the heuristic does (a few hundred
             // microseconds at most) and catches edge-flush minima the face heuristic misses, e.g.
-            // a tetrahedron (the corpus had one at 1.17x before this rule).
+            // on a tetrahedron.
             ObbMethod::Default if hull.triangles.len() <= DEFAULT_EXHAUSTIVE_HULL_FACES => {
                 optimal_axes(&local, &hull, options, &mut stats)
             }
