@@ -22,8 +22,8 @@ use crate::face::{FACE_CHUNK, FaceGeometry};
 /// `h` of [`Weighting::ScaleDependent`] as a multiple of the median centroid distance between
 /// neighbours. 2 leaves ordinary size variation alone (a uniform mesh is filtered exactly as with area
 /// weights) and damps only neighbours more than twice as far as usual; chosen by the tessellation survey
-/// (crate docs), where 1, 1.5, 2, 3 and 4 gave 1.71°, 1.29°, 1.28°, 1.55° and 1.75° mean deviation from
-/// refine-then-filter (area weights: 2.36°).
+/// (crate docs), where of the factors tried it deviated least from refine-then-filter (figures in
+/// `bench/normals/README.md`).
 pub const SCALE_REFERENCE_FACTOR: f32 = 2.0;
 
 /// Which faces count as neighbours of a face in the low-pass filter.
@@ -72,9 +72,8 @@ pub enum Weighting {
 ///
 /// The packed rows of a large mesh whose face order scatters neighbours ([`SWEEP_ORDER_MIN_FACES`],
 /// [`scattered`]) are stored in *sweep order*, a breadth-first order of the faces ([`SweepOrder`]),
-/// so that the neighbours a row reads lie within a short window around it: in the dragon's input
-/// order a face's neighbours lie up to 98,000 faces away (p90 6,100), in breadth-first order at
-/// most 1,670.
+/// so that the neighbours a row reads lie within a short window around it, where a scan's input
+/// order can put them tens of thousands of faces away (docs/bench.md#normals).
 /// Each row keeps its neighbours in the sequence of the face's own row, so every sum has the same
 /// terms in the same order as in face order, and the result does not depend on the order.
 #[derive(Clone, Debug, Default)]
@@ -345,17 +344,16 @@ impl FaceAdjacency {
 
 /// From this many faces, packed rows may be stored in sweep order. Below it the filter's arrays
 /// (about 60 bytes a face per step) stay in cache in any order, and ordering would cost more than it
-/// saves: on GearboxAssy (42 meshes, the largest 42k faces) the bake spent 3–7 % more CPU time with
-/// every mesh ordered.
+/// saves: an assembly of many meshes of a few tens of thousands of faces (GearboxAssy) spent more CPU
+/// time with every mesh ordered.
 const SWEEP_ORDER_MIN_FACES: usize = 1 << 16;
 
 /// Whether the face order scatters neighbours: more than [`SCATTERED_SHARE`] of the neighbour pairs of
 /// every 61st row lie more than [`NEAR_FACES`] faces apart. Ordering costs about 20 bytes a face at
 /// the stage's peak and the serial breadth-first pass; it pays only where the face order is poor.
-/// Measured share beyond 4,096 faces: the dragon's scan order 31 % (its filter 0.15 → 0.07–0.10 s at
-/// two threads with the order), the 4:1 subdivisions of the scaling benchmark 9 % at 136k faces, 5 %
-/// at 546k, 3 % at 2.18M (their filter no faster with the order, and the 2.18M bake's peak
-/// 542 → 592 MB with the order alone).
+/// The threshold separates the dragon's scan order, whose filter the order speeds up, from the
+/// scaling benchmark's subdivisions, whose filter it does not speed up while it raises their peak;
+/// their shares are in docs/bench.md#normals.
 fn scattered(rows: &[[u32; 3]]) -> bool {
     let padding = rows.len() as u32;
     let (mut far, mut pairs) = (0usize, 0usize);
@@ -406,9 +404,9 @@ fn breadth_first_order(rows: &[[u32; 3]]) -> SweepOrder {
     SweepOrder { face, position }
 }
 
-/// How many queued faces ahead the breadth-first order loads rows. On the dragon, one thread, a
-/// temporary example: 60–71 ms for the order with a separate visited array and no prefetch, 22–26 ms
-/// with the position array as the visited flag and this prefetch.
+/// How many queued faces ahead the breadth-first order loads rows. The order is built serially, so
+/// it must not wait on memory: the position array doubles as the visited flag, and each row is
+/// requested this far ahead of its use.
 const BFS_PREFETCH_AHEAD: usize = 8;
 
 /// How many rows (or entries) the median of [`Weighting::ScaleDependent`] samples, evenly strided.

@@ -32,7 +32,7 @@
 //! |---|---|---|
 //! | [`EnhanceOptions::strength`] `k` | [`DEFAULT_STRENGTH`] = 0.5 | paper: 0.2–0.7. Higher: more contrast at features, and flat faces next to features look slightly concave (§5.1). |
 //! | [`EnhanceOptions::iterations`] | [`DEFAULT_ITERATIONS`] = 20 | paper: 10–30. More: a wider shaded band along features; small features fade out of `n_L` and lose their own contrast (Fig. 6). |
-//! | [`EnhanceOptions::neighborhood`] | [`Neighborhood::Edge`] | as the paper and MeshLab; `Vertex` reaches about twice as far per iteration at about 4× the cost. |
+//! | [`EnhanceOptions::neighborhood`] | [`Neighborhood::Edge`] | as the paper and MeshLab; `Vertex` reaches about twice as far per iteration at several times the cost. |
 //! | [`EnhanceOptions::weighting`] | [`Weighting::ScaleDependent`] | area weights, damped by `(h/d)²` for neighbours farther than `h` = 2× the median centroid distance; equals area weighting on uniform meshes. |
 //! | [`CreaseOptions::crease_angle_deg`] | [`DEFAULT_CREASE_ANGLE_DEG`] = 30 | edges with a larger dihedral angle stay hard. |
 //! | [`CreaseOptions::weighting`] | [`VertexWeighting::Angle`] | corner-angle weights: a fan of slivers does not outvote one large triangle. |
@@ -41,21 +41,19 @@
 //! # Uneven tessellation (§4.1): scale-dependent weights by default, refinement opt-in
 //!
 //! The paper's filter assumes small, uniform triangles; it offers two remedies: split faces larger than
-//! a threshold, or weight by size. Measured with `examples/tessellation_survey.rs` on 24 CAD models of
-//! `../shared/models` (463k triangles; figures in `bench/normals/README.md`):
+//! a threshold, or weight by size. `examples/tessellation_survey.rs` measures both on the CAD models of
+//! `../shared/models` (its figures, with the command, are in `bench/normals/README.md`):
 //!
-//! * Most CAD exports are uneven: averaged over the models by face count, 45% of the surface lies in
-//!   triangles whose longest edge exceeds 4× the median edge, the 99th percentile of a face's
-//!   longest/shortest edge is ~100 and that of the area ratio between neighbours ~700. The remeshed
-//!   research sets (fandisk, block, joint, partLp, casting, ...) are uniform (neighbour area ratio
-//!   p99 ≤ 5).
-//! * Refining to edges ≤ 4× the median edge ([`refine`]) costs +363% triangles overall, +50× on
-//!   ADIS16480 (budget hit), +8× on ReciprocatingSaw, +3× on pinion: the paper's own warning ("even by
-//!   a factor of ten or more", §4.2). Every triangle is carried into the baked file.
+//! * Most CAD exports are uneven: a large share of their surface lies in triangles whose longest edge
+//!   exceeds 4× the median edge, and neighbouring faces differ in area by orders of magnitude. The
+//!   remeshed research sets (fandisk, block, joint, partLp, casting, ...) are uniform.
+//! * Refining to edges ≤ 4× the median edge ([`refine`]) multiplies the triangles of such models, on
+//!   some by far more than ten: the paper's own warning ("even by a factor of ten or more", §4.2).
+//!   Every triangle is carried into the baked file.
 //! * Taking refine-then-filter (area weights) as the reference, the filter on the *unrefined* mesh
-//!   deviates by a mean of 2.36° with area weights, 6.1° with uniform weights, and 1.28° with
-//!   scale-dependent weights (`h` = 2× median; 1.71° with 1×, 1.75° with 4×), while staying identical to
-//!   area weights on the uniform models.
+//!   lands closest to it with scale-dependent weights (`h` = 2× median, the best of the factors
+//!   tried), closer than with area or uniform weights, while staying identical to area weights on the
+//!   uniform models.
 //!
 //! So the default is [`Weighting::ScaleDependent`] with no refinement; [`refine`] stays available,
 //! opt-in and bounded ([`RefineOptions::max_added_ratio`], default: at most doubling), and its
@@ -65,9 +63,9 @@
 //!
 //! MeshLab's "UnSharp Mask Normals" (`FP_UNSHARP_NORMAL`; pymeshlab
 //! `apply_normal_unsharp_mask_per_vertex`) is the same paper with edge neighbours and area weights; with
-//! [`Weighting::Area`] our per-face `n_E` agree to a mean of 0.0002° on fandisk, 0.004° on the
-//! Stanford bunny and 0.09° on the dragon (`bench/normals/compare_meshlab.py`, figures in
-//! `bench/normals/README.md`). Remaining differences, all deliberate: MeshLab does not weld (the dragon
+//! [`Weighting::Area`] our per-face `n_E` agree with MeshLab's to a small fraction of a degree on
+//! average (`bench/normals/compare_meshlab.py`, figures in `bench/normals/README.md`). Remaining
+//! differences, all deliberate: MeshLab does not weld (the dragon
 //! has 2,100 duplicate positions, which we weld), counts a face itself once more across each boundary
 //! edge, and takes one neighbour across a non-manifold edge (we take none: such an edge bounds the
 //! filter, see [`Neighborhood::Edge`]); it leaves `n_E` unnormalised

@@ -193,8 +193,8 @@ struct Grouping<'a> {
 /// faces; `[EDGE_NONE; 2]` for every other edge.
 ///
 /// Each edge is decided once here, in edge order, instead of four times (from both faces, at both
-/// ends) with three random reads each inside the per-vertex loop. Measured alone on the dragon it
-/// saved little (layout 0.41 → 0.40 s at one thread); the corner angles below were the larger cost.
+/// ends) with three random reads each inside the per-vertex loop. On its own this saves little; the
+/// corner angles below are the larger cost.
 fn smooth_pairs(topology: &Topology, geometry: &FaceGeometry, cos_crease: f32) -> Vec<[u32; 2]> {
     let mut pairs = Vec::new();
     (0..topology.edge_count())
@@ -321,9 +321,8 @@ impl Grouping<'_> {
             }
             // The common case: no degenerate face (a face then holds `v` at one corner only) and
             // one smooth fan. Its corners in face order are what step 3 emits after its sort, so
-            // the sort and step 3's second read of every face are skipped. On the dragon (98 % of
-            // its vertices) the grouping went from 95–100 to 57–72 ms at two threads (temporary
-            // timers, `normals_bench`).
+            // the sort and step 3's second read of every face are skipped. Nearly every vertex of a
+            // smooth mesh takes this path, so it is most of the grouping's time (`normals_bench`).
             if !any_degenerate && (1..faces.len()).all(|i| find(&mut parent, i) == 0) {
                 let mut source = u32::MAX;
                 for (&f, &c) in faces.iter().zip(&corner_at) {
@@ -451,12 +450,10 @@ impl Grouping<'_> {
 /// How many welded vertices ahead the grouping prefetches the faces around a vertex (their
 /// corners, edges and areas), and how many edges ahead [`smooth_pairs`] prefetches its faces'
 /// areas and normals. Where the vertex order scatters a vertex's faces over the arrays (the scaling
-/// benchmark's subdivision order), these reads missed the cache: at 2.18M triangles the layout took
-/// 597 ms in that order against 288 ms in first-use order, and about 390 against 300 ms with this
-/// (smooth pairs 59 → 30 ms). Prefetching the vertex normals' face normals and the layout's
-/// triangle writes measured no gain and is not done; nor did the input triangles (the sources) and
-/// the smooth pairs of the fans 8 vertices ahead (dragon grouping 62–75 ms with them against 57–72
-/// without, five alternating runs).
+/// benchmark's subdivision order), these reads would miss the cache; fetched this far ahead, they
+/// have arrived when the grouping needs them (docs/bench.md#scaling). Prefetching the vertex
+/// normals' face normals, the layout's triangle writes, the input triangles (the sources) or the
+/// smooth pairs of the fans gained nothing measurable, so it is not done.
 const LAYOUT_PREFETCH_AHEAD: usize = 16;
 
 fn find(parent: &mut [u32], mut x: usize) -> u32 {
@@ -513,8 +510,8 @@ fn corner_angles(p: [DVec3; 3]) -> [f32; 3] {
 
 /// `atan2(sine, cosine)` for `sine ≥ 0`, in [0, π], within 2e-7 rad (tested against f64 `atan2`).
 ///
-/// Written here because libm's arctangent (f64 or f32) was a fifth of the vertex layout's time on the
-/// dragon: three per triangle. Cephes' `atanf` reduction to |x| ≤ tan(π/8) and its degree-9 odd
+/// Written here because libm's arctangent (f64 or f32) was a large share of the vertex layout's
+/// time: three per triangle. Cephes' `atanf` reduction to |x| ≤ tan(π/8) and its degree-9 odd
 /// polynomial (Moshier, *Methods and Programs for Mathematical Functions*, 1989), evaluated in f64.
 #[inline]
 fn angle_of(sine: f64, cosine: f64) -> f32 {
