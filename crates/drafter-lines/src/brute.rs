@@ -23,10 +23,9 @@
 //! for perspective), padded with zero normals to a multiple of 64 (a zero normal never passes the
 //! predicate). Each block of 64 candidates is evaluated into 64 bytes that LLVM vectorises with
 //! the baseline SSE2 of x86-64, then packed into one word of the answer's bitset by a multiply. Large
-//! inputs are split across threads with rayon. One core evaluates 1.2–2 G orthographic and
-//! 0.6–1.7 G perspective candidates per second on the 2-core Xeon and AMD EPYC VMs this was
-//! measured on (the low ends for the 1.3 M-candidate dragon, whose 31–47 MB do not fit in cache;
-//! see the `silhouette_bench` example).
+//! inputs are split across threads with rayon. A candidate costs about a nanosecond of one core;
+//! for a mesh whose arrays do not fit in cache (the dragon's), the stream is bound by memory
+//! rather than arithmetic. The `silhouette_bench` example measures both.
 //!
 //! # The hierarchies' block tests
 //!
@@ -193,22 +192,10 @@ const PREFETCH_BLOCKS: usize = 8;
 
 /// The fewest candidates for which a cone BVH's [`Stream`] keeps the 16-bit copy of its blocks
 /// ([`FixedBlock`]). The pretest halves the bytes a leaf's test reads, which pays where a view
-/// tests many blocks streamed from beyond the caches, and costs a little where it tests few.
-/// `silhouette_bench`, perspective ns a view without → with the pretest, two interleaved runs
-/// each (2-core Xeon VM, 2026-11-27):
-///
-/// | mesh | candidates | blocks a view | without | with |
-/// |---|---|---|---|---|
-/// | dragon | 1.3M | 54,149 | 734k, 778k | 638k, 626k |
-/// | UV sphere 1400 | 2.0M | 8,260 | 114k, 105k | 96k, 120k |
-/// | UV sphere 1000 | 1.0M | 6,063 | 73.4k, 63.9k | 70.7k, 70.6k |
-/// | UV sphere 700 | 489k | 4,218 | 39.0k, 47.9k | 39.6k, 43.9k |
-/// | bunny | 103k | 6,615 | 61.6k, 61.8k | 49.6k, 63.4k |
-/// | rocker-arm | 29k | 2,884 | 17.5k, 16.6k | 18.0k, 18.3k |
-/// | fandisk | 11.6k | 147 | 1.30k, 1.08k | 1.35k, 1.29k |
-///
-/// So the copy is built for the largest meshes only, where views are likeliest to test many
-/// blocks.
+/// tests many blocks streamed from beyond the caches, and costs a little where it tests few
+/// (`silhouette_bench` on meshes of several sizes, with and without the pretest:
+/// docs/bench.md#a-16-bit-pretest-for-the-cone-bvhs-leaves). So the copy is built for the largest
+/// meshes only, where views are likeliest to test many blocks.
 pub(crate) const PRETEST_MIN_CANDIDATES: usize = 1 << 20;
 
 #[cfg(test)]
@@ -407,7 +394,7 @@ impl WordBits {
 /// and the brute force's `f32` dot product is within `γ₃·|n|·|u| ≤ 1.81·10⁻⁷` of `n·u` (Higham's
 /// bound for a 3-term sum of products). So where `|D| > T` = [`Quantized::SURE`], `T/S² ≥` the
 /// two bounds added, the brute force's value is non-zero with the sign of `D`: the lane is decided
-/// exactly. Lanes with `|D| ≤ T` on either side (about 0.2% of the lanes a dragon query tests,
+/// exactly. Lanes with `|D| ≤ T` on either side (a small share of the lanes a query tests:
 /// normals within 6·10⁻⁵ of the view's great circle) are tested again in `f32` on the exact
 /// normals, after the stream, their blocks prefetched together. Normals that are not finite or
 /// longer than 1.01 are stored as zero, which is never decided, so they always take the exact
@@ -598,7 +585,8 @@ pub(crate) struct Stream {
 /// `(x, y)` with the view's `(u_x, u_y)` and another `(z, h)` with `(u_z, −c)`; then the candidate
 /// indices. 80 bytes where the `f32` block has 160: the walk's block tests read half the bytes,
 /// and do integer multiply-adds instead of subtractions and products in `f32` (an earlier copy
-/// with 16-bit points, decoded to `f32`, was slower than the `f32` blocks; docs/bench.md).
+/// with 16-bit points, decoded to `f32`, was slower than the `f32` blocks:
+/// docs/bench.md#what-did-not-help).
 ///
 /// # Why a decided lane is exact
 ///
@@ -616,8 +604,9 @@ pub(crate) struct Stream {
 /// non-zero with the sign of `D`.
 ///
 /// A block with a lane that is not decided on both normals is tested again in `f32` (the result
-/// of [`Stream::perspective`]): 0.4 % of the blocks a dragon view tests (214 of 54,149 on average
-/// over 300 eyes), since the candidates a walk reaches lie near the silhouette. A leaf the eye is
+/// of [`Stream::perspective`]): a small share of the blocks a view tests, since the candidates a
+/// walk reaches lie near the silhouette but few lie that near the tie
+/// (docs/bench.md#a-16-bit-pretest-for-the-cone-bvhs-leaves). A leaf the eye is
 /// within `R` of, or with a non-finite point, is tested in `f32` alone. Normals that are not
 /// finite, longer than 1.01, or whose components all round to zero are stored as zero with a
 /// zero offset, so `D = 0` and their block always takes the exact path. Unused lanes store the

@@ -33,12 +33,12 @@
 //! it reaches a vertex with another hard edge (the next dot of a dotted chamfer, or the chain's own
 //! other end around a circle), the gap is bridged and the edges it walked become creases. So it
 //! bridges gaps and never extends a chain into the open: on range scans, open-ended hysteresis
-//! grew the dragon's creases by 9.6% and the Stanford bunny's by 22% at 0.8 (noise lines trailing
-//! every feature's end); bridging alone, by 6.1% and 14% at 0.8 and 3.0% and 7.0% at the default 0.9. It follows one line, never floods: the facet lines of a cylinder meet its crease
-//! circles at 90° and a closed circle has no end, and a surface without creases gains none. Ends
-//! are visited in vertex order and the walk is serial, so the result depends on the topology
-//! alone. The continued edges count in [`EdgeClassCounts::continued`] (and in
-//! [`EdgeClassCounts::crease`]).
+//! grows noise lines trailing every feature's end, far more added creases than bridging alone
+//! (docs/drawing.md, "Creases kept whole"). It follows one line, never floods: the facet lines of a
+//! cylinder meet its crease circles at 90° and a closed circle has no end, and a surface without
+//! creases gains none. Ends are visited in vertex order and the walk is serial, so the result
+//! depends on the topology alone. The continued edges count in [`EdgeClassCounts::continued`] (and
+//! in [`EdgeClassCounts::crease`]).
 //!
 //! **Specks.** Range scans are covered in creases of a few edges each that are noise, not features
 //! (the dragon: 686 isolated crease edges and 1,061 chains of 2 or 3 at 30°). Hard edges are joined
@@ -95,9 +95,8 @@ pub const DEFAULT_CREASE_MIN_LENGTH: f32 = 0.01;
 /// Default of [`LineOptions::crease_continue`]: a gap in a crease chain is bridged along edges above
 /// 0.9 × the crease angle (27° at the default 30°). CAD tessellators keep a chamfer's facets within
 /// a few tenths of a degree of its angle (29.5–30.5° for a 30° chamfer), well inside; on range
-/// scans, where near-creases are noise, 0.9 bridges half as much as 0.8 (creases gained: dragon
-/// 3.0% against 6.1%, Stanford bunny 7.0% against 14%; `crease_survey` in drafter-bake's
-/// examples, figures in `docs/drawing.md`, "Creases kept whole").
+/// scans, where near-creases are noise, 0.9 bridges about half as much as 0.8 (`crease_survey` in
+/// drafter-bake's examples, figures in `docs/drawing.md`, "Creases kept whole").
 pub const DEFAULT_CREASE_CONTINUE: f32 = 0.9;
 
 /// Default of [`LineOptions::crease_turn_deg`]: a continued crease turns by less than 45° per
@@ -326,8 +325,9 @@ pub fn face_normals(topology: &Topology) -> Vec<Option<DVec3>> {
 
 /// "Is the dihedral angle `atan2(sine, cosine)` in degrees (`sine = |n₁ × n₂|`, `cosine = n₁·n₂`,
 /// accurate near 0° and 180°) above `threshold`?", answered as the arctangent answers it but mostly
-/// without it (an `atan2` per edge was 65 ms of the dragon's classification). For `sine ≥ 0` the angle lies in `[0°, 180°]` and, for a threshold `α`
-/// strictly inside that range, `sine·cos α − cosine·sin α` has the sign of the angle minus `α`.
+/// without it (an `atan2` per edge was a large share of the classification). For `sine ≥ 0` the
+/// angle lies in `[0°, 180°]` and, for a threshold `α` strictly inside that range, `sine·cos α −
+/// cosine·sin α` has the sign of the angle minus `α`.
 /// Both the product and the arctangent are accurate to a few units in the last place, so where
 /// that sign clears [`AngleTest::MARGIN`] of `|sine| + |cosine|` they agree; nearer, and for a
 /// threshold outside the open range, the arctangent decides.
@@ -382,7 +382,7 @@ pub fn classify_edges_labelled(
 }
 
 /// [`classify_edges_labelled`] for the edge encoder alone: [`FeatureEdges::candidate_normals`] and
-/// [`FeatureEdges::candidate_points`] are left empty (47 MB on the dragon's 1.3M candidates),
+/// [`FeatureEdges::candidate_points`] are left empty (tens of megabytes on a large scan),
 /// which the encoder does not read, and so is [`FeatureEdges::dihedral_deg`] (the classes come
 /// out the same, mostly without an arctangent per edge). Do not build a
 /// [`crate::SilhouetteIndex`] from the result.

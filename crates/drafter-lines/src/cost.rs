@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Per-operation costs in nanoseconds on one core. The defaults were fitted with
-/// `silhouette_bench --calibrate` (release build, 2-core Xeon VM, SSE2 code, warm caches) by
+/// `silhouette_bench --calibrate` (release build, SSE2 code, warm caches) by
 /// least squares of `time ≈ Σ count · cost` over random views of the generated sphere, the bunny,
 /// fandisk and rocker-arm; only their ratios matter. The individual node costs are poorly
 /// separated by the fit (nodes entered, bounds tested and ranges move together), their sum is not.

@@ -9,8 +9,9 @@ use crate::{
     GaussMapHierarchy, GaussMapOptions, View,
 };
 
-/// Default number of candidates below which no hierarchy is built: brute force over them takes
-/// about 2 µs, less than the traversal overhead of either hierarchy.
+/// Default number of candidates below which no hierarchy is built: brute force over so few is
+/// quicker than the traversal overhead of either hierarchy (the silhouette charts of
+/// docs/bench.md#drafter-bench-on-three-models).
 pub const DEFAULT_MIN_HIERARCHY_CANDIDATES: usize = 2048;
 
 /// Default predicted speedup a hierarchy must reach to be stored. Above 1 so that the error of the
@@ -140,9 +141,8 @@ impl SilhouetteIndex {
 
     /// What a file stores of the index over these candidates (see [`StoredHierarchies`]): the
     /// same hierarchies as [`SilhouetteIndex::from_candidates`], built without what only a query
-    /// reads (the arc blocks and the candidate stream; without them the dragon's lines stage went
-    /// from 1.77 to 1.39 s and the bake's peak RSS from 541 to 486 MB) and without copying the
-    /// candidates back out.
+    /// reads (the arc blocks and the candidate stream, which would cost a bake time and peak memory
+    /// for nothing) and without copying the candidates back out.
     pub fn stored_hierarchies(
         normals: Vec<[Vec3; 2]>,
         points: Vec<Vec3>,
@@ -179,9 +179,8 @@ impl SilhouetteIndex {
                     predicted_speedup: speedup,
                 };
                 let (g, permutation) = g.into_storage_order();
-                // Gathers of a million candidates each (a cache miss apiece), prefetched: 12.5–18.8
-                // ms for the dragon's three against 16–26 ms without the prefetches (temporary
-                // timers, four alternating bakes).
+                // Gathers of up to millions of candidates, a cache miss apiece unless prefetched
+                // (`drafter_core::gather` prefetches).
                 if candidate_edges.len() == n {
                     candidate_edges = drafter_core::gather(&candidate_edges, &permutation);
                 }

@@ -22,8 +22,7 @@
 //!    each corner's edge id instead of searching for it (the bake's path; same bytes, tested).
 //! 3. [`BruteForce`] tests every candidate: the reference and the fallback. Structure of arrays,
 //!    64 candidates per step into one bitset word, SSE2 by auto-vectorisation, rayon above
-//!    [`PARALLEL_MIN_CANDIDATES`]; about 1.2–2 G orthographic and 0.6–1.7 G perspective candidates
-//!    per second on one core of the 2-core Xeon VM it was tuned on.
+//!    [`PARALLEL_MIN_CANDIDATES`]; about a nanosecond a candidate on one core.
 //! 4. [`GaussMapHierarchy`] (orthographic): each candidate is the great-circle arc between its two
 //!    normals, stored in a hierarchy of spherical triangles (icosahedron, 4:1 splits) at the
 //!    deepest cell whose overlapping bin holds it (Gooch et al. §5.1.2, Fig. 8, Table 2); each
@@ -48,9 +47,9 @@
 //!    built without the query layouts.
 //!
 //! Both hierarchies are laid out breadth-first with up to 4 children tested per SIMD pass and
-//! candidates in blocks of 4 lanes: on these machines a dependent cache miss costs 50–350 ns while
-//! brute force streams a candidate per 0.5–1 ns, so what a query touches, and in which order,
-//! matters more than how many bounds it tests.
+//! candidates in blocks of 4 lanes: a dependent cache miss costs as much as streaming brute force
+//! over tens to hundreds of candidates, so what a query touches, and in which order, matters more
+//! than how many bounds it tests.
 //!
 //! # Guarantee and tie rule
 //!

@@ -6,11 +6,10 @@
 //! consecutive), and it owns the candidates `order[arc_start..arc_end]`; the own ranges of the
 //! nodes follow one another in node order. Node 0 is the root.
 //!
-//! Why breadth-first: on the 2-core machines this was tuned on, a dependent cache miss costs 50 ns
-//! (2 MB working set) to 350 ns (32 MB), while streaming brute force reads a candidate every 0.7 ns.
-//! A query therefore walks one level at a time: every node of the level is known before any of
-//! them is read, so their memory accesses overlap instead of waiting on one another, and the caps
-//! of a node's children sit side by side.
+//! Why breadth-first: a dependent cache miss costs as much as streaming brute force over tens to
+//! hundreds of candidates, the more the larger the working set. A query therefore walks one level
+//! at a time: every node of the level is known before any of them is read, so their memory accesses
+//! overlap instead of waiting on one another, and the caps of a node's children sit side by side.
 
 use std::cell::RefCell;
 
@@ -20,8 +19,7 @@ use crate::{ArraysError, CostModel};
 
 /// What a hierarchy build makes: everything a query reads, or only what a file stores and the
 /// cost estimate counts. The query layouts (the Gauss map's arc blocks and their 16-bit copy,
-/// the cone BVH's candidate stream) cost the dragon's bake 55 MB of peak RSS and 0.4 s, and a bake
-/// never queries.
+/// the cone BVH's candidate stream) cost a bake peak memory and time, and a bake never queries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Purpose {
     Query,

@@ -26,7 +26,8 @@
 //! bytes, `max(c / 127, −1)`. The decoder takes the decoded vectors, whatever type a file stored.
 //! Our own hierarchies are built on the decoded values, so that they answer exactly for the data
 //! every reader has; what 8 bits change against `f32` face normals is measured by
-//! `examples/normal_precision.rs` (docs/bench.md).
+//! `examples/normal_precision.rs`
+//! (docs/bench.md#format-02-bytes-and-what-the-silhouette-normals-precision-buys).
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -110,13 +111,12 @@ pub struct SilhouettesEncoded {
     written: Vec<bool>,
     /// Each face's normal as written ([`snorm8_encode_direction`]), once its first candidate is
     /// written: a face borders up to three candidates, so rounding per face instead of per
-    /// candidate side does a third of the work (2.6M sides, 871k faces on the dragon).
+    /// candidate side does about a third of the work.
     face_codes: Vec<[i8; 3]>,
     face_rounded: Vec<bool>,
     /// Candidate index of every topology edge (`u32::MAX`: not a candidate), built by the first
-    /// chunk: one table lookup per corner instead of a binary search over a million candidates
-    /// (a cache miss per step; the dragon's encoding took 367 ms with the search, 279 with the
-    /// table, at two threads).
+    /// chunk: one table lookup per corner instead of a binary search over up to millions of
+    /// candidates, which misses the cache at every step.
     candidate_of_edge: Vec<u32>,
 }
 
@@ -137,7 +137,7 @@ pub fn encode_edge_visibility_continuing(
 /// [`encode_edge_visibility_continuing`] for triangles that are the faces `first_face..` of the mesh
 /// `topology` was built from (a primitive's range of them, as the bake writes it): each corner's
 /// edge is read from `topology.face_edges` instead of searched for by its welded vertex pair
-/// (a binary search per corner, a third of the dragon's serial encoding time). Same output.
+/// (a binary search per corner, which misses the cache at every step). Same output.
 pub fn encode_faces_continuing(
     triangles: &[[u32; 3]],
     first_face: usize,
@@ -145,7 +145,7 @@ pub fn encode_faces_continuing(
     lines: &FeatureEdges,
     encoded: &mut SilhouettesEncoded,
 ) -> Result<EdgeVisibility, VisibilityError> {
-    // On one thread the passes cost more than the serial walk (dragon: 250 against 207 ms).
+    // On one thread the passes cost more than the serial walk: they only pay with a second core.
     if rayon::current_num_threads() == 1 {
         return encode_chunk(triangles, Some(first_face), topology, lines, encoded);
     }
@@ -156,9 +156,8 @@ pub fn encode_faces_continuing(
 /// visibility bits fill whole bytes.
 const FACE_BLOCK: usize = 4096;
 
-/// [`encode_chunk`] over the topology's faces `first_face..`, on the thread pool. The dragon's
-/// eight chunks, two threads, six bakes each: 171–187 ms for the serial walk, 142–168 ms here;
-/// the walk does not use a second core at all, these passes use every core there is.
+/// [`encode_chunk`] over the topology's faces `first_face..`, on the thread pool: the serial walk
+/// uses one core whatever the pool holds, these passes use every core there is.
 ///
 /// The encode-once rules only ask whether a corner is its edge's first in the chunk, so the
 /// serial walk becomes three passes: each triangle's edges, each edge's first corner (an atomic

@@ -244,13 +244,12 @@ fn left_of(bounds: &DualBox, c: f32, a: usize, bin: usize) -> bool {
 
 /// `bin_of` on all four axes at once: the same subtraction, division and product per lane
 /// (one vector division instead of four: the binning pass divides for every candidate on every
-/// axis at every level, and the scalar rule's line held 3 % of the samples of a one-thread
-/// profile of the dragon's whole bake). The lanes are clamped to the bins as floats, NaN to 0
+/// axis at every level, and the scalar rule's line stood out in profiles of a whole bake). The
+/// lanes are clamped to the bins as floats, NaN to 0
 /// (on x86-64 the vector maximum returns its second operand there; the test
 /// `bins_of_is_bin_of_on_each_axis` holds NaN lanes to the rule), so each conversion is a 32-bit
-/// one rather than `as usize`'s longer 64-bit sequence. With [`left_of`] in the partition, the
-/// dragon's dual-space trees took 147–175 ms (one run 202) instead of 164–194 (temporary timers,
-/// bakes alternating with the build before).
+/// one rather than `as usize`'s longer 64-bit sequence. The partition that follows avoids the
+/// conversion altogether ([`left_of`]).
 #[inline(always)]
 fn bins_of(bounds: &DualBox, c: [f32; 4]) -> [usize; 4] {
     let lo = Vec4::from_array(bounds[0]);

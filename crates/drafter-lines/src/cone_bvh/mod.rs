@@ -20,11 +20,10 @@
 //!   crosses a box is proportional to its mean width, the sum of its 4 extents, so a split
 //!   minimises `Σ count · width` over the two sides (see [`dual_node`](dual::dual_node)). Any subtree of at most
 //!   [`ConeBvhOptions::leaf_size`] candidates becomes a leaf. Written here because [`obvhs`]
-//!   builds in 3D only; it is measured against obvhs' BVH2 (PLOC) over the points stretched
-//!   8× along the cell's mean normal, what this crate used before: per perspective view on the
-//!   dragon 213.7k instead of 228.9k candidates tested (54.0k instead of 57.8k blocks), on the
-//!   bunny 25.6k instead of 29.6k, on fandisk 432 instead of 1,339 (coplanar CAD faces
-//!   coincide in the dual space), each with the default pruning;
+//!   builds in 3D only; against obvhs' BVH2 (PLOC) over the points stretched 8× along the
+//!   cell's mean normal, what this crate used before, a perspective view tests fewer candidates
+//!   on every mesh measured, with the largest saving on CAD models (coplanar CAD faces coincide
+//!   in the dual space), each with the default pruning;
 //! * [`NormalSplit::Off`] builds an [`obvhs`] BVH2 (PLOC) over the points `v` alone, the plain
 //!   spatialised hierarchy of Johnson & Cohen, kept as the baseline;
 //! * every node stores the tight box `B` of the points `v` below it and a cone (unit axis `c`,
@@ -51,9 +50,9 @@
 //! For nearly coplanar faces (what the stretched BVH groups) `h` spans almost nothing, and the
 //! test is as tight as the orthographic one with the cone alone; the classic anchored-cone test
 //! over the box corners (the cone must clear every direction from the eye to the box) also pays
-//! for the box's angular size. Measured on the dragon (1.3M candidates, 200 eyes outside the box),
-//! the corner test culled less than 0.1% beyond what the plane test culls, at 8 square roots per
-//! node, so the query uses the plane test alone (`box_culls` stays as a tested reference).
+//! for the box's angular size. On the dragon the corner test culled almost nothing beyond what
+//! the plane test culls, at 8 square roots per node, so the query uses the plane test alone
+//! (`box_culls` stays as a tested reference).
 //!
 //! Rounding: the cone's `sin α` is rounded up with a margin of [`CONE_MARGIN`] = 1e-5, `cos α`,
 //! `h_lo` rounded down and `h_hi`, the reach `max |v − p₀|` rounded up, all computed in `f64` from
@@ -95,13 +94,10 @@ use bounds::{PlaneBound, anchor};
 /// Margin added to the sine of every cone's half-angle.
 pub const CONE_MARGIN: f64 = 1e-5;
 
-/// Default largest leaf, in candidates, before the cost-model pruning. The pruning keeps leaves of
-/// about 120 candidates on average on the dragon, so a build that starts from 16 makes levels it
-/// only collapses (dragon: 243,802 nodes built, 15,592 stored). Measured with
-/// `silhouette_bench --leaf` (16 → 64): predicted query cost +0.1% on the dragon and the bunny,
-/// +0.2% rocker-arm, +2.6% a 100k-face sphere, +6.8% fandisk (1.21 → 1.29 µs a view); measured
-/// perspective query times equal within the noise; both hierarchies of the dragon built in
-/// 1.38–1.43 s instead of 1.59–1.88 s.
+/// Default largest leaf, in candidates, before the cost-model pruning. The pruning keeps leaves
+/// larger than this on average on a large mesh, so a build that starts from smaller leaves makes
+/// levels it only collapses: starting from 16 instead built many more nodes, in more time, while
+/// the query cost changed little (`silhouette_bench --leaf` prints both).
 pub const DEFAULT_LEAF_SIZE: u32 = 64;
 
 /// Default number of eyes sampled to estimate visit frequencies.
@@ -241,8 +237,8 @@ pub const PLANE_MARGIN: f32 = 1e-5;
 /// half-diagonals of the bounding box. Over a box of dual points, `n̂·(e − v)` for an eye at
 /// distance `D` from the centre in direction `u` varies by `D·Σ|u_i|·Δn_i + Δh`, and `|u_i|`
 /// averages ½: so the normal's extents count about `D/2`, and the sampled eyes lie 1.2 to 4
-/// half-diagonals away (0.6, 1.25 and 2.5 measured alike on the dragon: 213.9k, 213.7k and
-/// 217.4k candidates tested per view).
+/// half-diagonals away (half and twice this weight tested about as many candidates per view on
+/// the dragon).
 pub const DUAL_NORMAL_WEIGHT: f32 = 1.25;
 
 impl ConeBvh {

@@ -106,15 +106,14 @@ struct NormalSplitter {
 
 /// Candidate `id` with its path `(key, cells)` ([`arc_paths`]) in one word: the key above bit 40,
 /// the cell count in bits 32–39, the id below. The split moves these records instead of ids, so
-/// no level reads a path table at random (two serial passes over the dragon's 1.3M candidates
-/// took 30–40 ms each that way, most of it cache misses).
+/// no level reads a path table at random (a cache miss per candidate and level).
 fn path_record(id: u32, (key, cells): (u32, u8)) -> u64 {
     u64::from(key) << 40 | u64::from(cells) << 32 | u64::from(id)
 }
 
 /// The normal split's tree as [`NormalSplitter::node`] built it, step by step, so that it is
 /// built again around the dual-space trees without partitioning the candidates a second time
-/// (that second pass was 25 ms of one core on the dragon).
+/// (a serial pass over every candidate).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Step {
     /// [`Tree::open`] a node.

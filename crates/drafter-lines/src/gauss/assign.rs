@@ -79,8 +79,8 @@ pub(super) struct BinCell {
     pub(super) cos_bin: f64,
 }
 
-/// Arcs per task of [`drafter_core::scatter_in_parallel`] (serial, the dragon's root level was
-/// 30 ms of one core).
+/// Arcs per task of [`drafter_core::scatter_in_parallel`] (the root level's scatter touches every
+/// arc, too much to leave on one core).
 const SCATTER_CHUNK: usize = 1 << 16;
 
 struct Builder {

@@ -219,8 +219,8 @@ impl PathDescent<'_> {
 
 /// For each octant of the sphere, the base cells whose circumcap, widened by [`OCTANT_MARGIN`],
 /// reaches into it: the only cells [`most_inside`] can pick for a point there. The root assigns
-/// every arc to a base cell, and scoring all 20 icosahedron faces (60 dot products an arc) was
-/// about 15 % of a one-thread profile of the dragon's assignment; each octant meets 10 of them.
+/// every arc to a base cell, and scoring all 20 icosahedron faces (60 dot products an arc) was a
+/// visible share of the assignment's profile; each octant meets 10 of them.
 ///
 /// Why skipping the others picks the same cell, bit for bit: the point lies in some cell, whose
 /// computed score is within rounding (about 1e-15) of a non-negative one, and that cell's cap
