@@ -1,4 +1,4 @@
-//! Baked NPR lookup textures for drafter (issue 5): the shading styles of the papers are 1D and 2D
+//! Baked NPR lookup textures for drafter: the shading styles of the papers are 1D and 2D
 //! lookups that are cheap at run time once baked. Plain data in, images out; no files (except the
 //! explicit [`write_png`]), no globals, deterministic at any thread count.
 //!
