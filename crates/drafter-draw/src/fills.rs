@@ -1,4 +1,4 @@
-//! Part fills of a line drawing (`drafter draw --fill flat|bands`, issue 45): each part's
+//! Part fills of a line drawing (`drafter draw --fill flat|bands`): each part's
 //! projected area as vector regions, painted part by part under the lines.
 //!
 //! # What is exact and what is not
@@ -24,8 +24,8 @@
 //!   the farthest remaining patch. A patch seen both in front of another and behind it (a shaft
 //!   sticking out of a gear's face) is then cut into 16-pixel screen tiles, with the one it
 //!   conflicts with, and the order counted again. Runs of one part's patches become one group.
-//!   `viewer/tests/drawing.rs` measures the pixels painted with another part than the renderer
-//!   shows: 0.025% on the sample assembly, 0.070% on RodAssembly.
+//!   drafter-render's `tests/drawing.rs` (`the_fills_match_the_renderers_parts`) holds the
+//!   pixels painted with another part than the renderer shows to a small share.
 //! * Pieces of one surface painted apart would show hairline seams under anti-aliasing, so each
 //!   region is also stroked with its own grey, half a pixel wide (the SVG and the PDF).
 

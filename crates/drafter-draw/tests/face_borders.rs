@@ -1,4 +1,4 @@
-//! CAD face borders, end to end (issue 58): a block with a rounded edge written as a CAD exporter
+//! CAD face borders, end to end: a block with a rounded edge written as a CAD exporter
 //! writes it (one glTF primitive per B-rep face, the top face split in two coplanar faces) is
 //! baked; its tangent edges (plane to fillet, below the crease angle) come back from the file as
 //! `LineClass::Tangent` along exactly the two primitive borders, the coplanar border is drawn
@@ -164,8 +164,8 @@ fn a_tangent_edge_beside_a_face_seen_edge_on_is_the_outline() {
     // Seen from +x at elevation exactly 0 the top face y = H is edge-on and the fillet's last
     // facet faces the viewer: their border is the block's top outline, drawn as a silhouette even
     // with `--smooth none` (a face seen edge-on is a line, both its borders on the contour).
-    // Without the rule the border stayed a tangent edge and the outline was left out with it (the
-    // plate's slot against OpenCascade, issue 58).
+    // Without the rule the border stayed a tangent edge and the outline was left out with it (as
+    // the comparison with OpenCascade showed on a plate's slot, docs/drawing.md).
     let dir = std::env::temp_dir().join(format!("drafter-face-borders-edge-on-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("scratch folder");
     let model = common::baked(&write_gltf(&dir));
