@@ -196,7 +196,7 @@ pub fn sphere_directions(n: usize) -> Vec<Vec3> {
 /// fillets) of radius `r`.
 ///
 /// Equal to scanning every point for every direction (the farthest, the first of equals), which
-/// cost the Stanford dragon's 437k vertices 0.95 s at load: the points are bucketed into a grid
+/// on a large scan would cost a noticeable part of the load: the points are bucketed into a grid
 /// of cells, each bounded by a sphere around its points, and a cell is scanned for a direction
 /// only when its sphere reaches the best lower bound that any cell guarantees along it (with a
 /// margin far above `f32` rounding). Hand-written: no crate does support queries with ties
@@ -283,8 +283,9 @@ pub fn support_points(points: &[Vec3], directions: &[Vec3]) -> Vec<usize> {
 /// Indices of at most [`SUPPORT_DIRECTIONS`] points of `points` whose projection in any
 /// direction bounds theirs closely: all of them when there are no more, otherwise their
 /// [`support_points`] along as many [`sphere_directions`] (every direction within 4.8° of one of
-/// them). Measured shortfall of the kept points' extent (2,000 random directions): 0.35 % of a
-/// sphere's radius, 1.2 % of a cylinder's (its flat ends), inside [`FIT_MARGIN`].
+/// them). The kept points' extent falls short of the full extent by about `r (1 − cos θ)` on
+/// round shapes and more at a cylinder's flat ends, well inside [`FIT_MARGIN`] either way
+/// (`support_points_bound_the_projection_of_round_parts` holds it under 1.5 % of the radius).
 ///
 /// What the camera frames. An affine map takes hull vertices to hull vertices, so a mesh's
 /// sample, computed once, serves every instance of it; the union over instances is sampled

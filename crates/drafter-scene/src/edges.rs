@@ -101,9 +101,9 @@ pub enum Hierarchies {
     AtLoad,
     /// Later, by [`ModelLines::complete_hierarchies`]; until then each mesh's candidates are
     /// answered by brute force (the same sets). Checking a stored hierarchy means assigning its
-    /// candidates down the stored tree again, most of a large file's load (GearboxAssy: 0.6 of
-    /// 1.1 s in the browser, where one query by brute force is a few milliseconds), so the page
-    /// shows its first frame first and builds them after it.
+    /// candidates down the stored tree again, most of a large file's load in the browser, where
+    /// one query by brute force takes only milliseconds, so the page shows its first frame first
+    /// and builds them after it.
     Deferred,
     /// Never: brute force answers every query. For a few views (a drawing, a sheet) one pass over
     /// the candidates costs less than checking the stored hierarchies.
