@@ -82,8 +82,8 @@ fn child(model: &Path, level: u32, first_use_order: bool) -> Result<(), Box<dyn 
 /// Numbers the vertices in the order the triangles first use them, as exporters and scanners
 /// write meshes (and as meshoptimizer's vertex-fetch optimisation leaves them). Midpoint
 /// subdivision appends every level's midpoints after all older vertices, so a triangle's corners
-/// lie far apart in the vertex array, further at every level: measured on the 2.18M level, that
-/// alone took the topology from 337 to 605 ms and the normals from 998 to 1,522 ms.
+/// lie far apart in the vertex array, further at every level, and the topology's walk and the
+/// normals' fans miss the cache more (docs/bench.md#scaling).
 fn renumber_by_first_use(mesh: &mut TriMesh) {
     let mut new_of = vec![u32::MAX; mesh.positions.len()];
     let mut positions = Vec::with_capacity(mesh.positions.len());

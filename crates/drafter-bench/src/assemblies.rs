@@ -1,5 +1,5 @@
 //! Assemblies whose parts touch, merged into one mesh the way a CAD exporter writes an STL, with
-//! the true part of every triangle (issue 17); and the accuracy of a segmentation against that
+//! the true part of every triangle; and the accuracy of a segmentation against that
 //! truth.
 //!
 //! Each part is a closed, outward-oriented solid of revolution ([`lathe`]) or a box whose faces
@@ -531,7 +531,7 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
-    /// The issue's bar: ≥ 99% matched and the right part count.
+    /// The bar a segmentation must reach: ≥ 99% matched and the right part count.
     pub fn passes(&self) -> bool {
         self.matched >= 0.99 && self.parts == self.truth_parts
     }

@@ -21,7 +21,7 @@ pub fn all(report: &SweepReport) -> Vec<(&'static str, Figure)> {
     out
 }
 
-/// Issue 19: what each byte of the silhouette normals buys (see `crate::quantization`).
+/// What each byte of the silhouette normals buys (see `crate::quantization`).
 pub fn quantization(report: &SweepReport) -> Option<Figure> {
     let q = report.quantization.as_ref()?;
     let label = |bits: u32| match bits {
@@ -391,8 +391,8 @@ pub fn segmentation(report: &SweepReport) -> Figure {
     }
 }
 
-/// Issue 17: `auto` on the generated contact family, fans paired whole only (before), in part, and
-/// in part with cracks glued (now): triangles in a matching part, and parts found against the true
+/// `auto` on the generated contact family, fans paired whole only (the earlier rule), in part, and
+/// in part with cracks glued (the default): triangles in a matching part, and parts found against the true
 /// count.
 pub fn segmentation_contacts(report: &SweepReport) -> Figure {
     let c = &report.segmentation.contacts;

@@ -1,4 +1,4 @@
-//! Speed against accuracy for every bake stage (issue 7): parameter sweeps of each stage on a
+//! Speed against accuracy for every bake stage: parameter sweeps of each stage on a
 //! user's model ([`sweep`]), their charts ([`chart`], [`figures`]), and generated inputs where
 //! methods are known to fail ([`generate`], used by the stability suite in `tests/stability.rs`
 //! and by the scaling benchmark in `examples/scaling.rs`).

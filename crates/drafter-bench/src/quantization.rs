@@ -1,4 +1,4 @@
-//! Issue 19, "what each byte buys": the silhouette normals of one mesh (two per candidate edge, as
+//! What each byte buys: the silhouette normals of one mesh (two per candidate edge, as
 //! `EXT_mesh_primitive_edge_visibility` stores them) quantized to 4–16 bits per component and kept
 //! as f32, each stored as the file stores them and through meshoptimizer's vertex codec as
 //! `--compress` stores them, against what is lost: the angle to the f32 face normal, and the

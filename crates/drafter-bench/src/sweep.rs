@@ -96,7 +96,7 @@ pub struct SweepReport {
     pub silhouettes: Option<SilhouetteSweep>,
     pub segmentation: SegmentSweep,
     pub bake: BakeSweep,
-    /// Bytes against accuracy of the silhouette normals (issue 19).
+    /// Bytes against accuracy of the silhouette normals.
     #[serde(default)]
     pub quantization: Option<crate::quantization::QuantizationSweep>,
 }
@@ -610,13 +610,13 @@ pub struct SegmentSweep {
     /// `auto` mode on each unique mesh alone over [`MERGE_FRACTIONS`] (parts summed).
     pub by_merge_fraction: Vec<SegmentPoint>,
     /// `auto` mode on the generated contact family ([`crate::assemblies::contact_assemblies`]),
-    /// with fans paired whole only (before issue 17), in part, and in part with cracks glued (the
+    /// with fans paired whole only (the earlier rule), in part, and in part with cracks glued (the
     /// defaults).
     #[serde(default)]
     pub contacts: Vec<ContactPoint>,
 }
 
-/// Accuracy of `auto` on one generated contact assembly, before and after issue 17.
+/// Accuracy of `auto` on one generated contact assembly under each fan-pairing rule.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContactPoint {
     pub name: String,
@@ -624,7 +624,7 @@ pub struct ContactPoint {
     pub truth_parts: usize,
     /// [`FanPairing::Whole`]: fraction of triangles in a matching part, and parts found.
     pub whole: (f64, usize),
-    /// [`FanPairing::Partial`], without gluing cracks (before the second step of issue 17).
+    /// [`FanPairing::Partial`], without gluing cracks.
     pub partial: (f64, usize),
     /// The defaults: fans paired in part and open pieces glued across cracks.
     #[serde(default)]

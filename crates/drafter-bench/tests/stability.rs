@@ -564,7 +564,7 @@ fn sample_cad_parts_under_random_rotations() {
     assert!(parts_seen >= 8, "only {parts_seen} sample parts: is samples/ complete?");
 }
 
-/// Finding of this suite (drafter-normals, issue 7), fixed: across a non-manifold edge the filter
+/// Finding of this suite (drafter-normals), fixed: across a non-manifold edge the filter
 /// used to average every wing, and evenly spread wings sum to about zero, so the low-pass normal
 /// (and with it the enhanced normal) pointed wherever rounding sent it: a rotation moved the
 /// enhanced normals of a 3-wing fan by 11–22°. A non-manifold edge now bounds the filter.

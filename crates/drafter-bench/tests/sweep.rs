@@ -72,7 +72,7 @@ fn sweeps_of_the_sample_assembly_are_consistent() {
         ["obb", "normals", "silhouettes", "segmentation", "segmentation_contacts", "bake", "quantization"]
     );
 
-    // Quantization (issue 19): every width measured; f32 loses nothing, fewer bits lose more.
+    // Quantization: every width measured; f32 loses nothing, fewer bits lose more.
     let q = report.quantization.as_ref().expect("the sample has silhouette candidates");
     assert_eq!(q.points.iter().map(|p| p.bits).collect::<Vec<_>>(), drafter_bench::quantization::QUANTIZATION_BITS);
     let last = q.points.last().expect("f32");
@@ -81,7 +81,7 @@ fn sweeps_of_the_sample_assembly_are_consistent() {
     for (stem, figure) in &figures {
         let svg = drafter_bench::chart::to_svg(figure).expect("draws");
         if *stem == "segmentation_contacts" {
-            // The generated family of touching parts (issue 17), the same for every model.
+            // The generated family of touching parts, the same for every model.
             assert!(svg.contains("% of triangles") && svg.contains("extra parts"), "{stem}: axes");
             continue;
         }
