@@ -56,15 +56,14 @@ fn gltf_triangles(json: &[u8]) -> u64 {
     let mut triangles = 0u64;
     for mesh in doc.get("meshes").and_then(serde_json::Value::as_array).into_iter().flatten() {
         for primitive in mesh.get("primitives").and_then(serde_json::Value::as_array).into_iter().flatten() {
-            let listed = match primitive.get("indices") {
-                Some(indices) => count(Some(indices)),
-                None => count(primitive.get("attributes").and_then(|a| a.get("POSITION"))),
-            };
-            triangles = triangles.saturating_add(match primitive.get("mode").and_then(serde_json::Value::as_u64) {
-                None | Some(4) => listed / 3,
-                Some(5 | 6) => listed.saturating_sub(2),
-                _ => 0,
-            });
+            let mode = primitive.get("mode").map(|m| m.as_u64().unwrap_or(4));
+            let positions = primitive.get("attributes").and_then(|a| a.get("POSITION"));
+            let listed = drafter_format::gltf::triangle_count(
+                mode,
+                primitive.get("indices").map(|i| count(Some(i))),
+                positions.map(|p| count(Some(p))),
+            );
+            triangles = triangles.saturating_add(listed);
         }
     }
     triangles

@@ -26,6 +26,7 @@ mod edit;
 pub mod ext;
 mod external;
 pub mod glb;
+pub mod gltf;
 pub mod meshopt;
 mod reader;
 pub mod uri;

@@ -362,25 +362,17 @@ fn unit(v: glam::Vec3) -> [f32; 3] {
     v.try_normalize().unwrap_or(glam::Vec3::Z).to_array()
 }
 
-/// Triangles of a primitive as the importers count them: `n / 3` for mode 4 (triangles), `n − 2`
-/// for strips and fans, none for points and lines; `n` is the index count, or POSITION's count
-/// for a primitive without indices.
+/// Triangles of a primitive by the workspace's one rule ([`crate::gltf::triangle_count`]), its
+/// accessors' counts looked up in `doc`.
 fn triangle_count(doc: &Value, primitive: &Value) -> u64 {
-    let count_of = |accessor: Option<&Value>| {
-        accessor
-            .and_then(Value::as_u64)
-            .and_then(|a| doc.get("accessors")?.get(a as usize)?.get("count")?.as_u64())
-            .unwrap_or(0)
+    let count_of = |accessor: &Value| {
+        accessor.as_u64().and_then(|a| doc.get("accessors")?.get(a as usize)?.get("count")?.as_u64()).unwrap_or(0)
     };
-    let n = match primitive.get("indices") {
-        Some(indices) => count_of(Some(indices)),
-        None => count_of(primitive.get("attributes").and_then(|a| a.get("POSITION"))),
-    };
-    match primitive.get("mode").and_then(Value::as_u64).unwrap_or(4) {
-        4 => n / 3,
-        5 | 6 => n.saturating_sub(2),
-        _ => 0,
-    }
+    crate::gltf::triangle_count(
+        primitive.get("mode").map(|m| m.as_u64().unwrap_or(4)),
+        primitive.get("indices").map(count_of),
+        primitive.get("attributes").and_then(|a| a.get("POSITION")).map(count_of),
+    )
 }
 
 /// A mesh's silhouette candidates as format 0.2 defines them: the edges its primitives encode as 1,

@@ -112,16 +112,11 @@ fn check_listed_triangles(doc: &gltf::Document, limits: &Limits) -> Result<(), P
     let mut listed = 0u64;
     for mesh in doc.meshes() {
         for primitive in mesh.primitives() {
-            let count = match (primitive.indices(), primitive.get(&gltf::Semantic::Positions)) {
-                (Some(indices), _) => indices.count() as u64,
-                (None, Some(positions)) => positions.count() as u64,
-                (None, None) => 0,
-            };
-            listed += match primitive.mode() {
-                Mode::Triangles => count / 3,
-                Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
-                _ => 0,
-            };
+            listed += drafter_format::gltf::triangle_count(
+                Some(u64::from(primitive.mode().as_gl_enum())),
+                primitive.indices().map(|a| a.count() as u64),
+                primitive.get(&gltf::Semantic::Positions).map(|a| a.count() as u64),
+            );
             if listed > limits.max_triangles {
                 let place = format!("/meshes/{}/primitives/{}", mesh.index(), primitive.index());
                 return Err(ParseError::at_json(
