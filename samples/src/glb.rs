@@ -6,7 +6,8 @@
 //! ARRAY_BUFFER / ELEMENT_ARRAY_BUFFER) starting on a 4-byte boundary; accessors start at offset 0 of their view.
 //! Indices are u16 when every index fits below 65535 (the restart value a primitive must not use), else u32.
 //! The container is framed by `drafter_format::glb::write` (the workspace's one GLB writer): the JSON chunk padded
-//! with spaces, the BIN chunk with zeros, both to 4 bytes.
+//! with spaces, the BIN chunk with zeros, both to 4 bytes. The GL enums (component types, buffer view targets) are
+//! `drafter_format::accessor`'s.
 //!
 //! Determinism: JSON objects are built with keys inserted in sorted order (see [`object`]), so the bytes are the
 //! same whether or not some other crate of the build turns on serde_json's `preserve_order`; floats are written
@@ -15,20 +16,11 @@
 //! Each primitive's `extras.brepFaces` lists its B-rep faces as `[surface, firstTriangle, triangleCount]` (the
 //! triangles of a face are contiguous), for tests that want the CAD face of a triangle as ground truth.
 
+use drafter_format::accessor::{ARRAY_BUFFER, ComponentType, ELEMENT_ARRAY_BUFFER};
 use serde_json::{Map, Value};
 
 use crate::solid::{Surface, TriMesh};
 
-/// glTF `componentType` of f32.
-const FLOAT: u32 = 5126;
-/// glTF `componentType` of u16.
-const UNSIGNED_SHORT: u32 = 5123;
-/// glTF `componentType` of u32.
-const UNSIGNED_INT: u32 = 5125;
-/// glTF buffer view target for vertex attributes.
-const ARRAY_BUFFER: u32 = 34962;
-/// glTF buffer view target for indices.
-const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 /// Written to `asset.generator`.
 pub const GENERATOR: &str = "drafter-samples";
 
@@ -249,7 +241,8 @@ fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
         }
     }
     let vec3 = |extra: Vec<(&'static str, Value)>| {
-        let mut fields = vec![("componentType", FLOAT.into()), ("count", count.into()), ("type", "VEC3".into())];
+        let mut fields =
+            vec![("componentType", ComponentType::F32.code().into()), ("count", count.into()), ("type", "VEC3".into())];
         fields.extend(extra);
         fields
     };
@@ -260,16 +253,16 @@ fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
     );
     let normal = bin.push(&floats(&geometry.normals), ARRAY_BUFFER, vec3(Vec::new()));
     let flat = geometry.triangles.iter().flatten();
-    let (index_bytes, component): (Vec<u8>, u32) = if count <= usize::from(u16::MAX) {
-        (flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(), UNSIGNED_SHORT)
+    let (index_bytes, component): (Vec<u8>, ComponentType) = if count <= usize::from(u16::MAX) {
+        (flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(), ComponentType::U16)
     } else {
-        (flat.flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
+        (flat.flat_map(|&i| i.to_le_bytes()).collect(), ComponentType::U32)
     };
     let indices = bin.push(
         &index_bytes,
         ELEMENT_ARRAY_BUFFER,
         vec![
-            ("componentType", component.into()),
+            ("componentType", component.code().into()),
             ("count", (3 * geometry.triangles.len()).into()),
             ("type", "SCALAR".into()),
         ],

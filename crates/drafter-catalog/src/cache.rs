@@ -200,35 +200,31 @@ fn hash_file(hasher: &mut blake3::Hasher, path: &Path) -> std::io::Result<()> {
     hasher.update_mmap_rayon(path).map(|_| ())
 }
 
-/// The JSON of a glTF's bytes: a GLB's first chunk, or the bytes themselves (empty for a GLB whose
-/// container is malformed: the import refuses it anyway).
+/// The JSON of a glTF's bytes: a GLB's JSON chunk, or the bytes themselves (empty for a GLB whose
+/// header or JSON chunk is malformed: the import refuses it anyway). Only the GLB's head is read
+/// ([`drafter_format::glb::read_head`]), as [`json_of_file`] reads it from disk, so the two agree
+/// on every file.
 fn json_of(bytes: &[u8]) -> &[u8] {
     if drafter_format::glb::is_glb(bytes) {
-        drafter_format::glb::split(bytes).map_or(&[], |chunks| chunks.json)
+        drafter_format::glb::read_head(bytes, bytes.len() as u64).map_or(&[], |head| &bytes[head.json])
     } else {
         bytes
     }
 }
 
-/// What [`json_of`] gives for the file at `path`, reading no more than it: a GLB's header and JSON
+/// What [`json_of`] gives for the file at `path`, reading no more than it: a GLB's head and JSON
 /// chunk, a text file that starts like JSON whole, nothing of any other file.
 fn json_of_file(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let mut file = std::fs::File::open(path)?;
     let size = file.metadata()?.len();
-    let mut head = Vec::with_capacity(20);
-    (&mut file).take(20).read_to_end(&mut head)?;
-    if drafter_format::glb::is_glb(&head) && head.len() == 20 {
-        // The header's length and the JSON chunk's as `glb::split` checks them; a container sound
-        // here but refused there (or the reverse) only costs a key that a single bake of the same
-        // file would not share, and such a file fails its bake anyway.
-        let word = |at: usize| u64::from(u32::from_le_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]));
-        let json_length = word(12);
-        if word(8) != size || &head[16..20] != b"JSON" || 20 + json_length > size {
-            return Ok(Vec::new());
-        }
-        let mut json = Vec::with_capacity(json_length as usize);
-        file.take(json_length).read_to_end(&mut json)?;
+    let mut head = Vec::with_capacity(drafter_format::glb::HEAD);
+    (&mut file).take(drafter_format::glb::HEAD as u64).read_to_end(&mut head)?;
+    if drafter_format::glb::is_glb(&head) {
+        let Ok(glb) = drafter_format::glb::read_head(&head, size) else { return Ok(Vec::new()) };
+        // The JSON chunk's data start right after the head just read.
+        let mut json = Vec::with_capacity(glb.json.len());
+        file.take(glb.json.len() as u64).read_to_end(&mut json)?;
         return Ok(json);
     }
     if head.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
@@ -680,6 +676,16 @@ mod tests {
         let glb = dir.join("assembly.glb");
         std::fs::write(&glb, sample).unwrap();
         assert_eq!(key_of_file(&glb, &config).unwrap(), key_of(&glb, sample, &config));
+        // A GLB's JSON is found from its head, in the file as in the bytes, bytes after the
+        // container left out; the buffer file its JSON names is part of the key.
+        let mut named = drafter_format::glb::write(gltf, &[]).unwrap();
+        named.extend_from_slice(b"trailing");
+        let glb = dir.join("named.glb");
+        std::fs::write(&glb, &named).unwrap();
+        let from_bytes = key_of(&glb, &named, &config);
+        assert_eq!(key_of_file(&glb, &config).unwrap(), from_bytes, "from the file, the same key");
+        std::fs::write(dir.join("a.bin"), [9, 9, 9, 9]).unwrap();
+        assert_ne!(key_of(&glb, &named, &config), from_bytes, "the GLB's buffer file is part of its key");
         std::fs::remove_file(dir.join("a.bin")).unwrap();
         assert_eq!(key_of(&path, gltf, &config), None, "a missing external file is not cached");
         std::fs::remove_dir_all(&dir).unwrap();

@@ -6,6 +6,25 @@
 //! files (over the JSON they parse) describe an accessor to these functions and decode it here; what
 //! differs between them is only where the numbers come from and how an error names its place.
 
+/// A buffer view's `target` for vertex attributes (the GL enum ARRAY_BUFFER).
+pub const ARRAY_BUFFER: u32 = 34962;
+/// A buffer view's `target` for indices (the GL enum ELEMENT_ARRAY_BUFFER).
+pub const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+
+/// Components per element of an accessor's `type` (`"SCALAR"` 1 … `"MAT4"` 16); `None` for any
+/// other name.
+pub fn components(type_name: &str) -> Option<usize> {
+    Some(match type_name {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        "VEC4" | "MAT2" => 4,
+        "MAT3" => 9,
+        "MAT4" => 16,
+        _ => return None,
+    })
+}
+
 /// An accessor's `componentType` (glTF 2.0, "Accessor Data Types").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ComponentType {
@@ -29,6 +48,18 @@ impl ComponentType {
             5126 => Self::F32,
             _ => return None,
         })
+    }
+
+    /// The `componentType` code of this type, as written in a glTF.
+    pub const fn code(self) -> u32 {
+        match self {
+            Self::I8 => 5120,
+            Self::U8 => 5121,
+            Self::I16 => 5122,
+            Self::U16 => 5123,
+            Self::U32 => 5125,
+            Self::F32 => 5126,
+        }
     }
 
     /// Bytes per component.
@@ -199,6 +230,10 @@ mod tests {
         assert_eq!(U16.decode(&300u16.to_le_bytes(), false), 300.0);
         assert_eq!(F32.decode(&1.5f32.to_le_bytes(), false), 1.5);
         assert_eq!(ComponentType::from_code(5124), None, "INT is not a glTF accessor type");
+        for ty in [I8, U8, I16, U16, U32, F32] {
+            assert_eq!(ComponentType::from_code(u64::from(ty.code())), Some(ty));
+        }
+        assert_eq!((components("VEC3"), components("MAT3"), components("vec3")), (Some(3), Some(9), None));
     }
 
     #[test]

@@ -6,17 +6,15 @@ use std::collections::HashMap;
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
+use crate::accessor::{ARRAY_BUFFER, ComponentType, ELEMENT_ARRAY_BUFFER};
 use crate::reader::{ByteSections, sections_of};
 
-pub(crate) const ARRAY_BUFFER: u32 = 34962;
-pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-
-pub(crate) const BYTE: u32 = 5120;
-pub(crate) const SHORT: u32 = 5122;
-pub(crate) const UNSIGNED_BYTE: u32 = 5121;
-pub(crate) const UNSIGNED_SHORT: u32 = 5123;
-pub(crate) const UNSIGNED_INT: u32 = 5125;
-pub(crate) const FLOAT: u32 = 5126;
+const BYTE: u32 = ComponentType::I8.code();
+const SHORT: u32 = ComponentType::I16.code();
+const UNSIGNED_BYTE: u32 = ComponentType::U8.code();
+const UNSIGNED_SHORT: u32 = ComponentType::U16.code();
+const UNSIGNED_INT: u32 = ComponentType::U32.code();
+const FLOAT: u32 = ComponentType::F32.code();
 
 /// Extensions whose accessor and buffer-view references [`Doc::compact`] knows (or that have none).
 pub(crate) const COMPACTION_SAFE_EXTENSIONS: &[&str] = &[
@@ -313,21 +311,17 @@ impl Doc {
         if a.get("sparse").is_some() {
             return Err(bad("sparse vertex attributes cannot be re-laid out"));
         }
-        let component = match a.get("componentType").and_then(Value::as_u64) {
-            Some(5120 | 5121) => 1,
-            Some(5122 | 5123) => 2,
-            Some(5125 | 5126) => 4,
-            _ => return Err(bad("unknown componentType")),
-        };
-        let components = match a.get("type").and_then(Value::as_str) {
-            Some("SCALAR") => 1,
-            Some("VEC2") => 2,
-            Some("VEC3") => 3,
-            Some("VEC4" | "MAT2") => 4,
-            Some("MAT3") => 9,
-            Some("MAT4") => 16,
-            _ => return Err(bad("unknown type")),
-        };
+        let component = a
+            .get("componentType")
+            .and_then(Value::as_u64)
+            .and_then(ComponentType::from_code)
+            .ok_or_else(|| bad("unknown componentType"))?
+            .size();
+        let components = a
+            .get("type")
+            .and_then(Value::as_str)
+            .and_then(crate::accessor::components)
+            .ok_or_else(|| bad("unknown type"))?;
         let element = component * components;
         let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
         let view = self.array("bufferViews").get(view_index).cloned().ok_or_else(|| bad("bufferView missing"))?;

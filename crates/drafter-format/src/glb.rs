@@ -109,36 +109,68 @@ fn type_name(ty: [u8; 4]) -> String {
     }
 }
 
-/// Splits a GLB into its JSON and BIN chunks. Checks the magic, the version, that the header's
-/// total length fits in `bytes` (bytes after it are ignored), that the first chunk is JSON and
-/// that every chunk fits inside the total. A second chunk of type `BIN\0` is the buffer; chunks of
-/// other types are skipped, as the spec asks of readers.
-pub fn split(bytes: &[u8]) -> Result<Chunks<'_>, GlbError> {
-    if bytes.len() < HEADER {
-        return Err(malformed(
-            bytes.len(),
-            format!("header truncated: {HEADER} bytes needed, the file has {}", bytes.len()),
-        ));
+/// Bytes of the file header and of the JSON chunk's header: all that [`read_head`] looks at.
+pub const HEAD: usize = HEADER + CHUNK_HEADER;
+
+/// What a GLB's first [`HEAD`] bytes say: the container's length and where the JSON chunk's data
+/// lie, both checked against the file's length.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Head {
+    /// The header's total length (at most the file's; bytes after it are not the container's).
+    pub total: usize,
+    /// The JSON chunk's data (padding included), as byte offsets into the file.
+    pub json: std::ops::Range<usize>,
+}
+
+/// Reads a GLB's header and its first chunk's header from `head`, the first bytes of a file of
+/// `file_length` bytes (at least [`HEAD`] of them, or the whole file when it is shorter), without
+/// the rest: for a reader that wants the JSON chunk alone from disk. The same checks as [`split`]
+/// makes of the header and the first chunk: the magic, the version, that the total length fits in
+/// the file and that the first chunk is JSON and fits inside the total.
+pub fn read_head(head: &[u8], file_length: u64) -> Result<Head, GlbError> {
+    let file_length = usize::try_from(file_length).unwrap_or(usize::MAX);
+    if file_length < HEADER || head.len() < HEADER {
+        let has = file_length.min(head.len());
+        return Err(malformed(has, format!("header truncated: {HEADER} bytes needed, the file has {has}")));
     }
-    if !is_glb(bytes) {
+    if !is_glb(head) {
         return Err(malformed(0, "magic is not \"glTF\""));
     }
-    let version = u32_at(bytes, 4, "the version")?;
+    let version = u32_at(head, 4, "the version")?;
     if version != VERSION {
         return Err(malformed(4, format!("version {version} is not supported (only {VERSION})")));
     }
-    let total = u32_at(bytes, 8, "the length")? as usize;
-    if total > bytes.len() {
-        return Err(malformed(8, format!("header declares {total} bytes but the file has {}", bytes.len())));
+    let total = u32_at(head, 8, "the length")? as usize;
+    if total > file_length {
+        return Err(malformed(8, format!("header declares {total} bytes but the file has {file_length}")));
     }
-    if total < HEADER + CHUNK_HEADER {
+    if total < HEAD {
         return Err(malformed(8, format!("header declares {total} bytes, too few for a JSON chunk")));
     }
-    let bytes = &bytes[..total];
-    let (ty, json, mut at) = chunk_at(bytes, HEADER, 0)?;
+    let length = u32_at(head, HEADER, "the length of chunk 0")? as usize;
+    let ty = head.get(HEADER + 4..HEAD).ok_or_else(|| malformed(HEADER + 4, "truncated: chunk 0 has no type"))?;
+    let ty = [ty[0], ty[1], ty[2], ty[3]];
+    let end = HEAD.checked_add(length).filter(|&end| end <= total).ok_or_else(|| {
+        malformed(
+            HEADER,
+            format!("chunk 0 ({}) declares {length} bytes but {} remain in the container", type_name(ty), total - HEAD),
+        )
+    })?;
     if &ty != CHUNK_JSON {
         return Err(malformed(HEADER + 4, "first chunk is not JSON"));
     }
+    Ok(Head { total, json: HEAD..end })
+}
+
+/// Splits a GLB into its JSON and BIN chunks. Checks what [`read_head`] checks (bytes after the
+/// header's total length are ignored) and that every further chunk fits inside the total. A second
+/// chunk of type `BIN\0` is the buffer; chunks of other types are skipped, as the spec asks of
+/// readers.
+pub fn split(bytes: &[u8]) -> Result<Chunks<'_>, GlbError> {
+    let head = read_head(bytes, bytes.len() as u64)?;
+    let bytes = &bytes[..head.total];
+    let json = &bytes[head.json.clone()];
+    let mut at = head.json.end;
     let mut bin = None;
     let mut index = 1;
     while at < bytes.len() {
@@ -254,6 +286,39 @@ mod tests {
         }
         let message = split(&glb[..5]).expect_err("short").to_string();
         assert!(message.contains("at byte 5"), "{message}");
+    }
+
+    #[test]
+    fn the_head_alone_finds_the_json_chunk_as_split_does() {
+        let glb = write(b"{\"asset\":{}}", &[1; 8]).expect("write");
+        let head = read_head(&glb[..HEAD], glb.len() as u64).expect("head");
+        assert_eq!(head.total, glb.len());
+        assert_eq!(&glb[head.json.clone()], split(&glb).expect("split").json);
+        // Trailing bytes after the container are not its own.
+        assert_eq!(read_head(&glb[..HEAD], glb.len() as u64 + 7).expect("longer file"), head);
+        // The head refuses what split refuses for the header and the JSON chunk, at the same offset.
+        let mut cases = Vec::new();
+        for (at, value) in [(4, 1u32), (8, 1_000_000), (8, 16), (12, u32::MAX), (12, 1000)] {
+            let mut liar = glb.clone();
+            liar[at..at + 4].copy_from_slice(&value.to_le_bytes());
+            cases.push(liar);
+        }
+        let mut not_json = glb.clone();
+        not_json[16..20].copy_from_slice(b"BIN\0");
+        cases.push(not_json);
+        let mut not_glb = glb.clone();
+        not_glb[0] = b'x';
+        cases.push(not_glb);
+        for case in &cases {
+            let from_head = read_head(&case[..HEAD], case.len() as u64).expect_err("head");
+            assert_eq!(from_head, split(case).expect_err("split"));
+        }
+        // A file shorter than the header, and a head cut shorter than the file has.
+        for cut in 0..HEADER {
+            assert_eq!(offset_of(read_head(&glb[..cut], cut as u64).expect_err("short file")), cut);
+            assert_eq!(offset_of(read_head(&glb[..cut], glb.len() as u64).expect_err("short head")), cut);
+        }
+        assert!(read_head(&glb[..HEAD - 1], glb.len() as u64).is_err(), "no chunk type");
     }
 
     #[test]

@@ -154,22 +154,9 @@ fn uint(v: &Value, key: &str) -> Option<u64> {
 
 /// Bytes of one element of an accessor, from its componentType and type.
 fn element_size(accessor: &Value) -> Option<u64> {
-    let component = match uint(accessor, "componentType")? {
-        5120 | 5121 => 1,
-        5122 | 5123 => 2,
-        5125 | 5126 => 4,
-        _ => return None,
-    };
-    let components = match accessor.get("type")?.as_str()? {
-        "SCALAR" => 1,
-        "VEC2" => 2,
-        "VEC3" => 3,
-        "VEC4" | "MAT2" => 4,
-        "MAT3" => 9,
-        "MAT4" => 16,
-        _ => return None,
-    };
-    Some(component * components)
+    let component = crate::accessor::ComponentType::from_code(uint(accessor, "componentType")?)?.size();
+    let components = crate::accessor::components(accessor.get("type")?.as_str()?)?;
+    Some((component * components) as u64)
 }
 
 /// Calls `f` with the vertex codec's element type for `stride` (a multiple of 4, at most 64).

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use serde_json::{Map, Value, json};
 
 use crate::FormatError;
-use crate::doc::{Doc, ELEMENT_ARRAY_BUFFER, UNSIGNED_BYTE};
+use crate::accessor::{ComponentType, ELEMENT_ARRAY_BUFFER};
+use crate::doc::Doc;
 use crate::ext::{
     ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, GaussMapRecord, MeshExtension,
     NodeExtensionRef, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord, TexturesRecord,
@@ -420,14 +421,15 @@ fn write_edges(
     edges: &PrimitiveEdges,
     edge_material: &mut Option<usize>,
 ) -> Result<Option<u32>, FormatError> {
-    let visibility = doc.push_typed_scalars(UNSIGNED_BYTE, &edges.visibility, edges.visibility.len());
+    let visibility = doc.push_typed_scalars(ComponentType::U8.code(), &edges.visibility, edges.visibility.len());
     let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
     let mut ext = json!({"visibility": visibility, "material": material});
     if !edges.silhouette_normals.is_empty() {
         ext["silhouetteNormals"] = doc.push_unit_vec3(&edges.silhouette_normals).into();
     }
-    let hard_edge_classes = (!edges.hard_edge_classes.is_empty())
-        .then(|| doc.push_typed_scalars(UNSIGNED_BYTE, &edges.hard_edge_classes, edges.hard_edge_classes.len()) as u32);
+    let hard_edge_classes = (!edges.hard_edge_classes.is_empty()).then(|| {
+        doc.push_typed_scalars(ComponentType::U8.code(), &edges.hard_edge_classes, edges.hard_edge_classes.len()) as u32
+    });
     let prim = primitive_mut(doc, m, primitive)?;
     extension_slot(prim).insert(EDGE_VISIBILITY_EXTENSION.into(), ext);
     doc.use_extension(EDGE_VISIBILITY_EXTENSION);
@@ -813,7 +815,8 @@ fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord
         node_boxes: doc.push_f32_scalars(&b.node_boxes) as u32,
         node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
         nodes: doc.push_scalars(&b.nodes, None) as u32,
-        splits: (!b.splits.is_empty()).then(|| doc.push_typed_scalars(UNSIGNED_BYTE, &b.splits, b.splits.len()) as u32),
+        splits: (!b.splits.is_empty())
+            .then(|| doc.push_typed_scalars(ComponentType::U8.code(), &b.splits, b.splits.len()) as u32),
         split_starts: doc.push_scalars(&b.split_starts, None) as u32,
     });
     SilhouettesRecord {
