@@ -46,27 +46,10 @@ fn binary_stl_triangles(bytes: &[u8]) -> Option<u64> {
     (84 + 50 * count == bytes.len() as u64).then_some(count)
 }
 
+/// Triangles a glTF's JSON lists (drafter-format's typed document and triangle rule); 0 for JSON
+/// that is not a glTF document, which the import refuses.
 fn gltf_triangles(json: &[u8]) -> u64 {
-    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else { return 0 };
-    let accessors = doc.get("accessors").and_then(serde_json::Value::as_array);
-    let count = |index: Option<&serde_json::Value>| -> u64 {
-        let accessor = index.and_then(serde_json::Value::as_u64).and_then(|i| accessors?.get(i as usize));
-        accessor.and_then(|a| a.get("count")).and_then(serde_json::Value::as_u64).unwrap_or(0)
-    };
-    let mut triangles = 0u64;
-    for mesh in doc.get("meshes").and_then(serde_json::Value::as_array).into_iter().flatten() {
-        for primitive in mesh.get("primitives").and_then(serde_json::Value::as_array).into_iter().flatten() {
-            let mode = primitive.get("mode").map(|m| m.as_u64().unwrap_or(4));
-            let positions = primitive.get("attributes").and_then(|a| a.get("POSITION"));
-            let listed = drafter_format::gltf::triangle_count(
-                mode,
-                primitive.get("indices").map(|i| count(Some(i))),
-                positions.map(|p| count(Some(p))),
-            );
-            triangles = triangles.saturating_add(listed);
-        }
-    }
-    triangles
+    drafter_format::gltf::Root::from_slice(json).map_or(0, |root| root.listed_triangles())
 }
 
 /// The number after `key` on a header line (PLY: `element face N`).

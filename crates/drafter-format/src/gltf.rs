@@ -1,9 +1,390 @@
-//! The glTF 2.0 document as drafter reads it, typed: primitive modes and the one rule for how many
-//! triangles a primitive lists.
+//! The glTF 2.0 document as drafter reads it, typed: [`Root`] and the objects below it, the
+//! primitive modes and the one rule for how many triangles a primitive lists.
+//!
+//! **Typed, and lossless.** Each object types the members drafter reads (indices, counts, URIs,
+//! names, modes: integers and strings, which serialize back to the same text); every other member
+//! (transforms, `min`/`max`, `sparse`, materials' factors, members a later glTF adds) is kept as
+//! JSON in the object's `other`, and `extensions` and `extras` as they are, so a document read here
+//! and written again loses nothing. Members the spec requires are `Option`s all the same, so a
+//! reader names what is missing where it needs it instead of refusing the whole document; a
+//! member of the wrong JSON type is refused when the document is read. Serialize through
+//! `serde_json::Value` (`to_value`, then text) to get the sorted member order the writer's
+//! documents have: serde writes a struct's fields in declaration order.
+//!
+//! **Why not gltf-json's `Root`.** The importer reads its input through the gltf crate, whose
+//! validation it wants; this layer is for the readers of baked files and of inputs before an
+//! import (a batch's memory estimate) and, later, the writer's pass-through. gltf-json drops the
+//! members of core objects it does not know (its `Root`, `Node`, `Mesh` have no catch-all: a
+//! document written back loses them), serializes fields in declaration order rather than sorted,
+//! and requires `asset` and every required member up front; here an unknown member survives and a
+//! missing one is the reader's to name.
 //!
 //! The triangle count is needed before any accessor is read — by the importer's triangle limit
 //! (drafter-io), by a batch's memory estimate (drafter-catalog) and by the reader of baked files,
-//! which numbers a mesh's triangles across its primitives — so the three count alike here.
+//! which numbers a mesh's triangles across its primitives — so the three count alike here
+//! ([`triangle_count`]).
+
+use std::collections::BTreeMap;
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// An object's members that the types here do not name, or its `extensions`, as JSON.
+pub type Members = serde_json::Map<String, Value>;
+
+/// The top-level glTF object.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Root {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accessors: Option<Vec<Accessor>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub asset: Option<Asset>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buffer_views: Option<Vec<BufferView>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buffers: Option<Vec<Buffer>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions_required: Option<Vec<String>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions_used: Option<Vec<String>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub images: Option<Vec<Image>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub materials: Option<Vec<Material>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub meshes: Option<Vec<Mesh>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<Vec<Node>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scenes: Option<Vec<Scene>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub textures: Option<Vec<Texture>>,
+    /// Animations, cameras, samplers, skins and members a later glTF adds.
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// `asset`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Asset {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generator: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub version: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `scenes`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Scene {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<Vec<u32>>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `nodes` (its transform is in `other`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Node {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub children: Option<Vec<u32>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `meshes`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Mesh {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub primitives: Option<Vec<Primitive>>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of a mesh's `primitives` (its morph `targets` are in `other`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Primitive {
+    /// Attribute name → accessor index.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attributes: Option<BTreeMap<String, u32>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indices: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<u32>,
+    /// The mode's code ([`Mode::from_code`]); absent means triangles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<u64>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `accessors` (`min`, `max` and `sparse` are in `other`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Accessor {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buffer_view: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub byte_offset: Option<u64>,
+    /// The `componentType` code ([`crate::accessor::ComponentType::from_code`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component_type: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normalized: Option<bool>,
+    /// `"SCALAR"`, `"VEC3"`, … ([`crate::accessor::components`]).
+    #[serde(default, rename = "type", skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `bufferViews`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct BufferView {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buffer: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub byte_length: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub byte_offset: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub byte_stride: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// [`crate::accessor::ARRAY_BUFFER`] or [`crate::accessor::ELEMENT_ARRAY_BUFFER`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<u32>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `buffers`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Buffer {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub byte_length: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uri: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `images`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Image {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buffer_view: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mime_type: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uri: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `textures`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Texture {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampler: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<u32>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// An entry of `materials` (its factors and textures are in `other`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Material {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<Members>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads
+/// (accessor indices); `lineStrings` and the rest are in `other`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct EdgeVisibility {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub silhouette_normals: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visibility: Option<u32>,
+    #[serde(flatten)]
+    pub other: Members,
+}
+
+/// The slice in an optional array member (empty when the member is absent).
+fn items<T>(list: &Option<Vec<T>>) -> &[T] {
+    list.as_deref().unwrap_or_default()
+}
+
+/// The extension `name` of an object's `extensions`, decoded as `T`: `None` when absent.
+fn extension<T: DeserializeOwned>(extensions: &Option<Members>, name: &str) -> Option<serde_json::Result<T>> {
+    extensions.as_ref()?.get(name).map(T::deserialize)
+}
+
+impl Root {
+    /// Reads a document from its JSON text.
+    pub fn from_slice(json: &[u8]) -> serde_json::Result<Self> {
+        serde_json::from_slice(json)
+    }
+
+    pub fn accessors(&self) -> &[Accessor] {
+        items(&self.accessors)
+    }
+
+    pub fn buffer_views(&self) -> &[BufferView] {
+        items(&self.buffer_views)
+    }
+
+    pub fn buffers(&self) -> &[Buffer] {
+        items(&self.buffers)
+    }
+
+    pub fn images(&self) -> &[Image] {
+        items(&self.images)
+    }
+
+    pub fn meshes(&self) -> &[Mesh] {
+        items(&self.meshes)
+    }
+
+    pub fn nodes(&self) -> &[Node] {
+        items(&self.nodes)
+    }
+
+    pub fn textures(&self) -> &[Texture] {
+        items(&self.textures)
+    }
+
+    /// The root's extension `name` decoded as `T`; `None` when the root has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+
+    /// The `count` of accessor `index`; `None` when there is no such accessor or it has no count.
+    pub fn accessor_count(&self, index: u32) -> Option<u64> {
+        self.accessors().get(index as usize)?.count
+    }
+
+    /// Triangles the document's primitives list, every mesh once ([`Primitive::triangle_count`]).
+    pub fn listed_triangles(&self) -> u64 {
+        let primitives = self.meshes().iter().flat_map(Mesh::primitives);
+        primitives.fold(0u64, |sum, p| sum.saturating_add(p.triangle_count(self)))
+    }
+}
+
+impl Node {
+    /// The node's extension `name` decoded as `T`; `None` when it has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+}
+
+impl Mesh {
+    pub fn primitives(&self) -> &[Primitive] {
+        items(&self.primitives)
+    }
+
+    /// The mesh's extension `name` decoded as `T`; `None` when it has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+}
+
+impl Primitive {
+    /// The accessor of attribute `name` (`"POSITION"`, `"NORMAL"`, `"_ENHANCED_NORMAL"`, …).
+    pub fn attribute(&self, name: &str) -> Option<u32> {
+        self.attributes.as_ref()?.get(name).copied()
+    }
+
+    /// The primitive's extension `name` decoded as `T`; `None` when it has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+
+    /// Triangles the primitive lists by [`triangle_count`], its accessors' counts looked up in
+    /// `root` (an accessor that is missing or has no count counts 0).
+    pub fn triangle_count(&self, root: &Root) -> u64 {
+        let count = |accessor: u32| root.accessor_count(accessor).unwrap_or(0);
+        triangle_count(self.mode, self.indices.map(count), self.attribute("POSITION").map(count))
+    }
+}
 
 /// A primitive's `mode` (glTF 2.0, "meshes": the topology of its vertices).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,6 +439,65 @@ pub fn triangle_count(mode: Option<u64>, indices: Option<u64>, positions: Option
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A document with members of every kind: typed ones, unknown ones at every level, integers
+    /// written as floats where the spec has numbers, extensions and extras.
+    const DOCUMENT: &str = r#"{
+        "asset": {"version": "2.0", "generator": "g", "copyright": "c"},
+        "scene": 0, "scenes": [{"nodes": [0], "extras": {"a": 1}}],
+        "nodes": [{"mesh": 0, "translation": [1, 2.0, -0.0], "children": [1],
+                   "extensions": {"DRAFTER_illustration": {"parts": []}, "X_other": {"k": [1, 2]}}},
+                  {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "futureMember": true}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "_ENHANCED_NORMAL": 1}, "indices": 2,
+                    "mode": 4, "targets": [{"POSITION": 3}],
+                    "extensions": {"EXT_mesh_primitive_edge_visibility": {"visibility": 4, "lineStrings": []}}},
+                   {"attributes": {"POSITION": 0}, "mode": 5}, {"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 9, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1.5, 1e300, 1]},
+                      {"componentType": 5126, "count": 9, "type": "VEC3", "sparse": {"count": 1}},
+                      {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR", "normalized": false}],
+        "bufferViews": [{"buffer": 0, "byteLength": 108, "byteStride": 12, "target": 34962},
+                        {"buffer": 0, "byteOffset": 108, "byteLength": 24}],
+        "buffers": [{"byteLength": 132, "uri": "a.bin"}],
+        "images": [{"bufferView": 1, "mimeType": "image/png", "name": "i"}],
+        "textures": [{"source": 0, "sampler": 0}], "samplers": [{"magFilter": 9729}],
+        "materials": [{"name": "m", "pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0, 1]}}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1}}],
+        "extensionsUsed": ["X_other"], "extras": {"top": null}, "unknownTopLevel": [1, "two"]
+    }"#;
+
+    #[test]
+    fn a_document_reads_typed_and_writes_back_whole() {
+        let root = Root::from_slice(DOCUMENT.as_bytes()).expect("read");
+        let original: Value = serde_json::from_str(DOCUMENT).expect("JSON");
+        assert_eq!(serde_json::to_value(&root).expect("write"), original, "nothing lost or changed");
+        // Written through a Value, the text has the writer's sorted member order.
+        let text = serde_json::to_value(&root).expect("write").to_string();
+        assert_eq!(text, original.to_string());
+        assert!(text.contains(r#""translation":[1,2.0,-0.0]"#), "numbers as written: {text}");
+        let primitive = &root.meshes()[0].primitives()[0];
+        assert_eq!((primitive.attribute("_ENHANCED_NORMAL"), primitive.indices), (Some(1), Some(2)));
+        let edges: EdgeVisibility =
+            primitive.extension("EXT_mesh_primitive_edge_visibility").expect("some").expect("ok");
+        assert_eq!((edges.visibility, edges.silhouette_normals), (Some(4), None));
+        assert!(root.nodes()[0].extension::<Value>("DRAFTER_illustration").is_some());
+        assert!(root.nodes()[1].extension::<Value>("DRAFTER_illustration").is_none());
+        assert_eq!(root.accessors()[2].kind.as_deref(), Some("SCALAR"));
+        assert_eq!(root.buffers()[0].uri.as_deref(), Some("a.bin"));
+        assert_eq!(root.images()[0].mime_type.as_deref(), Some("image/png"));
+        // 12 indices: 4 triangles; a strip and a list of 9 positions: 7 and 3.
+        assert_eq!(root.listed_triangles(), 4 + 7 + 3);
+    }
+
+    #[test]
+    fn a_member_of_the_wrong_type_is_refused_and_a_missing_one_left_to_the_reader() {
+        assert!(Root::from_slice(br#"{"accessors": [{"count": "nine"}]}"#).is_err());
+        assert!(Root::from_slice(br#"{"meshes": [{"primitives": [{"mode": 4.5}]}]}"#).is_err());
+        let root = Root::from_slice(br#"{"accessors": [{"type": "SCALAR"}], "meshes": [{}]}"#).expect("read");
+        assert_eq!((root.accessor_count(0), root.accessor_count(1)), (None, None));
+        assert_eq!((root.asset.as_ref(), root.meshes()[0].primitives().len()), (None, 0));
+        assert_eq!(Root::from_slice(b"{}").expect("empty").listed_triangles(), 0);
+    }
 
     #[test]
     fn every_mode_counts_its_triangles() {
