@@ -2,10 +2,12 @@
 //! [`read`] gives the extension's records (the root's `textures` holds the glTF texture indices of
 //! the baked lookups); [`read_textures`] gives those textures' PNG bytes.
 
+use serde::Deserialize;
 use serde_json::Value;
 
 use crate::FormatError;
 use crate::accessor::{self, ComponentType, Layout, LayoutError};
+use crate::gltf::{EdgeVisibility, Root};
 
 /// `bytes`, or the plain GLB they decode to when they use `EXT_meshopt_compression` (see
 /// `crate::meshopt`): every reader here takes compressed and plain files alike.
@@ -95,9 +97,16 @@ pub fn read_textures(
     let decoded = plain(bytes)?;
     let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
-    let doc: Value = serde_json::from_slice(json)?;
-    let Some(record) = doc.pointer(&format!("/extensions/{EXTENSION}/textures")) else { return Ok(Vec::new()) };
-    let record: TexturesRecord = serde_json::from_value(record.clone())?;
+    let doc = Root::from_slice(json)?;
+    /// The root extension's `textures` alone, whatever the rest holds.
+    #[derive(Deserialize)]
+    struct Textures {
+        #[serde(default)]
+        textures: Option<TexturesRecord>,
+    }
+    let Some(record) = doc.extension::<Textures>(EXTENSION).transpose()?.and_then(|t| t.textures) else {
+        return Ok(Vec::new());
+    };
     let buffer = load_buffer(&doc, bin, external)?;
     record
         .indices()
@@ -105,23 +114,24 @@ pub fn read_textures(
         .map(|texture| {
             let bad = |what: &str| FormatError::Invalid(format!("/textures/{texture}: {what}"));
             let source = doc
-                .pointer(&format!("/textures/{texture}/source"))
-                .and_then(Value::as_u64)
+                .textures()
+                .get(texture as usize)
+                .and_then(|t| t.source)
                 .ok_or_else(|| bad("missing, or no source"))?;
-            let image = doc.pointer(&format!("/images/{source}")).ok_or_else(|| bad("image missing"))?;
-            if image.get("mimeType").and_then(Value::as_str) != Some("image/png") {
+            let image = doc.images().get(source as usize).ok_or_else(|| bad("image missing"))?;
+            if image.mime_type.as_deref() != Some("image/png") {
                 return Err(bad("image is not image/png"));
             }
-            let view = image.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("image has no bufferView"))?;
-            let view = doc.pointer(&format!("/bufferViews/{view}")).ok_or_else(|| bad("bufferView missing"))?;
-            let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-            let length = view.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad("no byteLength"))? as usize;
+            let view = image.buffer_view.ok_or_else(|| bad("image has no bufferView"))?;
+            let view = doc.buffer_views().get(view as usize).ok_or_else(|| bad("bufferView missing"))?;
+            let start = view.byte_offset.unwrap_or(0) as usize;
+            let length = view.byte_length.ok_or_else(|| bad("no byteLength"))? as usize;
             let png = buffer
                 .as_deref()
                 .and_then(|b| b.get(start..start.checked_add(length)?))
                 .ok_or_else(|| bad("image bytes outside the buffer"))?
                 .to_vec();
-            let name = image.get("name").and_then(Value::as_str).unwrap_or_default().to_owned();
+            let name = image.name.clone().unwrap_or_default();
             Ok(EmbeddedPng { texture, name, png })
         })
         .collect()
@@ -129,30 +139,37 @@ pub fn read_textures(
 
 /// The bytes of the single buffer: the .glb's BIN chunk or the .gltf's external file.
 fn load_buffer(
-    doc: &Value,
+    doc: &Root,
     bin: Option<&[u8]>,
     external: &dyn Fn(&str) -> Option<Vec<u8>>,
 ) -> Result<Option<Vec<u8>>, FormatError> {
-    Ok(match doc.get("buffers").and_then(|b| b.get(0)) {
-        Some(b) => match b.get("uri").and_then(Value::as_str) {
-            Some(uri) => {
-                Some(external(uri).ok_or_else(|| FormatError::Invalid(format!("cannot load buffer {uri:?}")))?)
-            }
+    Ok(match doc.buffers().first() {
+        Some(b) => match b.uri.as_deref() {
+            Some(uri) => Some(external_buffer(uri, external)?),
             None => bin.map(<[u8]>::to_vec),
         },
         None => None,
     })
 }
 
+/// The bytes of the buffer file `uri`, loaded by `external`.
+fn external_buffer(uri: &str, external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<Vec<u8>, FormatError> {
+    external(uri).ok_or_else(|| FormatError::Invalid(format!("cannot load buffer {uri:?}")))
+}
+
 /// The root object of the extension, refused unless its `version` is the one this crate reads
 /// (layouts change between versions; an older file is baked again, not guessed at).
-fn root_extension(doc: &Value) -> Result<RootExtension, FormatError> {
-    let root_value = doc
-        .get("extensions")
-        .and_then(|e| e.get(EXTENSION))
-        .ok_or_else(|| FormatError::NotBaked(format!("no {EXTENSION} extension on the root")))?;
-    match root_value.get("version").and_then(Value::as_str) {
-        Some(FORMAT_VERSION) => Ok(serde_json::from_value(root_value.clone())?),
+fn root_extension(doc: &Root) -> Result<RootExtension, FormatError> {
+    /// The extension's `version` alone (any JSON), read before its layout.
+    #[derive(Deserialize)]
+    struct Versioned {
+        #[serde(default)]
+        version: Value,
+    }
+    let not_baked = || FormatError::NotBaked(format!("no {EXTENSION} extension on the root"));
+    let found = doc.extension::<Versioned>(EXTENSION).ok_or_else(not_baked)?.map(|v| v.version);
+    match found.as_ref().ok().and_then(Value::as_str) {
+        Some(FORMAT_VERSION) => Ok(doc.extension(EXTENSION).ok_or_else(not_baked)??),
         found => Err(FormatError::Version(found.unwrap_or("(none)").to_owned())),
     }
 }
@@ -162,48 +179,41 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
     let decoded = plain(bytes)?;
     let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
-    let doc: Value = serde_json::from_slice(json)?;
+    let doc = Root::from_slice(json)?;
     let root = root_extension(&doc)?;
     let buffer = load_buffer(&doc, bin, external)?;
     let mut nodes = Vec::new();
-    for (i, node) in doc.get("nodes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
-        if let Some(ext) = node.get("extensions").and_then(|e| e.get(EXTENSION)) {
-            nodes.push((i as u32, serde_json::from_value::<NodeExtension>(ext.clone())?));
+    for (i, node) in doc.nodes().iter().enumerate() {
+        if let Some(ext) = node.extension::<NodeExtension>(EXTENSION) {
+            nodes.push((i as u32, ext?));
         }
     }
     let data = || buffer.as_deref().ok_or_else(|| FormatError::Invalid("accessors but no buffer".into()));
     let mut primitive_labels = Vec::new();
     let mut primitive_edges = Vec::new();
     let mut mesh_silhouettes = Vec::new();
-    for (m, mesh) in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
+    for (m, mesh) in doc.meshes().iter().enumerate() {
         // Mesh-wide number of each primitive's first triangle, and the edges of this mesh.
         let mut first_triangle = 0u64;
         let mut mesh_edges: Vec<(u64, usize)> = Vec::new();
-        for (p, prim) in
-            mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate()
-        {
-            let triangles = triangle_count(&doc, prim);
-            let extensions = prim.get("extensions");
-            let ours = match extensions.and_then(|e| e.get(EXTENSION)) {
-                Some(ext) => Some(serde_json::from_value::<PrimitiveExtension>(ext.clone())?),
-                None => None,
-            };
+        for (p, prim) in mesh.primitives().iter().enumerate() {
+            let triangles = prim.triangle_count(&doc);
+            let ours = prim.extension::<PrimitiveExtension>(EXTENSION).transpose()?;
             if let Some(accessor) = ours.as_ref().and_then(|e| e.part_labels) {
-                primitive_labels.push((m as u32, p as u32, read_scalars(&doc, accessor as usize, data()?)?));
+                primitive_labels.push((m as u32, p as u32, scalars(&doc, accessor as usize, data()?)?));
             }
-            if let Some(edges) = extensions.and_then(|e| e.get(EDGE_VISIBILITY_EXTENSION)) {
-                let accessor = |key: &str| edges.get(key).and_then(Value::as_u64).map(|a| a as usize);
+            if let Some(edges) = prim.extension::<EdgeVisibility>(EDGE_VISIBILITY_EXTENSION).transpose()? {
                 let bad = |what: &str| FormatError::Invalid(format!("/meshes/{m}/primitives/{p}: {what}"));
-                let visibility = accessor("visibility").ok_or_else(|| bad("edge visibility without `visibility`"))?;
+                let visibility = edges.visibility.ok_or_else(|| bad("edge visibility without `visibility`"))?;
                 let narrow = |values: Vec<u32>, what: &str| -> Result<Vec<u8>, FormatError> {
                     values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
                 };
-                let silhouette_normals = match accessor("silhouetteNormals") {
-                    Some(a) => read_unit_vec3s(&doc, a, data()?)?,
+                let silhouette_normals = match edges.silhouette_normals {
+                    Some(a) => read_unit_vec3s(&doc, a as usize, data()?)?,
                     None => StoredNormals::default(),
                 };
                 let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
-                    Some(a) => narrow(read_scalars(&doc, a as usize, data()?)?, "hardEdgeClasses above 8 bits")?,
+                    Some(a) => narrow(scalars(&doc, a as usize, data()?)?, "hardEdgeClasses above 8 bits")?,
                     None => Vec::new(),
                 };
                 mesh_edges.push((first_triangle, primitive_edges.len()));
@@ -211,7 +221,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     m as u32,
                     p as u32,
                     PrimitiveEdges {
-                        visibility: narrow(read_scalars(&doc, visibility, data()?)?, "visibility above 8 bits")?,
+                        visibility: narrow(scalars(&doc, visibility as usize, data()?)?, "visibility above 8 bits")?,
                         silhouette_normals,
                         hard_edge_classes,
                     },
@@ -219,12 +229,11 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
             }
             first_triangle += triangles;
         }
-        let Some(ext) = mesh.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
-        let ext: MeshExtension = serde_json::from_value(ext.clone())?;
-        if let Some(s) = ext.silhouettes {
+        let Some(ext) = mesh.extension::<MeshExtension>(EXTENSION) else { continue };
+        if let Some(s) = ext?.silhouettes {
             let data = data()?;
-            let u32s = |a: u32| read_scalars(&doc, a as usize, data);
-            let f32s = |a: u32| read_floats(&doc, a as usize, data);
+            let u32s = |a: u32| scalars(&doc, a as usize, data);
+            let f32s = |a: u32| floats(&doc, a as usize, data);
             let (candidate_corners, candidate_normals) = derived_candidates(&mesh_edges, &primitive_edges)
                 .map_err(|what| FormatError::Invalid(format!("/meshes/{m}: {what}")))?;
             let silhouettes = MeshSilhouettes {
@@ -278,8 +287,19 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
     Ok(BakedFile { root, nodes, primitive_labels, primitive_edges, mesh_silhouettes })
 }
 
-/// Reads a FLOAT SCALAR accessor from the single buffer.
+/// Reads a FLOAT SCALAR accessor of the document `doc` (its JSON, parsed) from the single buffer.
 pub fn read_floats(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<f32>, FormatError> {
+    floats(&Root::deserialize(doc)?, accessor, buffer)
+}
+
+/// Reads an unsigned SCALAR accessor of the document `doc` (its JSON, parsed) from the single
+/// buffer.
+pub fn read_scalars(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<u32>, FormatError> {
+    scalars(&Root::deserialize(doc)?, accessor, buffer)
+}
+
+/// Reads a FLOAT SCALAR accessor from the single buffer.
+fn floats(doc: &Root, accessor: usize, buffer: &[u8]) -> Result<Vec<f32>, FormatError> {
     let (a, view, layout) = accessor_in(doc, accessor, buffer, "SCALAR")?;
     if a.component != ComponentType::F32 {
         return Err(FormatError::Invalid(format!("/accessors/{accessor}: not a FLOAT accessor")));
@@ -288,7 +308,7 @@ pub fn read_floats(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<f3
 }
 
 /// Reads an unsigned SCALAR accessor from the single buffer.
-pub fn read_scalars(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<u32>, FormatError> {
+fn scalars(doc: &Root, accessor: usize, buffer: &[u8]) -> Result<Vec<u32>, FormatError> {
     let (a, view, layout) = accessor_in(doc, accessor, buffer, "SCALAR")?;
     accessor::read_indices(view, &layout, a.component)
         .ok_or_else(|| FormatError::Invalid(format!("/accessors/{accessor}: not an unsigned integer type")))
@@ -318,23 +338,18 @@ pub fn read_normal_sets(
     let decoded = plain(bytes)?;
     let bytes = &*decoded;
     let (json, bin) = split_container(bytes)?;
-    let doc: Value = serde_json::from_slice(json)?;
+    let doc = Root::from_slice(json)?;
     let root = root_extension(&doc)?;
     let swapped = root.normals.as_ref().is_some_and(|n| n.enhanced_in_normal);
     let mut buffer = None;
     let mut sets = Vec::new();
-    for (m, mesh) in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate() {
-        for (p, prim) in
-            mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice).iter().enumerate()
-        {
-            let Some(ext) = prim.get("extensions").and_then(|e| e.get(EXTENSION)) else { continue };
-            let ext: PrimitiveExtension = serde_json::from_value(ext.clone())?;
-            let Some(name) = ext.enhanced_normal else { continue };
+    for (m, mesh) in doc.meshes().iter().enumerate() {
+        for (p, prim) in mesh.primitives().iter().enumerate() {
+            let Some(ext) = prim.extension::<PrimitiveExtension>(EXTENSION) else { continue };
+            let Some(name) = ext?.enhanced_normal else { continue };
             let bad = |what: &str| FormatError::Invalid(format!("/meshes/{m}/primitives/{p}: {what}"));
             let attribute = |key: &str| {
-                prim.get("attributes")
-                    .and_then(|a| a.get(key))
-                    .and_then(Value::as_u64)
+                prim.attribute(key)
                     .ok_or_else(|| bad(&format!("enhancedNormal names {name}, but the primitive has no {key}")))
             };
             let (normal_accessor, other_accessor) = (attribute("NORMAL")?, attribute(&name)?);
@@ -360,19 +375,6 @@ pub fn read_normal_sets(
 /// `v` at unit length (+Z when it has none).
 fn unit(v: glam::Vec3) -> [f32; 3] {
     v.try_normalize().unwrap_or(glam::Vec3::Z).to_array()
-}
-
-/// Triangles of a primitive by the workspace's one rule ([`crate::gltf::triangle_count`]), its
-/// accessors' counts looked up in `doc`.
-fn triangle_count(doc: &Value, primitive: &Value) -> u64 {
-    let count_of = |accessor: &Value| {
-        accessor.as_u64().and_then(|a| doc.get("accessors")?.get(a as usize)?.get("count")?.as_u64()).unwrap_or(0)
-    };
-    crate::gltf::triangle_count(
-        primitive.get("mode").map(|m| m.as_u64().unwrap_or(4)),
-        primitive.get("indices").map(count_of),
-        primitive.get("attributes").and_then(|a| a.get("POSITION")).map(count_of),
-    )
 }
 
 /// A mesh's silhouette candidates as format 0.2 defines them: the edges its primitives encode as 1,
@@ -419,29 +421,23 @@ struct AccessorInfo {
 /// bytes and its elements' layout there, every offset checked with checked arithmetic (the numbers
 /// come from the file).
 fn accessor_in<'a>(
-    doc: &Value,
+    doc: &Root,
     accessor: usize,
     buffer: &'a [u8],
     kind: &str,
 ) -> Result<(AccessorInfo, &'a [u8], Layout), FormatError> {
     let bad = |what: &str| FormatError::Invalid(format!("/accessors/{accessor}: {what}"));
-    let a = doc.get("accessors").and_then(|a| a.get(accessor)).ok_or_else(|| bad("missing"))?;
-    if a.get("type").and_then(Value::as_str) != Some(kind) {
+    let a = doc.accessors().get(accessor).ok_or_else(|| bad("missing"))?;
+    if a.kind.as_deref() != Some(kind) {
         return Err(bad(&format!("not a {kind} accessor")));
     }
-    let component = a
-        .get("componentType")
-        .and_then(Value::as_u64)
-        .and_then(ComponentType::from_code)
-        .ok_or_else(|| bad("no valid componentType"))?;
-    let normalized = a.get("normalized").and_then(Value::as_bool).unwrap_or(false);
-    let view_index = a.get("bufferView").and_then(Value::as_u64).ok_or_else(|| bad("no bufferView"))? as usize;
-    let view = doc.get("bufferViews").and_then(|v| v.get(view_index)).ok_or_else(|| bad("bufferView missing"))?;
-    let count = a.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))?;
-    let number = |v: &Value, key: &str| v.get(key).and_then(Value::as_u64).unwrap_or(0);
-    let view_length =
-        view.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad("bufferView has no byteLength"))?;
-    let view_bytes = usize::try_from(number(view, "byteOffset"))
+    let component = a.component_type.and_then(ComponentType::from_code).ok_or_else(|| bad("no valid componentType"))?;
+    let normalized = a.normalized.unwrap_or(false);
+    let view_index = a.buffer_view.ok_or_else(|| bad("no bufferView"))? as usize;
+    let view = doc.buffer_views().get(view_index).ok_or_else(|| bad("bufferView missing"))?;
+    let count = a.count.ok_or_else(|| bad("no count"))?;
+    let view_length = view.byte_length.ok_or_else(|| bad("bufferView has no byteLength"))?;
+    let view_bytes = usize::try_from(view.byte_offset.unwrap_or(0))
         .ok()
         .zip(usize::try_from(view_length).ok())
         .and_then(|(start, length)| buffer.get(start..start.checked_add(length)?))
@@ -450,8 +446,8 @@ fn accessor_in<'a>(
     let as_usize = |v: u64| usize::try_from(v).map_err(|_| bad("data outside its buffer view"));
     let layout = Layout::new(
         view_bytes.len(),
-        Some(as_usize(number(view, "byteStride"))?),
-        as_usize(number(a, "byteOffset"))?,
+        Some(as_usize(view.byte_stride.unwrap_or(0))?),
+        as_usize(a.byte_offset.unwrap_or(0))?,
         as_usize(count)?,
         components * component.size(),
     )
@@ -464,7 +460,7 @@ fn accessor_in<'a>(
 
 /// Reads a VEC3 accessor of unit vectors as stored: BYTE or SHORT normalized, or FLOAT, the three
 /// component types the merged `EXT_mesh_primitive_edge_visibility` allows for `silhouetteNormals`.
-fn read_unit_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<StoredNormals, FormatError> {
+fn read_unit_vec3s(doc: &Root, accessor: usize, buffer: &[u8]) -> Result<StoredNormals, FormatError> {
     let (a, view, layout) = accessor_in(doc, accessor, buffer, "VEC3")?;
     match (a.component, a.normalized) {
         (ComponentType::I8, true) => {
@@ -487,7 +483,7 @@ fn read_unit_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Stored
 
 /// Reads a VEC3 accessor of FLOAT, or of BYTE / SHORT normalized (decoded as glTF defines, then
 /// renormalised: these are shading normals), from the single buffer, tightly packed or strided.
-fn read_vec3s(doc: &Value, accessor: usize, buffer: &[u8]) -> Result<Vec<[f32; 3]>, FormatError> {
+fn read_vec3s(doc: &Root, accessor: usize, buffer: &[u8]) -> Result<Vec<[f32; 3]>, FormatError> {
     let (a, view, layout) = accessor_in(doc, accessor, buffer, "VEC3")?;
     match (a.component, a.normalized) {
         (ComponentType::F32, _) => Ok(accessor::read_vectors(view, &layout, a.component, false)),
@@ -526,14 +522,16 @@ pub struct ByteSections {
     pub total: u64,
 }
 
-/// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns.
+/// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns. The JSON is read as
+/// the JSON tree the writer holds, and counted by the writer's own [`sections_of`], so that a bake's
+/// report and `drafter inspect` count alike by construction.
 pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<ByteSections, FormatError> {
     let decoded = plain(bytes)?;
     let bytes = &*decoded;
     let (json, _) = split_container(bytes)?;
     let doc: Value = serde_json::from_slice(json)?;
-    let external_bytes = match doc.pointer("/buffers/0/uri") {
-        Some(_) => load_buffer(&doc, None, external)?.map_or(0, |b| b.len() as u64),
+    let external_bytes = match doc.pointer("/buffers/0/uri").and_then(Value::as_str) {
+        Some(uri) => external_buffer(uri, external)?.len() as u64,
         None => 0,
     };
     let empty = serde_json::Map::new();
