@@ -241,8 +241,8 @@ fn sigint_at_random_points_of_a_200_file_batch_leaves_no_partial_file_and_a_cons
 
     // Random points of the batch (a fixed seed), each trial on a fresh output folder and cache: one
     // signal lets the running files finish, two exit at once.
-    let mut rng = drafter_core::rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
-    let mut next = || rng.next();
+    let mut rng = drafter_core::rng::Rng::new(0x2545_f491_4f6c_dd1du64);
+    let mut next = || rng.next_u64();
     let mut interrupted = 0;
     for trial in 0..8 {
         let out = dir.join(format!("out{trial}"));

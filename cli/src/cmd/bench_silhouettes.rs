@@ -3,7 +3,7 @@
 //!
 //! A baked file is measured as a reader loads it: each mesh's stored candidates (the Khronos edges
 //! encoded 1, with their decoded normals) and stored hierarchies, through the viewer's loader
-//! (`drafter_viewer::edges::load_silhouettes`); `build_ms` is then the load time. `--rebuild`, or
+//! (`drafter_scene::edges::load_silhouettes`); `build_ms` is then the load time. `--rebuild`, or
 //! any other file, gives every unique mesh what the bake would store for it: its welded topology
 //! (default weld), its edge classes at the default crease angle (part borders are not separated
 //! here: the bench measures the mesh's own edges) and the [`SilhouetteIndex`] with default
@@ -25,8 +25,9 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Result, bail};
+use drafter_core::rng::Rng;
 use drafter_core::{Scene, Topology, Weld};
-use drafter_lines::measure::{ViewRng, Warmth, icosa_directions, time_per_view};
+use drafter_lines::measure::{Warmth, icosa_directions, time_per_view};
 use drafter_lines::{
     BruteForce, EdgeSet, HierarchyChoice, LineOptions, SilhouetteIndex, SilhouetteOptions, View, classify_edges,
 };
@@ -185,7 +186,7 @@ fn stored(scene: &Scene, bytes: &[u8]) -> Option<Vec<Prepared>> {
             mesh.positions.get(tri[k % 3] as usize).copied()
         };
         let start = std::time::Instant::now();
-        let Some(lines) = drafter_viewer::edges::load_silhouettes(m, s, &position, &mut notices) else { continue };
+        let Some(lines) = drafter_scene::edges::load_silhouettes(m, s, &position, &mut notices) else { continue };
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         prepared.push(Prepared {
             mesh: m,
@@ -230,15 +231,15 @@ fn prepare(scene: &Scene) -> Vec<Prepared> {
 }
 
 fn make_views(scene: &Scene, args: &Args) -> Vec<View> {
-    let mut rng = ViewRng::new(args.seed);
+    let mut rng = Rng::new(args.seed);
     match args.views {
         Views::Icosa => icosa_directions().into_iter().map(|direction| View::Orthographic { direction }).collect(),
         Views::Random(n) if !args.perspective => {
-            (0..n).map(|_| View::Orthographic { direction: rng.direction() }).collect()
+            (0..n).map(|_| View::Orthographic { direction: rng.direction_f32() }).collect()
         }
         Views::Random(n) => {
             let (lo, hi) = world_bounds(scene);
-            (0..n).map(|_| View::Perspective { eye: rng.eye_outside(lo, hi) }).collect()
+            (0..n).map(|_| View::Perspective { eye: drafter_lines::measure::eye_outside(&mut rng, lo, hi) }).collect()
         }
     }
 }

@@ -31,7 +31,7 @@ fn models(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// A seeded uniform random rotation (Shoemake's method), no extra crate.
 fn rotation(seed: u64) -> DQuat {
-    let mut rng = drafter_core::rng::XorShift64::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut rng = drafter_core::rng::Rng::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
     let mut next = || rng.unit_f64();
     let (u1, u2, u3) = (next(), next(), next());
     let tau = std::f64::consts::TAU;

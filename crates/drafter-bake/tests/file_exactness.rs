@@ -7,6 +7,7 @@
 //! drafter-io's import of the baked bytes, `SilhouetteIndex::from_arrays` (which renumbers into
 //! the Gauss map's storage order), then queries mapped back to corners and compared as sets.
 
+use drafter_core::rng::Rng;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -21,25 +22,6 @@ fn model(rel: &str) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
     assert!(root.join("README.md").is_file(), "the shared model corpus is missing at {}", root.display());
     root.join(rel)
-}
-
-/// xorshift64*, as the other exactness tests.
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn direction(&mut self) -> Vec3 {
-        let z = 2.0 * self.unit() - 1.0;
-        let phi = std::f32::consts::TAU * self.unit();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
 }
 
 fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
@@ -100,13 +82,15 @@ fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
         let brute = BruteForce::new(&normals, &points);
         let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let (center, half) = ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6));
-        let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ u64::from(*m));
+        let mut rng = Rng::new(0x9E37_79B9_7F4A_7C15 ^ u64::from(*m));
         let (mut a, mut b) = (EdgeSet::new(normals.len()), EdgeSet::new(normals.len()));
         for v in 0..VIEWS {
             let view = match v % 4 {
-                0 | 1 => View::Orthographic { direction: rng.direction() },
-                2 => View::Perspective { eye: center + rng.direction() * half * (1.05 + 4.0 * rng.unit()) },
-                _ => View::Perspective { eye: lo + (hi - lo) * Vec3::new(rng.unit(), rng.unit(), rng.unit()) },
+                0 | 1 => View::Orthographic { direction: rng.direction_f32() },
+                2 => View::Perspective { eye: center + rng.direction_f32() * half * (1.05 + 4.0 * rng.unit_f32()) },
+                _ => View::Perspective {
+                    eye: lo + (hi - lo) * Vec3::new(rng.unit_f32(), rng.unit_f32(), rng.unit_f32()),
+                },
             };
             a.reset(normals.len());
             b.reset(normals.len());

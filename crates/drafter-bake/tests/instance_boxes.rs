@@ -76,7 +76,7 @@ fn placements() -> Vec<DMat4> {
         DMat4::from_scale_rotation_translation(DVec3::splat(1e-3), turn(DVec3::X, -0.4), DVec3::new(1e5, 1e5, 0.0)),
     ];
     // More turns about arbitrary axes (a seeded sequence, no extra crate).
-    let mut rng = drafter_core::rng::XorShift64::new(0x9E37_79B9_7F4A_7C15u64);
+    let mut rng = drafter_core::rng::Rng::new(0x9E37_79B9_7F4A_7C15u64);
     let mut next = || rng.unit_f64();
     for _ in 0..24 {
         let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);

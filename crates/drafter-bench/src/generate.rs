@@ -15,7 +15,7 @@
 //! | [`single_triangle`] | one face, three boundary edges, no interior |
 
 use drafter_core::{Mesh, Scene, SourceFormat, TriangleGroup};
-use glam::{DMat4, DQuat, DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 
 /// A triangle mesh as plain arrays.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -245,58 +245,8 @@ pub fn coincident_points(count: usize, p: DVec3) -> Vec<DVec3> {
     vec![p; count]
 }
 
-/// SplitMix64: small, seeded, and the same on every platform.
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in 0..n (n > 0).
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n.max(1)
-    }
-
-    /// A uniformly random rotation (Shoemake 1992).
-    pub fn rotation(&mut self) -> DQuat {
-        let (u1, u2, u3) = (self.unit(), self.unit() * std::f64::consts::TAU, self.unit() * std::f64::consts::TAU);
-        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        DQuat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()).normalize()
-    }
-
-    /// A uniformly random unit vector.
-    pub fn direction(&mut self) -> DVec3 {
-        let z = self.unit() * 2.0 - 1.0;
-        let a = self.unit() * std::f64::consts::TAU;
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(r * a.cos(), r * a.sin(), z)
-    }
-
-    /// A random permutation of 0..n: `p[i]` is where `i` goes.
-    pub fn permutation(&mut self, n: usize) -> Vec<u32> {
-        let mut p: Vec<u32> = (0..n as u32).collect();
-        for i in (1..n).rev() {
-            let j = self.below(i as u64 + 1) as usize;
-            p.swap(i, j);
-        }
-        p
-    }
-}
+/// The seeded generator of the generated inputs: the workspace's one (drafter-core's SplitMix64).
+pub use drafter_core::rng::Rng;
 
 #[cfg(test)]
 mod tests {

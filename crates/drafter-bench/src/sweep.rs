@@ -490,7 +490,7 @@ pub fn sweep_silhouettes(
         (0..options.views).map(|_| View::Orthographic { direction: rng.direction().as_vec3() }).collect();
     let persp: Vec<View> = (0..options.views)
         .map(|_| View::Perspective {
-            eye: center + rng.direction().as_vec3() * radius * (1.05 + 3.0 * rng.unit() as f32),
+            eye: center + rng.direction().as_vec3() * radius * (1.05 + 3.0 * rng.unit_f64() as f32),
         })
         .collect();
     let direction = |v: View| match v {

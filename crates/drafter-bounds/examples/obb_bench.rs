@@ -60,7 +60,7 @@ fn parse_xyz(text: &str) -> Vec<DVec3> {
 }
 
 fn stress_parts() -> Vec<(String, Vec<DVec3>)> {
-    let mut rng = shapes::Rng::new(99);
+    let mut rng = shapes::rng(99);
     let mut out = Vec::new();
     // About 2000 hull faces: 1000 points on an ellipsoid.
     out.push(("ellipsoid_1000pts".to_owned(), shapes::ellipsoid(&mut rng, 1000, DVec3::new(1.0, 2.0, 3.0))));

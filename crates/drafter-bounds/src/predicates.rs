@@ -250,7 +250,7 @@ mod tests {
     fn exact_path_matches_integer_arithmetic() {
         // Integer coordinates near 2^30: differences are exact in f64, products are not, and i128
         // evaluates the determinant exactly. Near-coplanar points make the float filter give up.
-        let mut rng = drafter_core::rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut rng = drafter_core::rng::Rng::new(0x2545_f491_4f6c_dd1du64);
         let mut next = |range: i64| -> i64 { rng.below(2 * range as u64 + 1) as i64 - range };
         let big = 1i64 << 30;
         for _ in 0..3000 {
@@ -272,7 +272,7 @@ mod tests {
 
     #[test]
     fn filter_and_exact_agree_on_random_inputs() {
-        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut rng = drafter_core::rng::Rng::new(0x9e37_79b9_7f4a_7c15u64);
         let mut next = || rng.unit_f64() - 0.5;
         for _ in 0..2000 {
             let a = [next(), next(), next()];

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::shapes::{self, Rng};
+use common::shapes;
 use drafter_bounds::{ConvexHull, HullDimension, HullOptions, convex_hull};
 use glam::{DMat3, DVec3};
 
@@ -63,11 +63,14 @@ fn check_solid(points: &[DVec3], h: &ConvexHull, what: &str) {
 }
 
 fn clouds() -> Vec<(String, Vec<DVec3>)> {
-    let mut rng = Rng::new(17);
+    let mut rng = shapes::rng(17);
     let mut out: Vec<(String, Vec<DVec3>)> = Vec::new();
     for trial in 0..6 {
         let n = 20 + trial * 150;
-        out.push((format!("uniform {n}"), (0..n).map(|_| DVec3::new(rng.f64(), rng.f64(), rng.f64())).collect()));
+        out.push((
+            format!("uniform {n}"),
+            (0..n).map(|_| DVec3::new(rng.unit_f64(), rng.unit_f64(), rng.unit_f64())).collect(),
+        ));
         out.push((format!("gaussian {n}"), shapes::noisy_cloud(&mut rng, n, DVec3::new(1.0, 0.3, 2.0))));
         out.push((format!("sphere {n}"), shapes::ellipsoid(&mut rng, n, DVec3::ONE)));
     }
@@ -106,7 +109,7 @@ fn every_point_is_inside_and_the_hull_is_closed() {
 
 #[test]
 fn points_on_a_sphere_are_all_vertices() {
-    let mut rng = Rng::new(8);
+    let mut rng = shapes::rng(8);
     let points = shapes::ellipsoid(&mut rng, 500, DVec3::ONE);
     assert_eq!(hull(&points).vertices.len(), 500);
     let cube = shapes::box_surface(DVec3::ONE, 7);
@@ -125,7 +128,7 @@ fn lower_dimensions() {
     assert_eq!(h.dimension, HullDimension::Segment);
     assert_eq!(h.input_indices.len(), 2);
     assert!(h.input_indices.contains(&0) && h.input_indices.contains(&9));
-    let r = DMat3::from_quat(Rng::new(1).rotation());
+    let r = DMat3::from_quat(shapes::rng(1).rotation());
     let square: Vec<DVec3> = (0..25).map(|i| r * DVec3::new((i % 5) as f64, (i / 5) as f64, 0.0) + p).collect();
     let h = hull(&square);
     assert_eq!((h.dimension, h.vertices.len()), (HullDimension::Polygon, 4));

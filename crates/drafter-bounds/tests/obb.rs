@@ -160,12 +160,12 @@ fn dense_search(points: &[DVec3], rng: &mut Rng) -> f64 {
 
 #[test]
 fn optimal_matches_a_dense_search_on_small_clouds() {
-    let mut rng = Rng::new(2024);
+    let mut rng = shapes::rng(2024);
     for trial in 0..12 {
         let n = 6 + trial * 2;
-        let scale = DVec3::new(rng.range(0.5, 3.0), rng.range(0.5, 3.0), rng.range(0.5, 3.0));
+        let scale = DVec3::new(rng.range_f64(0.5, 3.0), rng.range_f64(0.5, 3.0), rng.range_f64(0.5, 3.0));
         let points: Vec<DVec3> = (0..n)
-            .map(|_| DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale)
+            .map(|_| DVec3::new(rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0), rng.range_f64(-1.0, 1.0)) * scale)
             .collect();
         let (obb, stats) = oriented_box_with_stats(&points, &ObbOptions::with_method(ObbMethod::Optimal)).unwrap();
         assert_eq!(stats.edge_search, Coverage::Exhaustive);
@@ -177,7 +177,7 @@ fn optimal_matches_a_dense_search_on_small_clouds() {
 
 #[test]
 fn volume_is_invariant_under_rotation() {
-    let mut rng = Rng::new(99);
+    let mut rng = shapes::rng(99);
     for shape in test_shapes(2 * shapes::FAMILIES) {
         let base_optimal = fit(&shape.points, ObbMethod::Optimal).volume;
         let base_default = fit(&shape.points, ObbMethod::Default).volume;
@@ -221,11 +221,11 @@ fn translation_by_a_million_changes_nothing() {
 
 #[test]
 fn reindexing_does_not_change_the_box() {
-    let mut rng = Rng::new(5);
+    let mut rng = shapes::rng(5);
     for shape in test_shapes(shapes::FAMILIES) {
         let mut shuffled = shape.points.clone();
         for i in (1..shuffled.len()).rev() {
-            shuffled.swap(i, rng.below(i + 1));
+            shuffled.swap(i, rng.index(i + 1));
         }
         for method in ObbMethod::ALL {
             let a = fit(&shape.points, method).volume;
@@ -243,7 +243,7 @@ fn cube(side: f64, n: usize) -> Vec<DVec3> {
 #[test]
 fn cube_box_is_exact_and_the_same_every_run() {
     let side = 2.0;
-    let mut rng = Rng::new(11);
+    let mut rng = shapes::rng(11);
     for trial in 0..4 {
         let points: Vec<DVec3> = if trial == 0 {
             cube(side, 5)
@@ -281,7 +281,7 @@ fn cylinder_box_is_minimal_and_stable() {
     // A regular 32-gon prism: the minimum rectangle of the cap has sides 2r·cos(π/32) (edge-flush).
     let (r, h, k) = (1.0, 3.0, 32);
     let expected = h * (2.0 * r * (std::f64::consts::PI / k as f64).cos()).powi(2);
-    let mut rng = Rng::new(3);
+    let mut rng = shapes::rng(3);
     for trial in 0..3 {
         let rot = if trial == 0 { DMat3::IDENTITY } else { DMat3::from_quat(rng.rotation()) };
         let points: Vec<DVec3> = shapes::cylinder(r, h, k, 5).iter().map(|p| rot * *p).collect();

@@ -196,9 +196,9 @@ pub fn snorm16_decode(c: [i16; 3]) -> Vec3 {
 mod tests {
     use super::*;
 
-    /// xorshift64: uniform values in [−1, 1).
+    /// Uniform values in [−1, 1) from the seeded generator.
     fn uniform(seed: u64) -> impl FnMut() -> f32 {
-        let mut rng = crate::rng::XorShift64::new(seed);
+        let mut rng = crate::rng::Rng::new(seed);
         move || rng.signed_f32()
     }
 

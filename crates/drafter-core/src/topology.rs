@@ -251,11 +251,18 @@ fn weld_snap(positions: &[Vec3], fraction: f64) -> Welded {
     }
     // Rounding the coordinate itself (not relative to the box) keeps 0.0 at a cell centre, so noise
     // around zero welds.
-    weld_by_keys(
-        positions,
-        |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64),
-        |k| hash_words(k.map(|c| c as u64)),
-    )
+    weld_by_keys(positions, |p| p.as_dvec3().to_array().map(|c| snap_key(c, cell)), hash_words)
+}
+
+/// The cell `c` falls in on a grid of `cell`, as the bits of the rounded quotient (-0.0 folded onto
+/// 0.0). Not an integer conversion: a grid fine against the coordinates (a tiny robust diagonal
+/// beside far vertices) gives quotients beyond `i64`, where a saturating conversion would put
+/// vertices whole units apart in one cell. Distinct `f32` coordinates give distinct quotients on
+/// any grid, since `f64` division keeps their relative spacing.
+#[inline]
+fn snap_key(c: f64, cell: f64) -> u64 {
+    let q = (c / cell).round();
+    if q == 0.0 || q.is_nan() { 0 } else { q.to_bits() }
 }
 
 /// How far the core of a model may be outgrown by its outliers before they stop setting the weld
@@ -917,7 +924,7 @@ mod tests {
     /// Independent recount with a hash map over many random meshes.
     #[test]
     fn edges_match_hashmap_reference() {
-        let mut rng = crate::rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut rng = crate::rng::Rng::new(0x2545_f491_4f6c_dd1du64);
         let mut rnd = |m: u32| rng.below(u64::from(m)) as u32;
         for _ in 0..200 {
             let nv = 3 + rnd(30);
@@ -1016,8 +1023,8 @@ mod tests {
     }
 
     /// Welded ids in order of first occurrence by key, and the first position of each.
-    fn reference_weld(positions: &[Vec3], key: impl Fn(Vec3) -> [i64; 3]) -> (Vec<u32>, Vec<Vec3>) {
-        let mut ids: std::collections::BTreeMap<[i64; 3], u32> = Default::default();
+    fn reference_weld<K: Ord>(positions: &[Vec3], key: impl Fn(Vec3) -> [K; 3]) -> (Vec<u32>, Vec<Vec3>) {
+        let mut ids: std::collections::BTreeMap<[K; 3], u32> = Default::default();
         let mut welded_positions = Vec::new();
         let of_vertex = positions
             .iter()
@@ -1031,9 +1038,9 @@ mod tests {
         (of_vertex, welded_positions)
     }
 
-    /// A seeded xorshift generator of integers below its argument.
-    fn xorshift(seed: u64) -> impl FnMut(u32) -> u32 {
-        let mut rng = crate::rng::XorShift64::new(seed);
+    /// A seeded generator of integers below its argument.
+    fn seeded_below(seed: u64) -> impl FnMut(u32) -> u32 {
+        let mut rng = crate::rng::Rng::new(seed);
         move |m| rng.below(u64::from(m)) as u32
     }
 
@@ -1058,7 +1065,7 @@ mod tests {
     /// [`reference_tables`] and [`reference_weld`], for every weld.
     #[test]
     fn every_table_matches_a_brute_force_reference() {
-        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut rnd = seeded_below(0x9e37_79b9_7f4a_7c15);
         for _ in 0..400 {
             let nv = 1 + rnd(40);
             let grid = 1 + rnd(4);
@@ -1071,14 +1078,12 @@ mod tests {
             reference_tables(&exact, &triangles);
 
             let snap = Topology::from_triangles(&positions, &triangles, Weld::default());
-            let (lo, hi) = positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-            });
-            let cell = (hi - lo).length() * DEFAULT_SNAP_FRACTION;
+            let cell = robust_diagonal(&positions) * DEFAULT_SNAP_FRACTION;
             let expected = if cell > 0.0 {
-                reference_weld(&positions, |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i64))
+                // Cells as exact integers (`i128` holds every quotient of these coordinates).
+                reference_weld(&positions, |p| p.as_dvec3().to_array().map(|c| (c / cell).round() as i128))
             } else {
-                reference_weld(&positions, |p| weld_key(p).map(i64::from))
+                reference_weld(&positions, |p| weld_key(p).map(i128::from))
             };
             assert_eq!((&snap.welded_of_vertex, &snap.welded_positions), (&expected.0, &expected.1));
             reference_tables(&snap, &triangles);
@@ -1087,12 +1092,21 @@ mod tests {
         }
     }
 
+    /// A grid fine against the coordinates: four vertices whose core spans 1e-12 (so the snap cell
+    /// is 6.4e-20) two units apart in x. Their cells lie beyond `i64`; they must stay apart.
+    #[test]
+    fn a_grid_finer_than_the_coordinates_welds_nothing_apart() {
+        let positions = [[2.0, 0.0, 0.0], [2.0, 0.0, 1.0], [3.0, 1e-12, 1.0], [1.0, 1e-12, 1.0]].map(Vec3::from_array);
+        let topology = Topology::from_triangles(&positions, &[[0, 1, 2], [0, 2, 3]], Weld::default());
+        assert_eq!(topology.welded_of_vertex, [0, 1, 2, 3]);
+    }
+
     /// The partitioned weld against the serial reference, on random positions with many repeats
     /// (also -0.0 and snap-sized noise), with 1 to 10 bucket bits (many vertices per bucket, and
     /// more buckets than vertices), exact and snapped keys.
     #[test]
     fn partitioned_weld_is_the_serial_weld() {
-        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
+        let mut rnd = seeded_below(0x2545_f491_4f6c_dd1d);
         for round in 0..60 {
             let nv = 1 + rnd(if round % 10 == 0 { 70_000 } else { 3000 });
             let grid = 1 + rnd(20);
@@ -1101,10 +1115,10 @@ mod tests {
                 let exact = weld_partitioned(&positions, &weld_key, &|k: [u32; 3]| hash_words(k.map(u64::from)), bits);
                 let expected = reference_weld(&positions, |p| weld_key(p).map(i64::from));
                 assert_eq!((&exact.of_vertex, &exact.positions), (&expected.0, &expected.1), "exact, {nv} vertices");
-                let snap_key = |p: Vec3| p.as_dvec3().to_array().map(|c| (c / 0.01).round() as i64);
-                let snapped =
-                    weld_partitioned(&positions, &snap_key, &|k: [i64; 3]| hash_words(k.map(|c| c as u64)), bits);
-                let expected = reference_weld(&positions, snap_key);
+                let key = |p: Vec3| p.as_dvec3().to_array().map(|c| snap_key(c, 0.01));
+                let snapped = weld_partitioned(&positions, &key, &hash_words, bits);
+                let expected =
+                    reference_weld(&positions, |p| p.as_dvec3().to_array().map(|c| (c / 0.01).round() as i64));
                 assert_eq!((&snapped.of_vertex, &snapped.positions), (&expected.0, &expected.1), "snapped");
             }
         }

@@ -484,7 +484,7 @@ mod tests {
     /// Random pieces bunched along a few lines: near-parallel, crossing, overlapping, hidden and
     /// visible, of every class that ranks differently, with stubs across them.
     fn bunched_pieces(seed: u64, count: usize) -> Vec<Piece> {
-        let mut rng = drafter_core::rng::XorShift64::new(seed);
+        let mut rng = drafter_core::rng::Rng::new(seed);
         let classes = [LineClass::Crease, LineClass::Silhouette, LineClass::Boundary, LineClass::Tangent];
         let lines: Vec<(DVec2, f64)> = (0..6)
             .map(|_| (DVec2::new(rng.unit_f64(), rng.unit_f64()) * 60.0, rng.unit_f64() * std::f64::consts::PI))

@@ -57,7 +57,7 @@ fn main() {
         let points = &lines.candidate_points;
         let (lo, hi) = bounds(&mesh.positions);
         let mut rng = Rng::new(7);
-        let ortho: Vec<Vec3> = (0..views).map(|_| rng.direction()).collect();
+        let ortho: Vec<Vec3> = (0..views).map(|_| rng.direction_f32()).collect();
         let eyes: Vec<Vec3> = (0..views).map(|_| eye_outside(&mut rng, lo, hi)).collect();
         for (name, bytes, max) in
             [("BYTE nearest", 6, -1.0f32), ("BYTE", 6, 127.0), ("SHORT", 12, 32767.0), ("FLOAT", 24, 0.0)]

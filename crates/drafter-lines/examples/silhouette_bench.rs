@@ -186,7 +186,7 @@ fn bench(mesh: &TestMesh, parts: Option<&[PartId]>, args: &Args) {
 
     let mut rng = Rng::new(args.seed);
     let (lo, hi) = bounds(&mesh.positions);
-    let ortho: Vec<View> = (0..args.views).map(|_| View::Orthographic { direction: rng.direction() }).collect();
+    let ortho: Vec<View> = (0..args.views).map(|_| View::Orthographic { direction: rng.direction_f32() }).collect();
     let persp: Vec<View> = (0..args.views).map(|_| View::Perspective { eye: eye_outside(&mut rng, lo, hi) }).collect();
     let direction = |v: View| match v {
         View::Orthographic { direction } => direction,
@@ -296,7 +296,7 @@ fn calibration_samples(mesh: &TestMesh, args: &Args, gauss: &mut Vec<Sample>, bv
         let index = SilhouetteIndex::build(&lines, &options);
         let Some(g) = index.gauss_map() else { continue };
         for _ in 0..views {
-            let d = rng.direction();
+            let d = rng.direction_f32();
             let mut best = f64::INFINITY;
             let mut counts = QueryCounts::default();
             for _ in 0..3 {

@@ -1059,7 +1059,7 @@ mod tests {
 
     use glam::Quat;
 
-    use crate::measure::xorshift;
+    use crate::measure::signed_uniform;
 
     /// The walk's block test (the 16-bit pretest on x86-64) against the scalar predicate, on
     /// normals placed at distances from the view's great circle around the pretest's threshold
@@ -1067,7 +1067,7 @@ mod tests {
     /// zero), in ranges that start and end inside words.
     #[test]
     fn block_test_matches_predicate_near_the_circle() {
-        let mut r = xorshift(0x5eed);
+        let mut r = signed_uniform(0x5eed);
         let offsets = [0.0, 1e-9, 1e-7, 1e-6, 1e-5, 3e-5, 5e-5, 5.4e-5, 5.5e-5, 5.6e-5, 5.7e-5, 6e-5, 1e-4, 1e-3, 0.3];
         let mut checked = 0usize;
         for _ in 0..400 {
@@ -1116,7 +1116,7 @@ mod tests {
     /// which the pretest leaves to `f32`), a leaf with a non-finite point.
     #[test]
     fn leaf_test_matches_predicate_near_the_planes() {
-        let mut r = xorshift(0xface);
+        let mut r = signed_uniform(0xface);
         let offsets = [0.0, 1e-9, 1e-7, 1e-6, 1e-5, 5e-5, 8e-5, 8.8e-5, 9e-5, 1e-4, 3e-4, 1e-3, 0.3];
         let (mut checked, mut pretested, mut pending_blocks) = (0usize, 0usize, 0usize);
         for trial in 0..300 {
@@ -1204,7 +1204,7 @@ mod tests {
     /// exercise padding, and serial equals parallel.
     #[test]
     fn kernels_match_scalar_predicate() {
-        let mut r = xorshift(7);
+        let mut r = signed_uniform(7);
         for n in [0usize, 1, 63, 64, 65, 1000, PARALLEL_MIN_CANDIDATES + 3] {
             let normals: Vec<[Vec3; 2]> =
                 (0..n).map(|_| [Vec3::new(r(), r(), r()).normalize(), Vec3::new(r(), r(), r()).normalize()]).collect();

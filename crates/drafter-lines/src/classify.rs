@@ -689,19 +689,19 @@ mod tests {
     /// thresholds inside and outside (0°, 180°).
     #[test]
     fn angle_test_answers_as_the_arctangent() {
-        let mut rng = crate::measure::ViewRng::new(17);
+        let mut rng = drafter_core::rng::Rng::new(17);
         for threshold in [30.0, 0.001, 1e-9, 45.0, 90.0, 120.0, 179.999, 0.0, 180.0, -1.0, 200.0] {
             let test = super::AngleTest::new(threshold);
             let rule = |s: f64, c: f64| s.atan2(c).to_degrees() > threshold;
             let alpha = threshold.clamp(0.0, 180.0).to_radians();
             let mut pairs: Vec<(f64, f64)> = Vec::new();
             for _ in 0..20_000 {
-                let r = 10f64.powf(f64::from(rng.unit()) * 8.0 - 4.0);
-                let theta = f64::from(rng.unit()) * std::f64::consts::PI;
+                let r = 10f64.powf(f64::from(rng.unit_f32()) * 8.0 - 4.0);
+                let theta = f64::from(rng.unit_f32()) * std::f64::consts::PI;
                 pairs.push((r * theta.sin(), r * theta.cos()));
-                let near = alpha + (f64::from(rng.unit()) - 0.5) * 1e-13;
+                let near = alpha + (f64::from(rng.unit_f32()) - 0.5) * 1e-13;
                 pairs.push((near.sin().abs(), near.cos()));
-                let n1 = rng.direction().as_dvec3().normalize();
+                let n1 = rng.direction_f32().as_dvec3().normalize();
                 let axis = n1.any_orthonormal_vector();
                 let n2 = glam::DQuat::from_axis_angle(axis, alpha) * n1;
                 pairs.push((n1.cross(n2).length(), n1.dot(n2)));

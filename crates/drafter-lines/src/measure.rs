@@ -16,6 +16,7 @@
 
 use std::time::Instant;
 
+use drafter_core::rng::Rng;
 use glam::Vec3;
 
 /// The 20 fixed orthographic directions of `--views icosa`, normalised: the 12 icosahedron
@@ -39,63 +40,23 @@ pub fn icosa_directions() -> Vec<Vec3> {
     out.into_iter().map(Vec3::normalize).collect()
 }
 
-/// Numbers in [-1, 1) from a plain xorshift64 seeded with `seed`: the generator of the unit tests
-/// that place normals, boxes and eyes by hand.
+/// Numbers in [-1, 1) from the workspace's generator seeded with `seed`: the generator of the unit
+/// tests that place normals, boxes and eyes by hand.
 #[cfg(test)]
-pub(crate) fn xorshift(seed: u64) -> impl FnMut() -> f32 {
-    let mut rng = drafter_core::rng::XorShift64::new(seed);
+pub(crate) fn signed_uniform(seed: u64) -> impl FnMut() -> f32 {
+    let mut rng = Rng::new(seed);
     move || rng.signed_f32()
 }
 
-/// A seeded xorshift64* generator of views: deterministic, no dependency.
-#[derive(Clone, Debug)]
-pub struct ViewRng(u64);
-
-impl ViewRng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed.max(1).wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// Uniform below `n` (any `n`; 0 counts as 1).
-    pub fn below(&mut self, n: u32) -> u32 {
-        (self.next_u64() % u64::from(n.max(1))) as u32
-    }
-
-    /// Uniform direction on the sphere.
-    pub fn direction(&mut self) -> Vec3 {
-        let z = 2.0 * self.unit() - 1.0;
-        let phi = std::f32::consts::TAU * self.unit();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-
-    /// An eye outside the box `lo..hi`, at 1.05 to 5 half-diagonals from its centre in a uniform
-    /// direction (retried while inside the box).
-    pub fn eye_outside(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
-        let center = (lo + hi) * 0.5;
-        let half = ((hi - lo) * 0.5).length().max(1e-6);
-        loop {
-            let e = center + self.direction() * half * (1.05 + 3.95 * self.unit());
-            if !(e.cmpge(lo).all() && e.cmple(hi).all()) {
-                return e;
-            }
+/// An eye outside the box `lo..hi`, at 1.05 to 5 half-diagonals from its centre in a uniform
+/// direction (drawn again while inside the box).
+pub fn eye_outside(rng: &mut Rng, lo: Vec3, hi: Vec3) -> Vec3 {
+    let center = (lo + hi) * 0.5;
+    let half = ((hi - lo) * 0.5).length().max(1e-6);
+    loop {
+        let e = center + rng.direction_f32() * half * (1.05 + 3.95 * rng.unit_f32());
+        if !(e.cmpge(lo).all() && e.cmple(hi).all()) {
+            return e;
         }
     }
 }
@@ -165,10 +126,10 @@ mod tests {
 
     #[test]
     fn eyes_are_outside() {
-        let mut rng = ViewRng::new(3);
+        let mut rng = Rng::new(3);
         let (lo, hi) = (Vec3::ZERO, Vec3::new(1.0, 2.0, 0.01));
         for _ in 0..1000 {
-            let e = rng.eye_outside(lo, hi);
+            let e = eye_outside(&mut rng, lo, hi);
             assert!(!(e.cmpge(lo).all() && e.cmple(hi).all()));
             assert!(e.is_finite());
         }

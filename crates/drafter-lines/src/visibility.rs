@@ -546,7 +546,7 @@ mod tests {
     /// vertices, collapsed triangles (a repeated vertex, and two vertices at one position), a fin
     /// on a third face of an edge, and a doubled face.
     fn rough_grid(n: u32, seed: u64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let mut rng = drafter_core::rng::XorShift64::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let mut rng = drafter_core::rng::Rng::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
         let mut r = move || rng.unit_f32();
         let mut positions: Vec<Vec3> =
             (0..n * n).map(|i| Vec3::new((i % n) as f32, (i / n) as f32, if r() < 0.3 { r() } else { 0.0 })).collect();

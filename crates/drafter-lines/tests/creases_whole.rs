@@ -38,7 +38,7 @@ fn chamfered_cylinder(n: u32, spread: f32, seed: u64) -> (Vec<Vec3>, Vec<[u32; 3
         let outer = positions.len() as u32;
         for k in 0..n {
             let a = step * k as f32;
-            let angle = (30.0 + spread * rng.range(-1.0, 1.0)).to_radians();
+            let angle = (30.0 + spread * rng.range_f32(-1.0, 1.0)).to_radians();
             let drop = chamfer * half * angle.tan();
             positions.push(Vec3::new(radius * a.cos(), radius * a.sin(), top - sign * drop));
         }
@@ -131,7 +131,7 @@ fn noisy_plane(cells: u32, amplitude: f32, seed: u64) -> Topology {
     let mut positions = Vec::new();
     for j in 0..=cells {
         for i in 0..=cells {
-            positions.push(Vec3::new(i as f32 * h, j as f32 * h, amplitude * h * rng.range(-1.0, 1.0)));
+            positions.push(Vec3::new(i as f32 * h, j as f32 * h, amplitude * h * rng.range_f32(-1.0, 1.0)));
         }
     }
     let mut triangles = Vec::new();
@@ -156,7 +156,7 @@ fn folded_sheet(cells: u32, seed: u64) -> Topology {
     let mut positions = Vec::new();
     for j in 0..=cells {
         for i in 0..=cells {
-            let z = if i % 2 == 1 { c * h } else { 0.0 } + 0.008 * h * rng.range(-1.0, 1.0);
+            let z = if i % 2 == 1 { c * h } else { 0.0 } + 0.008 * h * rng.range_f32(-1.0, 1.0);
             positions.push(Vec3::new(i as f32 * h, j as f32 * h, z));
         }
     }

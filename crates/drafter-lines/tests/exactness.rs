@@ -39,17 +39,17 @@ fn views(x: &Indexed, rng: &mut Rng, ortho: usize, perspective: usize) -> Vec<Vi
     let mut out = Vec::with_capacity(ortho + perspective);
     for k in 0..ortho {
         let direction = match k % 6 {
-            0 | 1 => rng.direction(),
+            0 | 1 => rng.direction_f32(),
             2 => Vec3::new(rng.below(5) as f32 - 2.0, rng.below(5) as f32 - 2.0, rng.below(5) as f32 - 2.0),
             3 if n > 0 => {
-                let [n1, n2] = x.lines.candidate_normals[rng.below(n) as usize];
+                let [n1, n2] = x.lines.candidate_normals[rng.below(u64::from(n)) as usize];
                 n1.cross(n2)
             }
             4 if n > 0 => {
-                let [n1, _] = x.lines.candidate_normals[rng.below(n) as usize];
-                n1.cross(rng.direction())
+                let [n1, _] = x.lines.candidate_normals[rng.below(u64::from(n)) as usize];
+                n1.cross(rng.direction_f32())
             }
-            _ => rng.direction() * rng.range(1e-3, 1e3),
+            _ => rng.direction_f32() * rng.range_f32(1e-3, 1e3),
         };
         out.push(View::Orthographic { direction });
     }
@@ -59,13 +59,13 @@ fn views(x: &Indexed, rng: &mut Rng, ortho: usize, perspective: usize) -> Vec<Vi
             3 | 4 => eye_inside(rng, lo, hi),
             5 if n > 0 => {
                 // On the plane of a candidate's first face.
-                let c = rng.below(n) as usize;
+                let c = rng.below(u64::from(n)) as usize;
                 let [n1, _] = x.lines.candidate_normals[c];
-                let t = n1.cross(rng.direction()).normalize_or_zero();
-                x.lines.candidate_points[c] + t * rng.range(0.0, 2.0) * (hi - lo).length()
+                let t = n1.cross(rng.direction_f32()).normalize_or_zero();
+                x.lines.candidate_points[c] + t * rng.range_f32(0.0, 2.0) * (hi - lo).length()
             }
-            6 => x.mesh.positions[rng.below(x.mesh.positions.len() as u32) as usize],
-            _ => (lo + hi) * 0.5 + rng.direction() * (hi - lo).length() * 1e3,
+            6 => x.mesh.positions[rng.index(x.mesh.positions.len())],
+            _ => (lo + hi) * 0.5 + rng.direction_f32() * (hi - lo).length() * 1e3,
         };
         out.push(View::Perspective { eye });
     }
@@ -317,7 +317,7 @@ fn arrays_load_from_candidates_in_the_build_order() {
     let mut rng = Rng::new(5);
     let mut perm: Vec<usize> = (0..n).collect();
     for i in (1..n).rev() {
-        perm.swap(i, rng.below(i as u32 + 1) as usize);
+        perm.swap(i, rng.index(i + 1));
     }
     let edges: Vec<u32> = perm.iter().map(|&k| x.lines.candidates[k]).collect();
     let normals: Vec<[Vec3; 2]> = perm.iter().map(|&k| x.lines.candidate_normals[k]).collect();
@@ -372,7 +372,7 @@ fn standalone_hierarchies_answer_in_input_order() {
     let (lo, hi) = bounds(&mesh.positions);
     let (mut a, mut b, mut c) = (EdgeSet::default(), EdgeSet::default(), EdgeSet::default());
     for _ in 0..300 {
-        let d = rng.direction();
+        let d = rng.direction_f32();
         brute.query_serial(View::Orthographic { direction: d }, &mut a);
         gauss.query(d, &mut b);
         assert_eq!(a, b);

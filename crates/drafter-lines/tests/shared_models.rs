@@ -32,7 +32,7 @@ fn check_model(rel: &str) {
     let mut silhouettes = 0usize;
     for k in 0..VIEWS {
         let view = match k % 4 {
-            0 | 1 => View::Orthographic { direction: rng.direction() },
+            0 | 1 => View::Orthographic { direction: rng.direction_f32() },
             2 => View::Perspective { eye: eye_outside(&mut rng, lo, hi) },
             _ => View::Perspective { eye: eye_inside(&mut rng, lo, hi) },
         };

@@ -579,7 +579,7 @@ mod tests {
     /// A bumpy grid in shuffled face order, with a far vertex (damped neighbours), a degenerate face,
     /// a boundary, and a second piece.
     fn shuffled_grid(side: u32, seed: u64) -> Topology {
-        let mut rng = drafter_core::rng::XorShift64::new(seed);
+        let mut rng = drafter_core::rng::Rng::new(seed);
         let mut next = move || rng.unit_f64() as f32;
         let id = |x: u32, y: u32| y * (side + 1) + x;
         let mut positions: Vec<glam::Vec3> = (0..=side)

@@ -546,7 +546,7 @@ mod tests {
     /// spanning twelve decades, plus the axes and the zero pair.
     #[test]
     fn angle_matches_atan2() {
-        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut rng = drafter_core::rng::Rng::new(0x9e37_79b9_7f4a_7c15u64);
         let mut next = || rng.unit_f64();
         let mut worst = 0.0f64;
         for _ in 0..200_000 {

@@ -3,6 +3,7 @@
 mod common;
 
 use common::*;
+use drafter_core::rng::Rng;
 use drafter_core::{Mesh, Topology, Weld};
 use drafter_normals::*;
 use glam::Vec3;
@@ -546,36 +547,15 @@ fn low_pass_matches_a_reference_jacobi() {
     }
 }
 
-/// A small deterministic generator (SplitMix64) for the random meshes below.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
 /// A random height field with holes, fins on random edges (non-manifold), a separate fan touching
 /// one grid vertex (a bowtie vertex), split and shuffled input vertices and shuffled faces; no
 /// degenerate face.
 fn random_relief(seed: u64) -> Mesh {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let side = 3 + rng.below(10) as u32;
-    let height = rng.unit() * 1.5;
+    let height = rng.unit_f32() * 1.5;
     let mut positions: Vec<Vec3> = (0..side * side)
-        .map(|i| Vec3::new((i % side) as f32, (i / side) as f32, (rng.unit() - 0.5) * height))
+        .map(|i| Vec3::new((i % side) as f32, (i / side) as f32, (rng.unit_f32() - 0.5) * height))
         .collect();
     let mut triangles = Vec::new();
     for y in 0..side - 1 {
@@ -591,7 +571,7 @@ fn random_relief(seed: u64) -> Mesh {
     // Fins: a third face on a random grid edge.
     for _ in 0..rng.below(4) {
         let Some(&[a, b, _]) = triangles.get(rng.below(triangles.len().max(1) as u64) as usize) else { break };
-        let apex = (positions[a as usize] + positions[b as usize]) * 0.5 + Vec3::new(0.1, -0.2, 0.7 + rng.unit());
+        let apex = (positions[a as usize] + positions[b as usize]) * 0.5 + Vec3::new(0.1, -0.2, 0.7 + rng.unit_f32());
         positions.push(apex);
         triangles.push([a, b, positions.len() as u32 - 1]);
     }
@@ -602,7 +582,7 @@ fn random_relief(seed: u64) -> Mesh {
     let ring = 3 + rng.below(4) as u32;
     for k in 0..ring {
         let angle = k as f32 / ring as f32 * std::f32::consts::TAU;
-        positions.push(centre + Vec3::new(0.3 * angle.cos(), 0.3 * angle.sin(), 0.5 + 0.2 * rng.unit()));
+        positions.push(centre + Vec3::new(0.3 * angle.cos(), 0.3 * angle.sin(), 0.5 + 0.2 * rng.unit_f32()));
     }
     for k in 0..ring {
         triangles.push([first, first + 1 + k, first + 1 + (k + 1) % ring]);

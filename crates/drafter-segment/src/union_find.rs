@@ -145,10 +145,10 @@ mod tests {
     #[test]
     fn concurrent_unions_give_the_sequential_partition() {
         let n = 20_000u32;
-        let mut rng = drafter_core::rng::XorShift64::new(0x9e37_79b9_7f4a_7c15);
+        let mut rng = drafter_core::rng::Rng::new(0x9e37_79b9_7f4a_7c15);
         let pairs: Vec<(u32, u32)> = (0..15_000)
             .map(|_| {
-                let s = rng.next();
+                let s = rng.next_u64();
                 ((s % n as u64) as u32, ((s >> 32) % n as u64) as u32)
             })
             .collect();

@@ -6,47 +6,14 @@
 
 use std::f64::consts::{PI, TAU};
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DMat3, DVec3};
 
-/// SplitMix64: small, seeded, reproducible.
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
+pub use drafter_core::rng::Rng;
 
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed ^ 0x5851_f42d_4c95_7f2d)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.f64()
-    }
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-    /// Standard normal (Box–Muller).
-    pub fn normal(&mut self) -> f64 {
-        let u = self.f64().max(1e-300);
-        let v = self.f64();
-        (-2.0 * u.ln()).sqrt() * (TAU * v).cos()
-    }
-    /// Uniform random rotation (Shoemake).
-    pub fn rotation(&mut self) -> DQuat {
-        let (u1, u2, u3) = (self.f64(), self.f64(), self.f64());
-        let a = (1.0 - u1).sqrt();
-        let b = u1.sqrt();
-        DQuat::from_xyzw(a * (TAU * u2).sin(), a * (TAU * u2).cos(), b * (TAU * u3).sin(), b * (TAU * u3).cos())
-            .normalize()
-    }
+/// The generator these shapes are drawn with for `seed`: the workspace's one, its seed salted so
+/// that small seeds do not start the shapes of different tests alike.
+pub fn rng(seed: u64) -> Rng {
+    Rng::new(seed ^ 0x5851_f42d_4c95_7f2d)
 }
 
 /// A tessellated box surface: a grid of `n × n` points on each face (exactly coplanar in object space).
@@ -87,9 +54,9 @@ pub fn cylinder(radius: f64, height: f64, segments: usize, rings: usize) -> Vec<
 fn holes(rng: &mut Rng, size: DVec3, count: usize) -> Vec<DVec3> {
     let mut pts = Vec::new();
     for _ in 0..count {
-        let r = rng.range(0.05, 0.2) * size.x.min(size.y);
-        let cx = rng.range(-0.5 * size.x + r, 0.5 * size.x - r);
-        let cy = rng.range(-0.5 * size.y + r, 0.5 * size.y - r);
+        let r = rng.range_f64(0.05, 0.2) * size.x.min(size.y);
+        let cx = rng.range_f64(-0.5 * size.x + r, 0.5 * size.x - r);
+        let cy = rng.range_f64(-0.5 * size.y + r, 0.5 * size.y - r);
         for p in cylinder(r, size.z, 24, 2) {
             pts.push(p + DVec3::new(cx, cy, 0.0));
         }
@@ -192,10 +159,10 @@ pub const FAMILIES: usize = 11;
 
 /// [`cad_like`] with tessellation density scaled by `detail` (1 = bench size; tests use less).
 pub fn cad_like_with(seed: u64, index: usize, detail: f64) -> Shape {
-    let mut rng = Rng::new(seed.wrapping_mul(1_000_003).wrapping_add(index as u64));
+    let mut rng = rng(seed.wrapping_mul(1_000_003).wrapping_add(index as u64));
     let kind = index % FAMILIES;
     let count = |n: usize| ((n as f64 * detail).round() as usize).max(8);
-    let s = |rng: &mut Rng| rng.range(0.2, 3.0);
+    let s = |rng: &mut Rng| rng.range_f64(0.2, 3.0);
     let (name, pts) = match kind {
         0 => {
             let size = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
@@ -203,16 +170,20 @@ pub fn cad_like_with(seed: u64, index: usize, detail: f64) -> Shape {
             p.extend(holes(&mut rng, size, 3));
             ("box_with_holes", p)
         }
-        1 => ("cylinder", cylinder(rng.range(0.1, 1.0), rng.range(0.1, 4.0), count(8 * (2 + rng.below(16))), 4)),
-        2 => ("l_bracket", l_bracket(s(&mut rng), s(&mut rng), rng.range(0.05, 0.3), s(&mut rng))),
+        1 => {
+            ("cylinder", cylinder(rng.range_f64(0.1, 1.0), rng.range_f64(0.1, 4.0), count(8 * (2 + rng.index(16))), 4))
+        }
+        2 => ("l_bracket", l_bracket(s(&mut rng), s(&mut rng), rng.range_f64(0.05, 0.3), s(&mut rng))),
         3 => {
             let size = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
             let r = 0.2 * size.min_element();
             ("rounded_box", rounded_box(size, r, count(600)))
         }
-        4 => ("hex_nut", prism(6, rng.range(0.2, 1.0), rng.range(0.1, 0.6))),
-        5 => ("gear", gear(count(10 + rng.below(30)), 1.0, 1.15, rng.range(0.1, 0.8))),
-        6 => ("frustum", frustum(rng.range(0.2, 1.0), rng.range(0.05, 1.0), rng.range(0.2, 2.0), count(48))),
+        4 => ("hex_nut", prism(6, rng.range_f64(0.2, 1.0), rng.range_f64(0.1, 0.6))),
+        5 => ("gear", gear(count(10 + rng.index(30)), 1.0, 1.15, rng.range_f64(0.1, 0.8))),
+        6 => {
+            ("frustum", frustum(rng.range_f64(0.2, 1.0), rng.range_f64(0.05, 1.0), rng.range_f64(0.2, 2.0), count(48)))
+        }
         7 => {
             let sigma = DVec3::new(s(&mut rng), s(&mut rng), s(&mut rng));
             ("noisy_cloud", noisy_cloud(&mut rng, count(800), sigma))
@@ -222,7 +193,7 @@ pub fn cad_like_with(seed: u64, index: usize, detail: f64) -> Shape {
             ("ellipsoid", ellipsoid(&mut rng, count(400), radii))
         }
         9 => {
-            let size = DVec3::new(s(&mut rng), s(&mut rng), rng.range(0.005, 0.05));
+            let size = DVec3::new(s(&mut rng), s(&mut rng), rng.range_f64(0.005, 0.05));
             ("sheet_plate", plate_with_holes(&mut rng, size, 4))
         }
         _ => {
@@ -236,6 +207,6 @@ pub fn cad_like_with(seed: u64, index: usize, detail: f64) -> Shape {
         }
     };
     let rot = DMat3::from_quat(rng.rotation());
-    let offset = DVec3::new(rng.range(-10.0, 10.0), rng.range(-10.0, 10.0), rng.range(-10.0, 10.0));
+    let offset = DVec3::new(rng.range_f64(-10.0, 10.0), rng.range_f64(-10.0, 10.0), rng.range_f64(-10.0, 10.0));
     Shape { name: format!("{name}_{index}"), points: pts.into_iter().map(|p| rot * p + offset).collect() }
 }

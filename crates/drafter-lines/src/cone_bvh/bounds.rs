@@ -293,12 +293,12 @@ fn box_culls(b: &[f32; 6], c: &[f32; 4], e: Vec3) -> bool {
 mod tests {
     use super::*;
 
-    use crate::measure::xorshift;
+    use crate::measure::signed_uniform;
 
     /// The corner test agrees with dense sampling of the box and the cone.
     #[test]
     fn cull_test_is_conservative_on_samples() {
-        let mut r = xorshift(99);
+        let mut r = signed_uniform(99);
         let mut culled = 0;
         for _ in 0..3000 {
             let axis = Vec3::new(r(), r(), r()).normalize();
@@ -335,7 +335,7 @@ mod tests {
     /// ones, eyes near and far.
     #[test]
     fn plane_test_is_conservative() {
-        let mut r = xorshift(7);
+        let mut r = signed_uniform(7);
         let (mut culled, mut tested) = (0, 0);
         for case in 0..400 {
             let axis = Vec3::new(r(), r(), r()).normalize();
@@ -379,15 +379,15 @@ mod tests {
     /// patches of every spread (some past a hemisphere), with zero normals and repeated points.
     #[test]
     fn cone_and_planes_equal_the_two_passes() {
-        let mut rng = crate::measure::ViewRng::new(3);
+        let mut rng = drafter_core::rng::Rng::new(3);
         let mut never = 0;
         for case in 0..3000 {
-            let axis = rng.direction();
+            let axis = rng.direction_f32();
             let spread = [1e-4, 0.05, 0.6, 3.0][case % 4];
             let n = 1 + case % 40;
             let mut normals: Vec<[Vec3; 2]> =
-                (0..n).map(|_| [0, 1].map(|_| (axis + rng.direction() * spread).normalize_or_zero())).collect();
-            let mut points: Vec<Vec3> = (0..n).map(|_| rng.direction() * (1.0 + rng.unit() * 1e3)).collect();
+                (0..n).map(|_| [0, 1].map(|_| (axis + rng.direction_f32() * spread).normalize_or_zero())).collect();
+            let mut points: Vec<Vec3> = (0..n).map(|_| rng.direction_f32() * (1.0 + rng.unit_f32() * 1e3)).collect();
             if case % 97 == 0 {
                 normals[n / 2][1] = Vec3::ZERO;
             }
@@ -400,10 +400,12 @@ mod tests {
                 let centre = anchor(&bounding_box(points.iter().copied()));
                 let at = (case / 3) % (n + 1);
                 points.insert(at, centre);
-                normals
-                    .insert(at, [Vec3::new(-0.6, -0.8, -0.0), (axis + rng.direction() * spread).normalize_or_zero()]);
+                normals.insert(
+                    at,
+                    [Vec3::new(-0.6, -0.8, -0.0), (axis + rng.direction_f32() * spread).normalize_or_zero()],
+                );
                 points.push(centre);
-                normals.push([(axis + rng.direction() * spread).normalize_or_zero(), Vec3::new(0.0, 0.6, 0.8)]);
+                normals.push([(axis + rng.direction_f32() * spread).normalize_or_zero(), Vec3::new(0.0, 0.6, 0.8)]);
             }
             if case % 11 == 0 {
                 // Every candidate at one point: every offset is a zero of either sign.

@@ -358,11 +358,11 @@ mod tests {
     /// and non-finite ones.
     #[test]
     fn bins_of_is_bin_of_on_each_axis() {
-        let mut rng = crate::measure::ViewRng::new(5);
+        let mut rng = drafter_core::rng::Rng::new(5);
         for case in 0..20_000 {
-            let lo: [f32; 4] = std::array::from_fn(|_| rng.unit() * 10.0);
+            let lo: [f32; 4] = std::array::from_fn(|_| rng.unit_f32() * 10.0);
             let hi: [f32; 4] =
-                std::array::from_fn(|a| if case % 7 == a { lo[a] } else { lo[a] + rng.unit().abs() * 5.0 });
+                std::array::from_fn(|a| if case % 7 == a { lo[a] } else { lo[a] + rng.unit_f32().abs() * 5.0 });
             let bounds = [lo, hi];
             let c: [f32; 4] = std::array::from_fn(|a| match (case + a) % 9 {
                 0 => lo[a],
@@ -370,7 +370,7 @@ mod tests {
                 2 => f32::NAN,
                 3 => lo[a] - 1.0,
                 4 => f32::INFINITY,
-                _ => lo[a] + (hi[a] - lo[a]) * rng.unit().abs(),
+                _ => lo[a] + (hi[a] - lo[a]) * rng.unit_f32().abs(),
             });
             let bins = bins_of(&bounds, c);
             for a in 0..4 {

@@ -102,20 +102,20 @@ mod tests {
     /// The predicted cost walks without testing candidates: its counts must be a query's.
     #[test]
     fn counting_walk_counts_what_a_query_does() {
-        let mut rng = crate::measure::ViewRng::new(4);
-        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction() * 3.0).collect();
+        let mut rng = drafter_core::rng::Rng::new(4);
+        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction_f32() * 3.0).collect();
         let normals: Vec<[Vec3; 2]> = points
             .iter()
             .map(|&p| {
                 let n = p.normalize();
-                [(n + rng.direction() * 0.2).normalize(), (n + rng.direction() * 0.2).normalize()]
+                [(n + rng.direction_f32() * 0.2).normalize(), (n + rng.direction_f32() * 0.2).normalize()]
             })
             .collect();
         let bvh = ConeBvh::build(&normals, &points, &ConeBvhOptions::default(), &CostModel::default());
         let mut out = EdgeSet::default();
         let mut entered = 0;
         for k in 0..500 {
-            let eye = rng.direction() * if k % 2 == 0 { 10.0 } else { 1.5 };
+            let eye = rng.direction_f32() * if k % 2 == 0 { 10.0 } else { 1.5 };
             let counted = bvh.walk::<true, false>(eye, &mut EdgeSet::default());
             assert_eq!(counted, bvh.query_counted(eye, &mut out), "eye {eye}");
             entered += counted.nodes_entered;
@@ -127,13 +127,13 @@ mod tests {
     /// leaf to `f32`); the normals are close to radial, so many are close to tangent to a view.
     #[test]
     fn pretest_queries_match_brute_force() {
-        let mut rng = crate::measure::ViewRng::new(7);
-        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction() * 3.0 + Vec3::new(1e4, 0.0, 0.0)).collect();
+        let mut rng = drafter_core::rng::Rng::new(7);
+        let points: Vec<Vec3> = (0..20_000).map(|_| rng.direction_f32() * 3.0 + Vec3::new(1e4, 0.0, 0.0)).collect();
         let normals: Vec<[Vec3; 2]> = points
             .iter()
             .map(|&p| {
                 let n = (p - Vec3::new(1e4, 0.0, 0.0)).normalize();
-                [(n + rng.direction() * 0.05).normalize(), (n + rng.direction() * 0.05).normalize()]
+                [(n + rng.direction_f32() * 0.05).normalize(), (n + rng.direction_f32() * 0.05).normalize()]
             })
             .collect();
         crate::brute::FORCE_PRETEST.with(|f| f.set(true));
@@ -145,7 +145,7 @@ mod tests {
         let mut silhouettes = 0;
         for k in 0..2000 {
             let distance = [3.01, 3.5, 6.0, 30.0, 3000.0][k % 5];
-            let eye = Vec3::new(1e4, 0.0, 0.0) + rng.direction() * distance;
+            let eye = Vec3::new(1e4, 0.0, 0.0) + rng.direction_f32() * distance;
             bvh.query(eye, &mut got);
             brute.query(crate::View::Perspective { eye }, &mut expected);
             assert_eq!(got.to_vec(), expected.to_vec(), "eye {eye}");

@@ -109,7 +109,7 @@ mod tests {
 
     #[test]
     fn a_gauss_maps_arc_cells_give_the_bvh_paths() {
-        let mut rng = crate::measure::ViewRng::new(3);
+        let mut rng = drafter_core::rng::Rng::new(3);
         let normals = random_arcs(&mut rng, 30_000, &[1e-4, 1e-2, 0.1, 0.5]);
         let cost = CostModel::default();
         let factor = f64::from(DEFAULT_OVERLAP);

@@ -395,12 +395,12 @@ mod tests {
     /// bucket starts, for 4 and 20 children and counts around the chunk size.
     #[test]
     fn parallel_scatter_is_the_serial_scatter() {
-        let mut rng = crate::measure::ViewRng::new(9);
+        let mut rng = drafter_core::rng::Rng::new(9);
         for (len, children) in [(SCATTER_CHUNK * 3 + 17, 20usize), (SCATTER_CHUNK + 1, 4), (SCATTER_CHUNK - 1, 4)] {
             let arcs: Vec<Arc> = (0..len as u32).map(|id| Arc { id, ..Arc::default() }).collect();
             let targets: Vec<u8> = (0..len)
                 .map(|_| {
-                    let k = (rng.unit() * (children + 1) as f32) as usize;
+                    let k = (rng.unit_f32() * (children + 1) as f32) as usize;
                     if k >= children { STAY } else { k as u8 }
                 })
                 .collect();

@@ -154,10 +154,10 @@ mod tests {
     /// way every range ends sorted and nothing outside the ranges moves.
     #[test]
     fn sort_ranges_sorts_each_range_only() {
-        let mut rng = crate::measure::ViewRng::new(5);
+        let mut rng = drafter_core::rng::Rng::new(5);
         for case in 0..400 {
-            let items: Vec<u32> = (0..200).map(|_| (rng.unit().abs() * 1000.0) as u32).collect();
-            let mut cuts: Vec<usize> = (0..8).map(|_| (rng.unit().abs() * 200.0) as usize % 201).collect();
+            let items: Vec<u32> = (0..200).map(|_| (rng.unit_f32().abs() * 1000.0) as u32).collect();
+            let mut cuts: Vec<usize> = (0..8).map(|_| (rng.unit_f32().abs() * 200.0) as usize % 201).collect();
             cuts.sort_unstable();
             let mut ranges: Vec<std::ops::Range<usize>> = cuts.chunks_exact(2).map(|c| c[0]..c[1]).collect();
             if case % 3 == 1 {
@@ -181,14 +181,14 @@ mod tests {
     /// never made.
     #[test]
     fn early_stop_keeps_the_pruned_tree() {
-        let mut rng = crate::measure::ViewRng::new(19);
+        let mut rng = drafter_core::rng::Rng::new(19);
         let mixed = random_arcs(&mut rng, 40_000, &[0.0, 1e-5, 1e-3, 1e-2, 0.1, 0.7]);
         // A machined part: a few exact directions, arcs between neighbouring ones and fillets.
         let axes = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::NEG_X, Vec3::NEG_Y, Vec3::NEG_Z];
         let cad: Vec<[Vec3; 2]> = (0..20_000)
             .map(|k| {
                 let a = axes[k % 6];
-                let b = if k % 3 == 0 { axes[(k / 6) % 6] } else { (a + rng.direction() * 0.05).normalize() };
+                let b = if k % 3 == 0 { axes[(k / 6) % 6] } else { (a + rng.direction_f32() * 0.05).normalize() };
                 if a.dot(b) < -0.5 { [a, a] } else { [a, b] }
             })
             .collect();

@@ -173,16 +173,17 @@ mod tests {
 
     #[test]
     fn widest_angle_is_the_exact_maximum() {
-        let mut rng = crate::measure::ViewRng::new(11);
+        let mut rng = drafter_core::rng::Rng::new(11);
         for round in 0..200 {
-            let c = rng.direction().as_dvec3().normalize();
+            let c = rng.direction_f32().as_dvec3().normalize();
             let spread = [1e-7, 1e-3, 0.3, 1.5][round % 4];
-            let points: Vec<DVec3> = (0..500).map(|_| (c + rng.direction().as_dvec3() * spread).normalize()).collect();
+            let points: Vec<DVec3> =
+                (0..500).map(|_| (c + rng.direction_f32().as_dvec3() * spread).normalize()).collect();
             let exact = points.iter().map(|p| c.cross(*p).length().atan2(c.dot(*p))).fold(0.0f64, f64::max);
             assert_eq!(widest_angle(c, points.iter().copied()), exact, "round {round}");
             // The pass over arcs from two centres at once gives each centre's widest angle.
             let arcs: Vec<Arc> = points.chunks_exact(2).map(|p| Arc { n1: p[0], n2: p[1], ..Arc::default() }).collect();
-            let other = (c + rng.direction().as_dvec3() * spread).normalize();
+            let other = (c + rng.direction_f32().as_dvec3() * spread).normalize();
             let of_other = widest_angle(other, points.iter().copied());
             assert_eq!(widest_angles_of_arcs(&[c, other], &arcs), [exact, of_other], "round {round}");
             assert_eq!(widest_angles_of_arcs(&[other], &arcs), [of_other, 0.0], "round {round}");

@@ -284,7 +284,7 @@ pub(super) fn most_inside_reference(cells: &[Cell], p: DVec3) -> usize {
 
 /// Points on and near the cells' corners, edges and the octants' planes, and random ones.
 #[cfg(test)]
-pub(super) fn awkward_points(cells: &[Cell], rng: &mut crate::measure::ViewRng, random: usize) -> Vec<DVec3> {
+pub(super) fn awkward_points(cells: &[Cell], rng: &mut drafter_core::rng::Rng, random: usize) -> Vec<DVec3> {
     let mut points = Vec::new();
     for c in cells {
         let [a, b, c] = c.v;
@@ -296,7 +296,7 @@ pub(super) fn awkward_points(cells: &[Cell], rng: &mut crate::measure::ViewRng, 
     points.push(DVec3::new(-0.0, 0.6, -0.8));
     points.push(DVec3::new(0.6, -0.0, 0.8));
     for _ in 0..random {
-        let p = rng.direction().as_dvec3().normalize();
+        let p = rng.direction_f32().as_dvec3().normalize();
         points.push(p);
         // The same point with one component zeroed: on an octant's plane.
         let k = points.len() % 3;
@@ -315,7 +315,7 @@ mod tests {
 
     #[test]
     fn base_by_octant_picks_what_all_cells_pick() {
-        let mut rng = crate::measure::ViewRng::new(5);
+        let mut rng = drafter_core::rng::Rng::new(5);
         for solid in [BaseSolid::Icosahedron, BaseSolid::Octahedron] {
             let base = base_cells(solid);
             let index = BaseByOctant::new(&base);
@@ -328,14 +328,14 @@ mod tests {
     }
     #[test]
     fn arc_paths_equal_arc_path_arc_by_arc() {
-        let mut rng = crate::measure::ViewRng::new(7);
+        let mut rng = drafter_core::rng::Rng::new(7);
         let base = base_cells(BaseSolid::Icosahedron);
         // Random arcs of every length (short ones go deep), plus zero and antipodal ones.
         let mut unit: Vec<[DVec3; 2]> = (0..20_000)
             .map(|k| {
-                let a = rng.direction().as_dvec3().normalize();
+                let a = rng.direction_f32().as_dvec3().normalize();
                 let spread = [1e-4, 1e-2, 0.1, 0.5, 2.0][k % 5];
-                let b = (a + rng.direction().as_dvec3() * spread).normalize_or_zero();
+                let b = (a + rng.direction_f32().as_dvec3() * spread).normalize_or_zero();
                 [a, b]
             })
             .collect();
@@ -360,7 +360,7 @@ mod tests {
             let cells = base_cells(base);
             assert_eq!(cells.len(), faces);
             // Every direction lies in exactly one cell (up to boundaries).
-            let mut rng = drafter_core::rng::XorShift64::new(1);
+            let mut rng = drafter_core::rng::Rng::new(1);
             for _ in 0..2000 {
                 let mut r = || rng.signed_f64();
                 let p = DVec3::new(r(), r(), r()).normalize();

@@ -355,12 +355,12 @@ fn is_identity(order: &[u32]) -> bool {
 /// `count` random arcs: a random first normal and a second one `spreads[k % spreads.len()]` away
 /// (normalised; zero where the two cancel).
 #[cfg(test)]
-fn random_arcs(rng: &mut crate::measure::ViewRng, count: usize, spreads: &[f32]) -> Vec<[Vec3; 2]> {
+fn random_arcs(rng: &mut drafter_core::rng::Rng, count: usize, spreads: &[f32]) -> Vec<[Vec3; 2]> {
     (0..count)
         .map(|k| {
-            let a = rng.direction();
+            let a = rng.direction_f32();
             let spread = spreads[k % spreads.len()];
-            [a, (a + rng.direction() * spread).normalize_or_zero()]
+            [a, (a + rng.direction_f32() * spread).normalize_or_zero()]
         })
         .collect()
 }

@@ -181,7 +181,7 @@ mod tests {
     /// down to level 8, and on points far outside.
     #[test]
     fn quad_scores_pick_the_cell_scores_pick() {
-        let mut rng = crate::measure::ViewRng::new(11);
+        let mut rng = drafter_core::rng::Rng::new(11);
         let mut cell = base_cells(BaseSolid::Icosahedron)[3];
         for level in 0..9 {
             let children = cell.children();
@@ -190,12 +190,12 @@ mod tests {
             let [a, b, c] = cell.v;
             let mut points = vec![a, b, c, (a + b).normalize(), (b + c).normalize(), (c + a).normalize()];
             for _ in 0..3000 {
-                let w = [rng.unit().abs(), rng.unit().abs(), rng.unit().abs()];
+                let w = [rng.unit_f32().abs(), rng.unit_f32().abs(), rng.unit_f32().abs()];
                 // Inside, and pulled onto an edge by zeroing one weight.
                 let k = points.len() % 4;
                 let w = if k < 3 { std::array::from_fn(|i| if i == k { 0.0 } else { w[i] }) } else { w };
                 points.push((a * f64::from(w[0]) + b * f64::from(w[1]) + c * f64::from(w[2])).normalize_or_zero());
-                points.push(rng.direction().as_dvec3().normalize());
+                points.push(rng.direction_f32().as_dvec3().normalize());
             }
             for p in points {
                 if p == DVec3::ZERO {
@@ -209,7 +209,7 @@ mod tests {
     }
     #[test]
     fn quad_targets_are_the_bin_rule() {
-        let mut rng = crate::measure::ViewRng::new(13);
+        let mut rng = drafter_core::rng::Rng::new(13);
         let mut cell = base_cells(BaseSolid::Icosahedron)[7];
         let mut checked = 0;
         for level in 0..10 {
@@ -222,7 +222,7 @@ mod tests {
                 // Points inside the cell, where its arcs' midpoints lie.
                 let [a, b, c] = cell.v;
                 for _ in 0..600 {
-                    let w = [rng.unit().abs(), rng.unit().abs(), rng.unit().abs()].map(f64::from);
+                    let w = [rng.unit_f32().abs(), rng.unit_f32().abs(), rng.unit_f32().abs()].map(f64::from);
                     points.push((a * w[0] + b * w[1] + c * w[2]).normalize_or_zero());
                 }
                 points.retain(|p| *p != DVec3::ZERO);

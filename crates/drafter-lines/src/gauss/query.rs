@@ -120,18 +120,18 @@ mod tests {
     /// The predicted cost walks without testing arcs: its counts must be a query's.
     #[test]
     fn counting_walk_counts_what_a_query_does() {
-        let mut rng = crate::measure::ViewRng::new(8);
+        let mut rng = drafter_core::rng::Rng::new(8);
         let normals: Vec<[Vec3; 2]> = (0..30_000)
             .map(|_| {
-                let a = rng.direction();
-                [a, (a + rng.direction() * 0.3).normalize()]
+                let a = rng.direction_f32();
+                [a, (a + rng.direction_f32() * 0.3).normalize()]
             })
             .collect();
         let h = GaussMapHierarchy::build(&normals, &GaussMapOptions::default(), &CostModel::default());
         let mut out = EdgeSet::default();
         let mut blocks = 0;
         for _ in 0..500 {
-            let d = rng.direction();
+            let d = rng.direction_f32();
             let counted = h.counts_only(d);
             assert_eq!(counted, h.query_counted(d, &mut out), "direction {d}");
             blocks += counted.blocks_tested;

@@ -15,8 +15,8 @@ pub struct TestMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// The seeded generator of the tests' views and meshes: drafter-lines' own (`measure::ViewRng`).
-pub use drafter_lines::measure::ViewRng as Rng;
+/// The seeded generator of the tests' views and meshes: the workspace's one.
+pub use drafter_core::rng::Rng;
 
 /// A UV sphere of radius 1: `segments` around, `rings` from pole to pole; 2·segments·(rings−1) faces.
 pub fn uv_sphere(segments: u32, rings: u32) -> TestMesh {
@@ -31,7 +31,7 @@ pub fn noisy_sphere(segments: u32, rings: u32, amplitude: f32, seed: u64) -> Tes
         let theta = PI * r as f32 / rings as f32;
         for s in 0..segments {
             let phi = TAU * s as f32 / segments as f32;
-            let radius = 1.0 + amplitude * rng.range(-1.0, 1.0);
+            let radius = 1.0 + amplitude * rng.range_f32(-1.0, 1.0);
             positions.push(radius * Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()));
         }
     }
@@ -147,7 +147,7 @@ pub fn random_lattice_mesh(vertices: u32, triangles: u32, seed: u64) -> TestMesh
     let mut rng = Rng::new(seed);
     let positions: Vec<Vec3> =
         (0..vertices).map(|_| Vec3::new(rng.below(5) as f32, rng.below(5) as f32, rng.below(5) as f32)).collect();
-    let tris = (0..triangles).map(|_| [rng.below(vertices), rng.below(vertices), rng.below(vertices)]).collect();
+    let tris = (0..triangles).map(|_| [0; 3].map(|_| rng.below(u64::from(vertices)) as u32)).collect();
     TestMesh { name: format!("random lattice {seed}"), positions, triangles: tris }
 }
 
@@ -164,21 +164,13 @@ pub fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
     positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
 }
 
-/// A random eye outside the box: on a sphere around the centre at 1.05–5 half-diagonals.
-pub fn eye_outside(rng: &mut Rng, lo: Vec3, hi: Vec3) -> Vec3 {
-    let center = (lo + hi) * 0.5;
-    let half = ((hi - lo) * 0.5).length().max(1e-6);
-    loop {
-        let e = center + rng.direction() * half * rng.range(1.05, 5.0);
-        if !(e.cmpge(lo).all() && e.cmple(hi).all()) {
-            return e;
-        }
-    }
-}
+/// A random eye outside the box (drafter-lines' own, which the benchmarks draw their views with).
+#[allow(unused_imports)]
+pub use drafter_lines::measure::eye_outside;
 
 /// A random eye inside the box.
 pub fn eye_inside(rng: &mut Rng, lo: Vec3, hi: Vec3) -> Vec3 {
-    lo + (hi - lo) * Vec3::new(rng.unit(), rng.unit(), rng.unit())
+    lo + (hi - lo) * Vec3::new(rng.unit_f32(), rng.unit_f32(), rng.unit_f32())
 }
 
 /// Imports `path` with drafter-io and flattens every instance into one world-space mesh; the part
