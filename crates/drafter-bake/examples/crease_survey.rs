@@ -1,4 +1,4 @@
-//! What the bake's edge classes gain from face borders and crease hysteresis (issue 58): per model,
+//! What the bake's edge classes gain from face borders and crease hysteresis: per model,
 //! summed over its meshes (each mesh once, however many instances draw it), the creases with the
 //! threshold alone, with hysteresis at a few continuation fractions, the continued edges and the
 //! tangent edges the input's faces (glTF primitives) give. Parts are not separated (no part

@@ -5,20 +5,18 @@
 //!
 //! * Every rayon worker has its own arena, and a freed block stays in the arena of the thread that
 //!   freed it. Since bounds and normals run side by side, the blocks they free stay spread over those
-//!   arenas: at the dragon's peak 30–60 MB of freed memory still counted as resident (494 MB against
-//!   443 MB with the stages in turn), and 180 MB at the 2.18M-triangle level of the scaling benchmark.
+//!   arenas and still count as resident when the lines stage peaks.
 //! * Every block above the mmap threshold (at most 32 MB) gets a mapping of its own, unmapped on free,
-//!   so the next stage's arrays fault in and zero fresh pages again: the dragon bake touched 900 MB of
-//!   new pages (233k page faults) to peak at about 440 MB, 0.6–0.8 s of system time in 3.7 CPU-seconds.
+//!   so the next stage's arrays fault in and zero fresh pages again: a large bake touches about twice
+//!   its peak in new pages, and the page faults are a sizeable share of its system time.
 //!
 //! [`keep_freed_memory`], for a process that bakes (the command-line tool calls it first thing), turns
 //! both off: one arena, no block mappings, no trimming. Freed blocks stay in one heap and the next
-//! stage reuses them: 110k page faults, 0.43–0.46 s of system time, the same peak (docs/bench.md,
-//! "Heap reuse"). mimalloc was measured too: it kept 535 MB instead of 443 MB at the peak and spent as
-//! much system time. In a process that did not call it (a library user with its own allocator
-//! policy), [`release_free_memory`] instead returns the free pages of every arena to the kernel as the
-//! lines stage starts, where a bake's memory peaks (dragon 430 MB, 2.18M level 581 MB, when this was
-//! measured; the input's bytes and each mesh's topology are freed before the hierarchies since).
+//! stage reuses them: about half the page faults, at the same peak (docs/bench.md, "Heap reuse", has
+//! the figures and the command; mimalloc, measured there too, kept more at the peak). In a process
+//! that did not call it (a library user with its own allocator policy), [`release_free_memory`]
+//! instead returns the free pages of every arena to the kernel as the lines stage starts, where a
+//! bake's memory peaks.
 //!
 //! The crate's one `unsafe` place: calls into the C library with no preconditions beyond the one
 //! stated. Off glibc (musl, macOS, Windows) there is nothing to call.

@@ -255,8 +255,8 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     timed(Stage::Segment, start.elapsed());
 
     // Bounds and normals read only the scene, the topologies and the parts: they run side by side.
-    // Bounds is one task per part, so a single-part mesh (the dragon: 87 ms of hull and search) ran
-    // on one core while the other waited; beside the normals' many small tasks it no longer does.
+    // Bounds is one task per part, so a single-part mesh's hull and box search would hold one core
+    // while the others wait; beside the normals' many small tasks they do not.
     // Their timings overlap in the report.
     begin(Stage::Bounds);
     let bounds_start = Instant::now();
@@ -1080,8 +1080,8 @@ fn points_through(scene: &Scene, parts: &Parts, part: PartId, transform: &DMat4)
 /// rotation, a mirror and a uniform scale. Their box is oriented once, in the mesh's own frame,
 /// and each part's box takes that orientation turned by its instance's transform, its extents and
 /// centre from its own points ([`box_with_axes`]). The searches for a box are nearly all of the
-/// bounds stage (GearboxAssy: 95 parts of 42 meshes, 242 ms of one core), and an assembly's
-/// repeated screws, washers and gears are where its parts come from.
+/// bounds stage, and an assembly's repeated screws, washers and gears are where its parts come
+/// from.
 struct SharedOrientations {
     /// Per part: the index of its shared orientation in `axes`, if it has one.
     slot: Vec<Option<usize>>,

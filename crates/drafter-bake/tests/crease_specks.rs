@@ -1,4 +1,4 @@
-//! Crease specks on a range scan (issue 50): after the bake's classification, the dragon holds no
+//! Crease specks on a range scan: after the bake's classification, the dragon holds no
 //! isolated crease and no chain of at most three creases unless one of them is sharper than the
 //! strong angle (60°) or the chain is long against the model; counted here independently of the
 //! classifier's own chain search (a breadth-first walk over the hard edges, dihedral angles from

@@ -1,6 +1,6 @@
 //! `EXT_mesh_primitive_edge_visibility` is written only on primitives with something to draw: the
 //! draft requires a non-zero value in the bitfield, and CesiumJS stops rendering (a TypeError) on a
-//! primitive whose bitfield is all zeros (issue 50). A primitive whose every edge is smooth or
+//! primitive whose bitfield is all zeros. A primitive whose every edge is smooth or
 //! coplanar gets no extension; every written one holds a non-zero byte.
 
 use drafter_core::{Mesh, Scene, SourceFormat, TriangleGroup};
