@@ -71,7 +71,7 @@ pub fn discover_all(
     for item in items.iter() {
         if let Some(first) = seen.insert(item.relative_output.clone(), item.input.clone()) {
             return Err(DiscoverError(format!(
-                "{} and {} would both be written to {}; bake them in separate runs or rename one",
+                "{} and {} would both be written to {}; name them in separate runs or rename one",
                 first.display(),
                 item.input.display(),
                 item.relative_output.display()
