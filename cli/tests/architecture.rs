@@ -1,15 +1,19 @@
 //! ARCHITECTURE.md against the code: the code map names every workspace member and only paths that
-//! exist, the viewer's pass order is the order the renderer encodes its passes, and the bake's
-//! stage order is `drafter_bake::STAGE_NAMES`. Each test reads the document and the code as they
-//! are, so a change to either that makes the document untrue fails here. And the crate graph's
-//! arrows, read from every member's Cargo.toml: stage crates depend on drafter-core only, the CPU
-//! scene and the drawings reach no GPU or window crate, and only the viewer and the CLI name a
-//! window crate.
+//! exist, the renderer's pass order is the order it encodes its passes, and the bake's stage order
+//! is `drafter_bake::STAGE_NAMES`. Each test reads the document and the code as they are, so a
+//! change to either that makes the document untrue fails here. And the crate graph's arrows, read
+//! from every member's Cargo.toml and, past the workspace, from Cargo.lock: stage crates depend on
+//! drafter-core only; the CPU scene and the drawings reach no GPU or window crate; the renderer
+//! (drafter-render) and the browser build (drafter-web) reach no window crate; only the desktop app
+//! (drafter-app) and the CLI name a window crate.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use drafter_viewer::renderer::PASS_ORDER;
+use drafter_render::renderer::PASS_ORDER;
+
+/// The renderer's crate folder.
+const RENDER: &str = "crates/drafter-render";
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("cli/ has a parent").to_path_buf()
@@ -102,8 +106,8 @@ fn code_map_lists_every_workspace_member_and_only_paths_that_exist() {
 
 /// The names of the passes `Renderer::encode_frame` encodes (`self.NAME.encode(`), in source order.
 fn encoded_passes() -> Vec<String> {
-    let source = read("viewer/src/renderer.rs");
-    let start = source.find("pub fn encode_frame(").expect("Renderer::encode_frame in viewer/src/renderer.rs");
+    let source = read(&format!("{RENDER}/src/renderer.rs"));
+    let start = source.find("pub fn encode_frame(").expect("Renderer::encode_frame in the renderer's renderer.rs");
     let body = &source[start..];
     let body = &body[..body.find("\n    }\n").expect("the end of encode_frame")];
     let mut passes = Vec::new();
@@ -120,8 +124,8 @@ fn encoded_passes() -> Vec<String> {
 #[test]
 fn the_renderer_encodes_its_passes_in_pass_order() {
     assert_eq!(encoded_passes(), PASS_ORDER, "Renderer::encode_frame and renderer::PASS_ORDER disagree");
-    let mut modules: Vec<String> = std::fs::read_dir(root().join("viewer/src/passes"))
-        .expect("viewer/src/passes")
+    let mut modules: Vec<String> = std::fs::read_dir(root().join(RENDER).join("src/passes"))
+        .expect("the renderer's src/passes")
         .map(|e| e.expect("a directory entry").file_name().into_string().expect("a UTF-8 file name"))
         .filter_map(|name| name.strip_suffix(".rs").map(str::to_string))
         .filter(|name| name != "mod")
@@ -129,31 +133,32 @@ fn the_renderer_encodes_its_passes_in_pass_order() {
     modules.sort();
     let mut order: Vec<String> = PASS_ORDER.iter().map(|s| s.to_string()).collect();
     order.sort();
-    assert_eq!(modules, order, "a module under viewer/src/passes/ that PASS_ORDER does not name, or the reverse");
+    assert_eq!(modules, order, "a module under {RENDER}/src/passes/ that PASS_ORDER does not name, or the reverse");
 }
 
 #[test]
 fn architecture_states_the_renderers_pass_order() {
     let doc = read("ARCHITECTURE.md");
-    // The numbered list of "The viewer's passes", each item naming its module's file.
-    let listed: Vec<&str> = section(&doc, "The viewer's passes")
+    // The numbered list of "The renderer's passes", each item naming its module's file.
+    let passes = format!("`{RENDER}/src/passes/");
+    let listed: Vec<&str> = section(&doc, "The renderer's passes")
         .lines()
         .filter(|line| {
             line.split_once(". ").is_some_and(|(n, _)| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
         })
         .map(|line| {
-            let file = line.split("`viewer/src/passes/").nth(1).unwrap_or_else(|| panic!("no pass file in {line:?}"));
+            let file = line.split(passes.as_str()).nth(1).unwrap_or_else(|| panic!("no pass file in {line:?}"));
             &file[..file.find(".rs`").unwrap_or_else(|| panic!("no pass file in {line:?}"))]
         })
         .collect();
-    assert_eq!(listed, PASS_ORDER, "the numbered passes of ARCHITECTURE.md's \"The viewer's passes\"");
-    // The code map's viewer row names them in the same order.
+    assert_eq!(listed, PASS_ORDER, "the numbered passes of ARCHITECTURE.md's \"The renderer's passes\"");
+    // The code map's renderer row names them in the same order.
     let row = section(&doc, "Code map")
         .lines()
-        .find(|line| line.starts_with("| `viewer/`"))
-        .expect("the code map's viewer/ row");
+        .find(|line| line.starts_with(&format!("| `{RENDER}`")))
+        .unwrap_or_else(|| panic!("the code map's {RENDER} row"));
     let named: Vec<&str> = backticked(row).into_iter().filter(|span| PASS_ORDER.contains(span)).collect();
-    assert_eq!(named, PASS_ORDER, "the passes as the code map's viewer/ row names them");
+    assert_eq!(named, PASS_ORDER, "the passes as the code map's {RENDER} row names them");
 }
 
 #[test]
@@ -194,25 +199,19 @@ fn architecture_states_the_bakes_stage_order() {
 #[derive(Debug)]
 struct Manifest {
     path: String,
-    /// `[dependencies]` and `[build-dependencies]`, target-specific ones included: name → optional.
-    normal: BTreeMap<String, bool>,
+    /// `[dependencies]` and `[build-dependencies]`, target-specific and optional ones included.
+    normal: BTreeSet<String>,
     /// `[dev-dependencies]`, target-specific ones included.
     dev: BTreeSet<String>,
-    /// `[features]`: feature → what it enables.
-    features: BTreeMap<String, Vec<String>>,
 }
 
-/// The names of a dependency table, each with whether it is optional.
-fn dependency_names(table: Option<&toml::Value>) -> Vec<(String, bool)> {
+/// The names of a dependency table.
+fn dependency_names(table: Option<&toml::Value>) -> Vec<String> {
     let Some(table) = table.and_then(toml::Value::as_table) else { return Vec::new() };
     table
         .iter()
-        .map(|(key, spec)| {
-            // `foo = { package = "bar" }` depends on bar.
-            let name = spec.get("package").and_then(toml::Value::as_str).unwrap_or(key).to_string();
-            let optional = spec.get("optional").and_then(toml::Value::as_bool).unwrap_or(false);
-            (name, optional)
-        })
+        // `foo = { package = "bar" }` depends on bar.
+        .map(|(key, spec)| spec.get("package").and_then(toml::Value::as_str).unwrap_or(key).to_string())
         .collect()
 }
 
@@ -232,31 +231,36 @@ fn manifests() -> BTreeMap<String, Manifest> {
         if let Some(targets) = doc.get("target").and_then(toml::Value::as_table) {
             tables.extend(targets.values().cloned());
         }
-        let mut normal = BTreeMap::new();
+        let mut normal = BTreeSet::new();
         let mut dev = BTreeSet::new();
         for table in &tables {
             for kind in ["dependencies", "build-dependencies"] {
-                for (dep, optional) in dependency_names(table.get(kind)) {
-                    normal.insert(dep, optional);
-                }
+                normal.extend(dependency_names(table.get(kind)));
             }
-            dev.extend(dependency_names(table.get("dev-dependencies")).into_iter().map(|(d, _)| d));
+            dev.extend(dependency_names(table.get("dev-dependencies")));
         }
-        let features = doc
-            .get("features")
-            .and_then(toml::Value::as_table)
-            .map(|f| {
-                f.iter()
-                    .map(|(k, v)| {
-                        let list =
-                            v.as_array().map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_string)).collect());
-                        (k.clone(), list.unwrap_or_default())
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        out.insert(name, Manifest { path: member, normal, dev, features });
+        out.insert(name, Manifest { path: member, normal, dev });
     }
+    out
+}
+
+/// The dependencies of every package Cargo.lock resolves, by name (the versions of one name
+/// merged): for the crates outside the workspace, what they bring in on any target with the
+/// features the workspace enables.
+fn locked_dependencies() -> BTreeMap<String, BTreeSet<String>> {
+    let lock: toml::Value = toml::from_str(&read("Cargo.lock")).expect("Cargo.lock parses");
+    let packages = lock.get("package").and_then(toml::Value::as_array).expect("Cargo.lock lists packages");
+    let mut out: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for package in packages {
+        let name = package.get("name").and_then(toml::Value::as_str).expect("a locked package's name");
+        let entry = out.entry(name.to_string()).or_default();
+        for dep in package.get("dependencies").and_then(toml::Value::as_array).into_iter().flatten() {
+            // "name", "name version" or "name version (source)".
+            let dep = dep.as_str().expect("a locked dependency is a string");
+            entry.insert(dep.split(' ').next().expect("a dependency name").to_string());
+        }
+    }
+    assert!(out.len() >= 50, "too few packages parsed from Cargo.lock: {}", out.len());
     out
 }
 
@@ -264,26 +268,39 @@ fn manifests() -> BTreeMap<String, Manifest> {
 const STAGE_CRATES: [&str; 5] =
     ["drafter-segment", "drafter-bounds", "drafter-normals", "drafter-lines", "drafter-textures"];
 
-/// The GPU crates, and the window side of the viewer (the event loop and the egui panel).
-const GPU_CRATES: [&str; 1] = ["wgpu"];
-const WINDOW_CRATES: [&str; 4] = ["winit", "egui", "egui-winit", "egui-wgpu"];
+/// A GPU crate: wgpu and its parts.
+fn is_gpu_crate(name: &str) -> bool {
+    name == "wgpu" || name.starts_with("wgpu-")
+}
 
-/// Every crate `root` depends on through workspace crates' normal dependencies (its own
-/// dev-dependencies included: `cargo tree` shows them too), with the workspace crate that names
-/// each first.
-fn reached(root: &str, manifests: &BTreeMap<String, Manifest>) -> BTreeMap<String, String> {
+/// A window crate: the event loop and the egui panel of `drafter view` (winit, egui, egui-winit,
+/// egui-wgpu, ...).
+fn is_window_crate(name: &str) -> bool {
+    name == "winit" || name.starts_with("egui")
+}
+
+/// Every crate `root` depends on, with the crate that names each first: through workspace crates'
+/// normal dependencies (read from their Cargo.toml; `root`'s own dev-dependencies included, as
+/// `cargo tree` shows them), and past the workspace through Cargo.lock.
+fn reached(
+    root: &str,
+    manifests: &BTreeMap<String, Manifest>,
+    locked: &BTreeMap<String, BTreeSet<String>>,
+) -> BTreeMap<String, String> {
     let mut seen: BTreeMap<String, String> = BTreeMap::new();
     let first = &manifests[root];
     let mut stack: Vec<(String, String)> =
-        first.normal.keys().chain(&first.dev).map(|d| (d.clone(), root.to_string())).collect();
+        first.normal.iter().chain(&first.dev).map(|d| (d.clone(), root.to_string())).collect();
     while let Some((name, via)) = stack.pop() {
         if seen.contains_key(&name) {
             continue;
         }
         seen.insert(name.clone(), via);
-        if let Some(m) = manifests.get(&name) {
-            stack.extend(m.normal.keys().map(|d| (d.clone(), name.clone())));
-        }
+        let next = match manifests.get(&name) {
+            Some(m) => &m.normal,
+            None => locked.get(&name).unwrap_or_else(|| panic!("{name} is not in Cargo.lock")),
+        };
+        stack.extend(next.iter().map(|d| (d.clone(), name.clone())));
     }
     seen
 }
@@ -294,7 +311,7 @@ fn stage_crates_depend_on_drafter_core_only() {
     for stage in STAGE_CRATES {
         let manifest = manifests.get(stage).unwrap_or_else(|| panic!("stage crate {stage} is not a workspace member"));
         let workspace: Vec<&String> =
-            manifest.normal.keys().filter(|d| manifests.contains_key(d.as_str()) && *d != "drafter-core").collect();
+            manifest.normal.iter().filter(|d| manifests.contains_key(d.as_str()) && *d != "drafter-core").collect();
         assert!(
             workspace.is_empty(),
             "{} depends on workspace crates {workspace:?}: a stage crate depends on drafter-core only",
@@ -303,46 +320,64 @@ fn stage_crates_depend_on_drafter_core_only() {
     }
 }
 
+/// Fails when `root` reaches a crate `forbidden` says yes to, naming the crate that brings it in.
+fn assert_reaches_none(root: &str, forbidden: fn(&str) -> bool, why: &str) {
+    let manifests = manifests();
+    assert!(manifests.contains_key(root), "{root} is not a workspace member");
+    let reached = reached(root, &manifests, &locked_dependencies());
+    let found: Vec<String> = reached
+        .iter()
+        .filter(|(name, _)| forbidden(name))
+        .map(|(name, via)| format!("{name} (named by {via})"))
+        .collect();
+    assert!(found.is_empty(), "{root} depends on {found:?}: {why}");
+}
+
 #[test]
 fn the_scene_and_the_drawings_reach_no_gpu_or_window_crate() {
-    let manifests = manifests();
     for root in ["drafter-scene", "drafter-draw"] {
-        assert!(manifests.contains_key(root), "{root} is not a workspace member");
-        let reached = reached(root, &manifests);
-        for forbidden in GPU_CRATES.iter().chain(&WINDOW_CRATES) {
-            if let Some(via) = reached.get(*forbidden) {
-                panic!("{root} depends on {forbidden} (named by {via}): it must build without GPU or window code");
-            }
-        }
+        assert_reaches_none(
+            root,
+            |name| is_gpu_crate(name) || is_window_crate(name),
+            "it must build without GPU or window code",
+        );
     }
 }
 
 #[test]
-fn only_the_viewer_and_the_cli_name_window_crates() {
+fn the_renderer_and_the_browser_build_reach_no_window_crate() {
+    assert_reaches_none(
+        "drafter-render",
+        is_window_crate,
+        "the renderer builds for the browser; the window and its panel are drafter-app's",
+    );
+    assert_reaches_none("drafter-web", is_window_crate, "the browser page draws through drafter-render alone");
+}
+
+/// The walk the arrows rely on sees through both layers: the CLI names no GPU or window crate
+/// itself, yet reaches wgpu through workspace crates, and egui's painter (epaint) only through
+/// Cargo.lock.
+#[test]
+fn the_arrows_are_followed_through_the_workspace_and_cargo_lock() {
     let manifests = manifests();
-    for (name, manifest) in &manifests {
-        for window in WINDOW_CRATES {
-            let Some(&optional) = manifest.normal.get(window) else { continue };
-            match name.as_str() {
-                "drafter-cli" => {}
-                // The viewer's window side is behind its `native` feature, which the browser build
-                // leaves out.
-                "drafter-viewer" => {
-                    let native = manifest.features.get("native").cloned().unwrap_or_default();
-                    assert!(
-                        optional && native.contains(&format!("dep:{window}")),
-                        "viewer/Cargo.toml: {window} must be optional and enabled by the `native` feature only"
-                    );
-                }
-                _ => panic!("{} depends on {window}: only the viewer's window side and the CLI may", manifest.path),
-            }
+    let cli = &manifests["drafter-cli"];
+    assert!(!cli.normal.iter().any(|d| is_gpu_crate(d)), "{} names a GPU crate itself", cli.path);
+    let reached = reached("drafter-cli", &manifests, &locked_dependencies());
+    assert!(reached.contains_key("wgpu"), "drafter-cli reaches wgpu through drafter-render and drafter-app");
+    let via = reached.get("epaint").expect("drafter-cli reaches epaint through egui");
+    assert!(!manifests.contains_key(via), "epaint is named by {via}, a crate outside the workspace");
+}
+
+#[test]
+fn only_the_app_and_the_cli_name_window_crates() {
+    for (name, manifest) in &manifests() {
+        if name == "drafter-app" || name == "drafter-cli" {
+            continue;
         }
+        let named: Vec<&String> = manifest.normal.iter().chain(&manifest.dev).filter(|d| is_window_crate(d)).collect();
         assert!(
-            !manifest
-                .dev
-                .iter()
-                .any(|d| WINDOW_CRATES.contains(&d.as_str()) && name != "drafter-viewer" && name != "drafter-cli"),
-            "{} names a window crate",
+            named.is_empty(),
+            "{} names {named:?}: only the desktop app (drafter-app) and the CLI may name a window crate",
             manifest.path
         );
     }

@@ -237,7 +237,8 @@ fn near_share(mask: &[bool], other: &[bool], (w, h): (usize, usize)) -> (f64, us
 
 /// The SVG opens in Chromium, and Chromium's rendering of it matches `drafter render --lines` of
 /// the same view: its black lines against the raster pass's black silhouettes and borders (the
-/// measure of `viewer/tests/drawing.rs`, here on a browser's rasterisation of the file itself).
+/// measure of `crates/drafter-render/tests/drawing.rs`, here on a browser's rasterisation of the
+/// file itself).
 #[test]
 fn chromium_draws_the_svg_where_drafter_render_draws_its_lines() {
     let dir = common::scratch("draw-chromium");
@@ -271,10 +272,10 @@ fn chromium_draws_the_svg_where_drafter_render_draws_its_lines() {
         .concat(),
     );
     assert!(rendered.status.success(), "{}", String::from_utf8_lossy(&rendered.stderr));
-    let read = |p: &std::path::Path| drafter_viewer::Image::from_png(&std::fs::read(p).unwrap()).unwrap();
+    let read = |p: &std::path::Path| drafter_render::Image::from_png(&std::fs::read(p).unwrap()).unwrap();
     let (page, raster) = (read(&shot), read(&render));
     assert_eq!((page.width, page.height, raster.width, raster.height), (800, 600, 800, 600));
-    let dark = |img: &drafter_viewer::Image, level: u8| -> Vec<bool> {
+    let dark = |img: &drafter_render::Image, level: u8| -> Vec<bool> {
         img.rgba.chunks_exact(4).map(|p| p[0].max(p[1]).max(p[2]) < level).collect()
     };
     // Chromium's anti-aliased strokes (half-dark or darker); the raster's black lines.

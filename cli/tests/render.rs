@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use drafter_viewer::Image;
+use drafter_render::Image;
 
 fn bake_sample(dir: &Path) -> std::path::PathBuf {
     let baked = dir.join("sample.baked.glb");

@@ -1,5 +1,5 @@
 //! `drafter view` without a display: one line on stderr, exit code 2, no panic (the window's event
-//! handling itself is unit-tested in `drafter_viewer::window`); `drafter view --help` tells a new
+//! handling itself is unit-tested in `drafter_app::window`); `drafter view --help` tells a new
 //! user how to edit, save and export.
 
 mod common;

@@ -21,7 +21,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use drafter_format::PartRecord;
-use drafter_viewer::{Model, RenderOptions, Renderer, Style, View};
+use drafter_render::{Model, RenderOptions, Renderer, Style, View};
 
 const SIZE: (u32, u32) = (800, 600);
 /// Time for the window to draw after an input on lavapipe (a frame is ~0.2 s at this size).
@@ -124,7 +124,7 @@ fn inside(ids: &[Option<u32>], id: u32) -> Option<(i32, i32)> {
         .filter(|&(x, y)| {
             x >= 4
                 && y >= 4
-                && x < w - 16 - drafter_viewer::panel::PANEL_WIDTH as i32
+                && x < w - 16 - drafter_app::panel::PANEL_WIDTH as i32
                 && y < h - 4
                 && (-4..=4).all(|dy| (-4..=4).all(|dx| at(x + dx, y + dy) == Some(id)))
         })

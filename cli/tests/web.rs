@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use drafter_viewer::{Image, Style};
+use drafter_render::{Image, Style};
 use serde_json::Value;
 
 /// A pixel differs when some channel is more than this many levels (of 255) from the native render.

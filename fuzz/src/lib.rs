@@ -5,8 +5,8 @@
 //! Each [`Target`] is one entry point fed with bytes: the six importers (through
 //! [`drafter_io::import_bytes`], then the whole [`drafter_bake::bake`] of whatever imports, then
 //! drafter-format's reader on the bake's own output), and the baked-file side (drafter-format's
-//! readers and the viewer's CPU model building, [`drafter_viewer::Model::load_bytes`], plus one
-//! silhouette query). A case takes a seed of its target ([`seeds`]), applies one to four
+//! readers and the CPU model the renderer and the drawings build, [`drafter_scene::Model::load_bytes`],
+//! plus one silhouette query). A case takes a seed of its target ([`seeds`]), applies one to four
 //! mutations ([`mutate`]: byte flips, truncation, splices between seeds, number mutations,
 //! structure-aware JSON mutations for glTF, header mutations for OBJ/PLY/OFF/STL) and runs it under
 //! `catch_unwind`. A case is a finding when it panics, returns an internal error (what the CLI maps
@@ -29,8 +29,8 @@ use std::panic::AssertUnwindSafe;
 use std::path::Path;
 
 use drafter_bake::{BakeConfig, BakeError};
-use drafter_viewer::Model;
-use drafter_viewer::edges::WorldView;
+use drafter_scene::Model;
+use drafter_scene::edges::WorldView;
 
 pub use drafter_bench::generate::Rng;
 
@@ -51,7 +51,7 @@ pub enum Target {
     Off,
     /// PLY (ASCII and binary little-endian), imported then baked.
     Ply,
-    /// A baked .glb: drafter-format's readers and the viewer's model building (CPU only).
+    /// A baked .glb: drafter-format's readers and drafter-scene's model building (CPU only).
     Baked,
 }
 

@@ -1,12 +1,12 @@
-//! drafter's viewer in the browser: the viewer's renderer (`drafter-viewer` without its `native`
-//! feature) compiled to WebAssembly, drawing into a canvas through WebGPU, or WebGL2 where the
+//! drafter's viewer in the browser: the renderer (`drafter-render`, which names no window crate)
+//! compiled to WebAssembly, drawing into a canvas through WebGPU, or WebGL2 where the
 //! browser has no WebGPU adapter. The same passes and WGSL as `drafter render` and `drafter view`;
 //! only the device request (asynchronous here) and the surface are the browser's.
 //!
 //! The page (`web/page/`) owns the DOM: it reads the file (a URL or a dropped file), turns mouse,
 //! wheel and key events into the calls below, and asks for a frame when something changed. The
-//! view controls are the window's own ([`drafter_viewer::controls`]), so a drag, the wheel and the
-//! keys do here what they do in `drafter view`. Editing stays in the desktop window.
+//! view controls are the desktop window's own ([`drafter_render::controls`]), so a drag, the wheel and
+//! the keys do here what they do in `drafter view`. Editing stays in the desktop window (drafter-app).
 //!
 //! Everything here is wasm32-only: natively this crate is empty (`cargo build --workspace` builds
 //! it without any of the browser's crates). Built by `scripts/web`.
@@ -14,9 +14,9 @@
 
 use std::path::Path;
 
-use drafter_viewer::controls::{Action, Orbit, PIXELS_PER_LINE, action_for_char};
-use drafter_viewer::edges::Hierarchies;
-use drafter_viewer::{Enhancements, Gpu, Model, RenderOptions, Renderer, ShadowMode, Style};
+use drafter_render::controls::{Action, Orbit, PIXELS_PER_LINE, action_for_char};
+use drafter_render::edges::Hierarchies;
+use drafter_render::{Enhancements, Gpu, Model, RenderOptions, Renderer, ShadowMode, Style};
 use wasm_bindgen::prelude::*;
 
 /// Reports panics on the console (the page shows the last console error too).

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use drafter_viewer::{Enhancements, Model, RenderOptions, Renderer, ShadowMode, Style};
+use drafter_render::{Enhancements, Model, RenderOptions, Renderer, ShadowMode, Style};
 use serde::Serialize;
 
 use crate::exit::BadInput;
@@ -314,7 +314,7 @@ pub struct EditCost {
 /// Times [`EditCost`] on the 1000-part labelled model, its parts given baked records (a box and a
 /// projector each) so that the editor can change them.
 fn edit_cost(renderer: &mut Renderer, base: &RenderOptions, triangles: usize) -> Result<EditCost> {
-    use drafter_viewer::edit::{Adjust, Editor, ScreenView, Tool};
+    use drafter_app::edit::{Adjust, Editor, ScreenView, Tool};
     const EDITS: usize = 101;
     let mut model = spheres::model(1000, triangles, true)?;
     let origin = model.origin;
@@ -493,7 +493,7 @@ fn parts(args: PartsArgs) -> Result<()> {
 mod spheres {
     use drafter_core::{Instance, Mesh, MeshId, Node, NodeId, Scene, SourceFormat, TriangleGroup};
     use drafter_format::{BakedFile, NodeExtension, PartRecord, RootExtension};
-    use drafter_viewer::Model;
+    use drafter_render::Model;
     use glam::{DMat4, Vec3};
 
     /// Appends a UV sphere of about `triangles` triangles at `center` to `mesh`.

@@ -161,7 +161,7 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 /// The drawing and the fastest of three runs' time.
-fn timed_draw(model: &drafter_viewer::Model, options: &DrawOptions) -> (Drawing, Duration) {
+fn timed_draw(model: &drafter_scene::Model, options: &DrawOptions) -> (Drawing, Duration) {
     let mut best = Duration::MAX;
     let mut drawing = Drawing::default();
     for _ in 0..3 {
@@ -214,7 +214,7 @@ fn share_within(points: &[(DVec2, f64)], of: &[(DVec2, f64)], radius: f64) -> f6
 
 /// Times `samples` points on the view's edges ray-cast against every triangle, and extrapolates to
 /// one point per pixel of every edge.
-fn brute_force(model: &drafter_viewer::Model, options: &DrawOptions, view: usize, samples: usize) -> Brute {
+fn brute_force(model: &drafter_scene::Model, options: &DrawOptions, view: usize, samples: usize) -> Brute {
     let vis = drawing::visibility(model, options);
     let triangles = world_triangles(model);
     let edge_px: f64 = vis.edges.iter().map(|e| e.screen[0].distance(e.screen[1])).sum();

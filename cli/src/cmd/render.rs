@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use drafter_viewer::{Enhancements, LoadError, Model, RenderOptions, Renderer, ShadowMode, Style, View};
+use drafter_render::{Enhancements, LoadError, Model, RenderOptions, Renderer, ShadowMode, Style, View};
 
 use crate::exit::BadInput;
 
@@ -46,7 +46,7 @@ pub struct Args {
     #[arg(long, default_value_t = 2)]
     pub supersample: u32,
     /// Steps of cel and Goochel shading (2–4).
-    #[arg(long, default_value_t = drafter_viewer::style::DEFAULT_CEL_STEPS)]
+    #[arg(long, default_value_t = drafter_render::style::DEFAULT_CEL_STEPS)]
     pub cel_steps: u32,
     /// Gooch's splash-back term on cool-to-warm shading.
     #[arg(long)]
@@ -159,7 +159,7 @@ pub fn run(args: Args) -> Result<()> {
             eprintln!("  note: no enhanced normals in the file (bake it with normals): drawn with its own normals");
         }
         if args.lines
-            && let Some(notice) = drafter_viewer::passes::lines::notice(&model.lines)
+            && let Some(notice) = drafter_render::passes::lines::notice(&model.lines)
         {
             eprintln!("  note: {notice}");
         }

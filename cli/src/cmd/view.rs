@@ -4,14 +4,14 @@
 //! a click selects a part (printed and shown in the title), `P` saves a screenshot; parts are
 //! edited in place (Lux et al. 2013 §4: anchor, scale, direction and projector-line tools, gradient
 //! keys, undo, `Ctrl`+`S` saves into the file, `Ctrl`+`E` exports the edits as bake overrides); see
-//! `drafter_viewer::window` and `--help` ([`KEYS`]). Without a display it fails with one line (exit
+//! `drafter_app::window` and `--help` ([`KEYS`]). Without a display it fails with one line (exit
 //! code 2).
 
 use std::path::PathBuf;
 
 use anyhow::Result;
-use drafter_viewer::window::WindowError;
-use drafter_viewer::{Enhancements, RenderOptions, View};
+use drafter_app::window::WindowError;
+use drafter_render::{Enhancements, RenderOptions, View};
 
 use crate::cmd::render::{ShadowArg, load};
 use crate::exit::BadInput;
@@ -49,8 +49,8 @@ pub struct Args {
     /// The model to show: a baked .glb/.gltf, or any glTF, OBJ, STL, OFF, PLY.
     pub file: PathBuf,
     /// Shading style to start with.
-    #[arg(long, value_enum, default_value_t = drafter_viewer::Style::Gradient)]
-    pub style: drafter_viewer::Style,
+    #[arg(long, value_enum, default_value_t = drafter_render::Style::Gradient)]
+    pub style: drafter_render::Style,
     /// Initial window size in pixels, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = crate::cmd::render::parse_size)]
     pub size: (u32, u32),
@@ -98,7 +98,7 @@ pub fn run(args: Args) -> Result<()> {
     let writer = |path: &std::path::Path, bytes: &[u8]| {
         drafter_catalog::output::replace_in_place(path, bytes).map_err(|e| e.to_string())
     };
-    drafter_viewer::window::run(model, &args.file, options, &writer).map_err(|e| match e {
+    drafter_app::window::run(model, &args.file, options, &writer).map_err(|e| match e {
         WindowError::NoDisplay(_) => anyhow::Error::from(BadInput(e.to_string())),
         other => anyhow::Error::from(other),
     })

@@ -175,9 +175,9 @@ mod tests {
         let limit: u64 = page_constant("DEFAULT_MAX_TRIANGLES").replace('_', "").parse().expect("a number");
         assert_eq!(limit, PAGE_MAX_TRIANGLES, "the page's DEFAULT_MAX_TRIANGLES");
         // The styles in the viewer's order, as the toolbar lists them and the keys 1-7 number them.
-        let styles: Vec<&str> = drafter_viewer::Style::ALL.iter().map(|s| s.name()).collect();
+        let styles: Vec<&str> = drafter_render::Style::ALL.iter().map(|s| s.name()).collect();
         assert_eq!(page_strings("STYLES"), styles, "the page's STYLES");
-        let shadows: Vec<&str> = drafter_viewer::ShadowMode::ALL.iter().map(|s| s.name()).collect();
+        let shadows: Vec<&str> = drafter_render::ShadowMode::ALL.iter().map(|s| s.name()).collect();
         assert_eq!(page_strings("SHADOWS"), shadows, "the page's SHADOWS");
         // The files a drop loads: any format the importers read (the page imports with drafter-io).
         let mut dropped = page_strings("MODEL_EXTENSIONS");

@@ -4,7 +4,7 @@
 //! baked edges and the per-view silhouette query ([`edges`]), and the file's NPR lookup textures
 //! ([`lookups`]).
 //!
-//! Two crates read it: drafter-viewer (the wgpu renderer and the window) uploads it, and
+//! Two crates read it: drafter-render (the wgpu renderer of the window and the page) uploads it, and
 //! drafter-draw (`drafter draw`, vector drawings with exact hidden lines) projects it. So the
 //! drawing does not link wgpu.
 //!

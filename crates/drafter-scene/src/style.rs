@@ -1,6 +1,6 @@
 //! The shading styles and the view: what the viewer's frames and the drawings share, with the
 //! documented defaults, and the procedural lookup tables a file without baked ones falls back on.
-//! The options of a GPU frame are the viewer's (`drafter_viewer::RenderOptions`).
+//! The options of a GPU frame are the renderer's (`drafter_render::RenderOptions`).
 
 use drafter_core::gradient::{IntensityTransfer, TransferCurve};
 

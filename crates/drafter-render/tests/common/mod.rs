@@ -1,11 +1,12 @@
-//! Shared by the viewer's integration tests: the renderer (which must exist: no GPU adapter is a
-//! failure, not a skip), the baked sample, and golden-image comparison.
+//! Shared by the renderer's integration tests and drafter-app's (which include this file): the
+//! renderer (which must exist: no GPU adapter is a failure, not a skip), the baked sample, and
+//! golden-image comparison.
 
 #![allow(dead_code)]
 
 use std::path::Path;
 
-use drafter_viewer::{Image, Renderer};
+use drafter_render::{Image, Renderer};
 
 /// Mean absolute difference (RGB, in [0, 1]) a golden image may show.
 pub const MAX_MEAN_ABS: f64 = 0.02;
@@ -20,14 +21,14 @@ pub fn renderer() -> Renderer {
     match Renderer::new() {
         Ok(r) => r,
         Err(e) => panic!(
-            "the viewer tests need a GPU adapter and found none: {e}\n\
+            "the renderer tests need a GPU adapter and found none: {e}\n\
              (CI installs lavapipe: apt-get install -y mesa-vulkan-drivers libvulkan1)"
         ),
     }
 }
 
 // The baked models come from the drawing's test helpers, one copy for both crates.
-#[path = "../../../crates/drafter-draw/tests/common/mod.rs"]
+#[path = "../../../drafter-draw/tests/common/mod.rs"]
 mod baking;
 #[allow(unused_imports)] // each test binary uses some of them
 pub use baking::{baked, corpus_path, repo_path, sample};

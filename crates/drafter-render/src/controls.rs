@@ -1,4 +1,4 @@
-//! The view controls the desktop window ([`crate::window`]) and the browser page (`web/`) share:
+//! The view controls the desktop window (drafter-app's `window`) and the browser page (`web/`) share:
 //! the orbit a drag, the wheel and a pan change, and what a key does to the frame's options. Pure
 //! functions of plain data, so both front ends behave alike and the tests need no display.
 

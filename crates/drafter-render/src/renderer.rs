@@ -117,7 +117,7 @@ pub struct Renderer {
 
 impl Renderer {
     /// A headless renderer on the default adapter (see [`Gpu::headless`]).
-    #[cfg(feature = "native")]
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new() -> Result<Renderer, RenderError> {
         Self::with_gpu(Gpu::headless()?, crate::targets::OUTPUT_FORMAT)
     }
@@ -638,12 +638,12 @@ impl ErrorScopes {
 /// nothing may block: WebGL2 (wgpu-core) answers at once; a WebGPU answer still pending after one
 /// poll is awaited on the page's event loop and, if it is an error, written to the console (which
 /// the page and its tests watch), since the frame that caused it has already returned.
-#[cfg(feature = "native")]
+#[cfg(not(target_arch = "wasm32"))]
 fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>>) -> Option<wgpu::Error> {
     pollster::block_on(pop)
 }
 
-#[cfg(not(feature = "native"))]
+#[cfg(target_arch = "wasm32")]
 fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>> + 'static) -> Option<wgpu::Error> {
     let mut pop = Box::pin(pop);
     match pop.as_mut().poll(&mut std::task::Context::from_waker(std::task::Waker::noop())) {
@@ -655,7 +655,7 @@ fn settle(pop: impl std::future::Future<Output = Option<wgpu::Error>> + 'static)
     }
 }
 
-#[cfg(all(not(feature = "native"), target_arch = "wasm32"))]
+#[cfg(target_arch = "wasm32")]
 fn report_later(pop: std::pin::Pin<Box<dyn std::future::Future<Output = Option<wgpu::Error>>>>) {
     wasm_bindgen_futures::spawn_local(async move {
         if let Some(error) = pop.await {
@@ -663,10 +663,6 @@ fn report_later(pop: std::pin::Pin<Box<dyn std::future::Future<Output = Option<w
         }
     });
 }
-
-/// Off the web without `native` (a check build) nothing answers later.
-#[cfg(all(not(feature = "native"), not(target_arch = "wasm32")))]
-fn report_later(_pop: std::pin::Pin<Box<dyn std::future::Future<Output = Option<wgpu::Error>>>>) {}
 
 /// Runs `f` inside error scopes.
 fn scoped<T>(device: &wgpu::Device, f: impl FnOnce() -> T) -> Result<T, RenderError> {

@@ -1,5 +1,6 @@
-//! drafter-viewer: renders baked files (and any model drafter-io reads) for non-photorealistic
-//! technical illustration with wgpu, in a window or headless to PNG.
+//! drafter-render: renders baked files (and any model drafter-io reads) for non-photorealistic
+//! technical illustration with wgpu: headless to PNG, into a window's surface (drafter-app, `drafter
+//! view`) or into the browser page's canvas (`web/`).
 //!
 //! # The frame
 //! A multi-pass pipeline after Lux et al. 2013, §5, Algorithm 1 (../shared/papers/000_*), with the
@@ -19,11 +20,10 @@
 //! 5. [`passes::lines`]: the baked hard edges and this frame's silhouettes (queried per instance
 //!    from the baked hierarchies, [`edges`]) as screen-space quads over the display output.
 //!
-//! [`window`] runs the same frame in a winit window (`drafter view`); its input handling is pure
-//! functions ([`window::Orbit`], [`window::action_for_key`]) tested without a display. The
-//! illustrator's edits there (Lux et al. 2013 §4: selection, projector manipulators, gradient
-//! keys, undo, save and export) are the plain data and functions of [`edit`]; an edit rewrites the
-//! part table only ([`Renderer::update_parts`]).
+//! drafter-app runs the same frame in a winit window (`drafter view`), with the illustrator's edits
+//! (Lux et al. 2013 §4); an edit rewrites the part table only ([`Renderer::update_parts`]). The view
+//! controls the window and the browser page share (the orbit, the zoom and pan, what a key does)
+//! are pure functions here, in [`controls`], tested without a display.
 //!
 //! Frame times (`drafter bench render`, lavapipe, 1600×1200, ratio to Phong in the same run): every
 //! style 1.00–1.03×; edges 1.4×; soft shadow 1.1×; full illustration (gradient, edges, soft shadow)
@@ -32,20 +32,19 @@
 //! # Use
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! let model = drafter_viewer::Model::load(std::path::Path::new("sample.baked.glb"))?;
-//! let mut renderer = drafter_viewer::Renderer::new()?; // lavapipe works: no GPU needed
+//! let model = drafter_render::Model::load(std::path::Path::new("sample.baked.glb"))?;
+//! let mut renderer = drafter_render::Renderer::new()?; // lavapipe works: no GPU needed
 //! renderer.set_model(&model)?;
-//! let options = drafter_viewer::RenderOptions { style: drafter_viewer::Style::Gooch, ..Default::default() };
+//! let options = drafter_render::RenderOptions { style: drafter_render::Style::Gooch, ..Default::default() };
 //! std::fs::write("out.png", renderer.render(&options)?.to_png()?)?;
 //! # Ok(()) }
 //! ```
 //!
 //! # Platforms
-//! The default feature `native` adds the desktop side: [`window`] and [`panel`] (winit, egui),
-//! blocking device requests ([`Gpu::headless`], [`Renderer::new`]).
-//! Without it the crate is the renderer alone and builds for `wasm32-unknown-unknown` (the browser
-//! page in `web/`, WebGPU or WebGL2): the same passes and WGSL, the device requested
-//! asynchronously with [`Gpu::request`], frames recorded with [`Renderer::encode_frame`].
+//! No window crate: the crate builds for `wasm32-unknown-unknown` as it is (the browser page in
+//! `web/`, WebGPU or WebGL2), the same passes and WGSL, the device requested asynchronously with
+//! [`Gpu::request`], frames recorded with [`Renderer::encode_frame`]. Off the web the device
+//! requests also block ([`Gpu::headless`], [`Renderer::new`], through pollster).
 //!
 //! # The CPU side
 //! What a frame is made of on the CPU (the [`Model`], the [`Camera`] fit, the baked edges and the
@@ -54,25 +53,20 @@
 //! in [`style`], beside the frame's options). The vector drawings (`drafter draw`) are
 //! drafter-draw, which reads the same model without wgpu.
 //!
-//! Invariant: the viewer renders what drafter-io and drafter-format read; it never runs a bake
+//! Invariant: the renderer draws what drafter-io and drafter-format read; it never runs a bake
 //! stage. A file without `DRAFTER_illustration` data renders with one part per instance and a
 //! bounding-box projector, and [`Model::notices`] says so.
 
 pub mod context;
 pub mod controls;
-pub mod edit;
 pub mod gpu_types;
 pub mod image;
-#[cfg(feature = "native")]
-pub mod panel;
 pub mod passes;
 pub mod renderer;
 pub mod scene;
 pub mod style;
 pub mod table;
 pub mod targets;
-#[cfg(feature = "native")]
-pub mod window;
 
 pub use drafter_scene::{camera, edges, lookups, model};
 

@@ -50,7 +50,7 @@ impl Gpu {
     /// groups when the instance has [`wgpu::InstanceFlags::DEBUG`] (the default of debug builds). On
     /// lavapipe the instance is therefore made again without that flag, unless `WGPU_DEBUG` asks
     /// for it explicitly; debug groups are then no-ops.
-    #[cfg(feature = "native")]
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless() -> Result<Gpu, RenderError> {
         let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         let debug = descriptor.flags.contains(wgpu::InstanceFlags::DEBUG);
@@ -66,7 +66,7 @@ impl Gpu {
         Self::with_adapter(instance, adapter)
     }
 
-    #[cfg(feature = "native")]
+    #[cfg(not(target_arch = "wasm32"))]
     fn adapter(descriptor: wgpu::InstanceDescriptor) -> Result<(wgpu::Instance, wgpu::Adapter), RenderError> {
         let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
@@ -75,7 +75,7 @@ impl Gpu {
     }
 
     /// A device on `adapter` (the window chooses one compatible with its surface).
-    #[cfg(feature = "native")]
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
         pollster::block_on(Self::request(instance, adapter))
     }

@@ -5,8 +5,8 @@
 
 mod common;
 
-use drafter_viewer::camera::FIT_MARGIN;
-use drafter_viewer::{Image, RenderOptions, ShadowMode, Style, View};
+use drafter_render::camera::FIT_MARGIN;
+use drafter_render::{Image, RenderOptions, ShadowMode, Style, View};
 
 /// The drawn content's box (left, right, top, bottom margins in pixels): every pixel that differs
 /// from the background corner by more than a few levels.
@@ -81,7 +81,7 @@ fn an_interactive_frame_is_the_still_frame_at_a_lower_resolution() {
     let still = RenderOptions {
         size: (320, 240),
         style: Style::Gradient,
-        enhancements: drafter_viewer::Enhancements::ALL,
+        enhancements: drafter_render::Enhancements::ALL,
         lines: true,
         shadow: ShadowMode::Soft,
         ..RenderOptions::default()

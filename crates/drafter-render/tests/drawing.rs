@@ -5,7 +5,7 @@
 mod common;
 
 use drafter_draw::{self as drawing, DrawOptions, Hidden};
-use drafter_viewer::edges::LineClass;
+use drafter_render::edges::LineClass;
 
 /// The drawing's visible black lines (silhouettes, boundaries, part borders) against the raster
 /// lines pass of `drafter render --lines` in the Gooch style (black lines over cool-to-warm shading,
@@ -19,13 +19,13 @@ fn the_drawing_matches_the_raster_lines_pass() {
     let drawing = drawing::draw(&model, &options);
     let mut renderer = common::renderer();
     renderer.set_model(&model).expect("upload");
-    let render = drafter_viewer::RenderOptions {
+    let render = drafter_render::RenderOptions {
         size,
-        style: drafter_viewer::Style::Gooch,
+        style: drafter_render::Style::Gooch,
         use_part_styles: false,
         lines: true,
         view: options.view,
-        ..drafter_viewer::RenderOptions::default()
+        ..drafter_render::RenderOptions::default()
     };
     let image = renderer.render(&render).expect("frame");
     let (w, h) = (size.0 as usize, size.1 as usize);
@@ -144,11 +144,11 @@ fn the_fills_match_the_renderers_parts() {
         let size = (800u32, 600u32);
         let mut renderer = common::renderer();
         renderer.set_model(&model).expect("upload");
-        let render = drafter_viewer::RenderOptions {
+        let render = drafter_render::RenderOptions {
             size,
             supersample: 1,
             view: DrawOptions::default().view,
-            ..drafter_viewer::RenderOptions::default()
+            ..drafter_render::RenderOptions::default()
         };
         renderer.render(&render).expect("frame");
         let parts = renderer.part_map().expect("part ids").expect("a frame");

@@ -2,12 +2,12 @@
 //! the file's lookup textures), a few option variants, and models from ../shared/models (an unbaked
 //! one in the procedural metal), compared with the committed references in
 //! `tests/golden/` within the tolerance of `common` (mean |Δ| ≤ 0.02, ≤ 1 % of pixels off by more
-//! than 8 levels). `DRAFTER_UPDATE_GOLDEN=1 cargo test -p drafter-viewer --test golden` rewrites
+//! than 8 levels). `DRAFTER_UPDATE_GOLDEN=1 cargo test -p drafter-render --test golden` rewrites
 //! them; look at every one before committing.
 
 mod common;
 
-use drafter_viewer::{Enhancements, RenderOptions, ShadowMode, Style, View};
+use drafter_render::{Enhancements, RenderOptions, ShadowMode, Style, View};
 
 /// Small images keep the suite fast on lavapipe.
 const SIZE: (u32, u32) = (256, 192);
@@ -23,7 +23,7 @@ fn options(style: Style) -> RenderOptions {
     }
 }
 
-fn run_cases(model: &drafter_viewer::Model, cases: &[(String, RenderOptions)]) {
+fn run_cases(model: &drafter_render::Model, cases: &[(String, RenderOptions)]) {
     let mut renderer = common::renderer();
     renderer.set_model(model).expect("upload");
     let mut failures = Vec::new();
@@ -94,10 +94,10 @@ fn corpus_models() {
         ],
     );
     // A single-mesh CAD part, unbaked: one part, a bounding-box projector, and a notice.
-    let fandisk = drafter_viewer::Model::load(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"))
+    let fandisk = drafter_render::Model::load(&common::corpus_path("obj/common-3d-test-models/fandisk.obj"))
         .expect("fandisk loads");
     assert!(!fandisk.baked && !fandisk.notices.is_empty());
-    assert_eq!(*fandisk.lookups(), drafter_viewer::lookups::BakedLookups::default(), "procedural metal");
+    assert_eq!(*fandisk.lookups(), drafter_render::lookups::BakedLookups::default(), "procedural metal");
     run_cases(&fandisk, &[("fandisk_unbaked_metal".into(), options(Style::Metal))]);
 }
 
@@ -155,9 +155,9 @@ fn bgra_output_reads_back_as_the_rgba_render() {
     let mut rgba = common::renderer();
     rgba.set_model(&model).expect("upload");
     let expected = rgba.render(&options).expect("rgba render");
-    let gpu = drafter_viewer::context::Gpu::headless().expect("adapter");
+    let gpu = drafter_render::context::Gpu::headless().expect("adapter");
     let mut bgra =
-        drafter_viewer::renderer::Renderer::with_gpu(gpu, wgpu::TextureFormat::Bgra8Unorm).expect("bgra renderer");
+        drafter_render::renderer::Renderer::with_gpu(gpu, wgpu::TextureFormat::Bgra8Unorm).expect("bgra renderer");
     bgra.set_model(&model).expect("upload");
     let image = bgra.render(&options).expect("bgra render");
     assert_eq!((image.width, image.height), (expected.width, expected.height));

@@ -8,8 +8,8 @@ mod common;
 use std::path::Path;
 
 use drafter_bake::BakeConfig;
-use drafter_viewer::lookups::{BakedLookups, LookupImage};
-use drafter_viewer::{Model, RenderOptions, Style};
+use drafter_render::lookups::{BakedLookups, LookupImage};
+use drafter_render::{Model, RenderOptions, Style};
 
 const SIZE: (u32, u32) = (160, 120);
 
@@ -63,7 +63,7 @@ fn the_loader_returns_the_texels_drafter_textures_generates() {
     // The γ atlas holds the parts' curves; its rows are the procedural atlas's rows to 8 bits.
     let gamma = lookups.gamma.as_ref().expect("γ atlas");
     assert_eq!(gamma.image.levels[0], level0(&drafter_textures::gamma_atlas(&gamma.curves)));
-    let procedural = drafter_viewer::lookups::procedural_gamma();
+    let procedural = drafter_render::lookups::procedural_gamma();
     for (r, &curve) in gamma.curves.iter().enumerate() {
         let p = procedural.row(curve).expect("every curve has a procedural row");
         for k in 0..128 {
@@ -143,7 +143,7 @@ fn a_file_without_textures_renders_procedurally_with_a_notice() {
     }
     // Only the metal parts (hint-free, metallic materials) would have brought metal textures.
     let mut metal_only = BakeConfig::default();
-    metal_only.textures.styles = vec!["phong".into()];
+    metal_only.textures.styles = vec!["phong".parse().expect("a style name")];
     let model = sample_with(&metal_only);
     let names = model.lookups().names();
     assert_eq!(names, ["metal_bands", "metal_highlights"], "{:?}", model.notices);

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use drafter_viewer::Model;
+use drafter_render::Model;
 
 #[test]
 fn a_huge_part_count_is_not_allocated() {

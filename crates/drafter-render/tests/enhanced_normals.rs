@@ -9,7 +9,7 @@ mod common;
 
 use std::path::Path;
 
-use drafter_viewer::{Model, RenderOptions, Style, View};
+use drafter_render::{Model, RenderOptions, Style, View};
 
 const SIZE: (u32, u32) = (256, 192);
 

@@ -9,7 +9,7 @@ use drafter_bounds::Projector;
 use drafter_core::gradient::{TransferCurve, omega};
 use drafter_core::{Instance, Mesh, MeshId, Node, NodeId, Scene, SourceFormat, TriangleGroup};
 use drafter_format::{BakedFile, BoxRecord, GradientRecord, NodeExtension, PartRecord, ProjectorRecord, RootExtension};
-use drafter_viewer::{Model, RenderOptions, Style, View};
+use drafter_render::{Model, RenderOptions, Style, View};
 use glam::{DMat4, DVec3, Vec3, Vec4Swizzles};
 
 const SIZE: (u32, u32) = (240, 120);

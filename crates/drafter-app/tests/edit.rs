@@ -3,14 +3,16 @@
 //! reloads to the same parameters; the exported overrides, re-baked from the source model, give
 //! the same part records as the saved file.
 
+// The renderer's test helpers (a renderer that must exist, the baked sample), one copy for both crates.
+#[path = "../../drafter-render/tests/common/mod.rs"]
 mod common;
 
 use std::path::Path;
 
+use drafter_app::edit::{Adjust, Editor, ScreenView, Tool};
 use drafter_format::PartRecord;
-use drafter_viewer::camera::Camera;
-use drafter_viewer::edit::{Adjust, Editor, ScreenView, Tool};
-use drafter_viewer::{Model, View};
+use drafter_render::camera::Camera;
+use drafter_render::{Model, View};
 use glam::DVec2;
 
 const SIZE: (u32, u32) = (1024, 768);
@@ -114,7 +116,7 @@ fn exported_overrides_rebake_to_the_saved_records() {
 #[test]
 fn an_edit_reaches_the_next_frame_through_the_part_table_alone() {
     let original = bake(&drafter_bake::BakeConfig::default());
-    let options = drafter_viewer::RenderOptions { size: (320, 240), ..Default::default() };
+    let options = drafter_render::RenderOptions { size: (320, 240), ..Default::default() };
     let mut model = Model::load_bytes(Path::new("sample.baked.glb"), &original).unwrap();
     // The base plate's gradient (q) and the right bracket's tone: both large in the default view.
     let mut editor = Editor::new(model.parts.iter().map(|p| p.record.clone()).collect());

@@ -6,7 +6,7 @@
 //! read again with drafter-format, each candidate's point is taken from the imported mesh, the
 //! camera of the rendered frame is taken into each instance's object space with this file's own
 //! f64 arithmetic, and [`drafter_lines::BruteForce`] tests every candidate serially. The viewer's
-//! side is what the renderer uploaded in that frame ([`drafter_viewer::Renderer::last_silhouettes`]),
+//! side is what the renderer uploaded in that frame ([`drafter_render::Renderer::last_silhouettes`]),
 //! which went through the stored hierarchies when the file has them.
 
 mod common;
@@ -15,8 +15,8 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use drafter_lines::{BruteForce, EdgeSet, View as LinesView};
-use drafter_viewer::edges::{DrawnSilhouette, Hierarchies};
-use drafter_viewer::{Camera, Model, RenderOptions, Renderer, Style, View};
+use drafter_render::edges::{DrawnSilhouette, Hierarchies};
+use drafter_render::{Camera, Model, RenderOptions, Renderer, Style, View};
 use glam::{DMat4, Vec3};
 
 /// A baked file in memory: the viewer's model, the file's extension data and its imported scene.
@@ -220,7 +220,7 @@ fn lines_change_the_image_and_picking_reads_parts() {
     let plain = renderer.render(&base).expect("render");
     let lined = renderer.render(&RenderOptions { lines: true, ..base.clone() }).expect("render");
     let black =
-        |img: &drafter_viewer::Image| img.rgba.chunks_exact(4).filter(|p| p[0] < 40 && p[1] < 40 && p[2] < 40).count();
+        |img: &drafter_render::Image| img.rgba.chunks_exact(4).filter(|p| p[0] < 40 && p[1] < 40 && p[2] < 40).count();
     assert!(black(&lined) > black(&plain) + 300, "lines added {} dark pixels", black(&lined) - black(&plain));
     // Picking: the centre of the frame is on a part, the corner is background.
     let (w, h) = (base.size.0, base.size.1);

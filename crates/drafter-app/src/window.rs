@@ -4,10 +4,10 @@
 //! * left drag: turn the *object* (Gooch et al. 1999, §4.1: the viewer and the light stay put, so
 //!   the cool-to-warm shading sweeps over the surface as it turns). For one frame that is the
 //!   camera orbiting the other way with the light fixed to it, which is how the renderer draws it
-//!   ([`crate::camera`]): dragging right turns the object's front to the right.
+//!   ([`drafter_render::camera`]): dragging right turns the object's front to the right.
 //! * wheel: zoom about the frame's centre; right or middle drag: pan. While a button drags, frames
 //!   are drawn at reduced resolution and filtered up ([`RenderOptions::interactive`], at the
-//!   adapter's [`crate::Gpu::interactive_scale`]); the frame after the release is full quality.
+//!   adapter's [`drafter_render::Gpu::interactive_scale`]); the frame after the release is full quality.
 //! * `1`–`7`: style (gradient, cel, gooch, goochel, phong, metal, hatch); `S`: next style.
 //! * `E` image-space edges, `L` baked lines, `H` next drop shadow (none, hard, penumbra, soft),
 //!   `O` orthographic, `R` reset the view.
@@ -63,14 +63,15 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
-use crate::context::{Gpu, RenderError};
-use crate::edit::{Adjust, Editor, PartBox, ScreenView, Tool, parts_in_lasso};
-use crate::model::Model;
-use crate::panel::{self, Handle, Overlay, PanelAction, PanelPart, PanelView, Status, count};
-use crate::renderer::Renderer;
-use crate::style::RenderOptions;
+use drafter_render::context::{Gpu, RenderError};
+use drafter_render::model::Model;
+use drafter_render::renderer::Renderer;
+use drafter_render::style::RenderOptions;
 
-pub use crate::controls::{
+use crate::edit::{Adjust, Editor, PartBox, ScreenView, Tool, parts_in_lasso};
+use crate::panel::{self, Handle, Overlay, PanelAction, PanelPart, PanelView, Status, count};
+
+pub use drafter_render::controls::{
     Action, DEGREES_PER_PIXEL, MAX_ELEVATION_DEG, Orbit, PIXELS_PER_LINE, ZOOM_PER_LINE, action_for_char,
 };
 
@@ -1042,7 +1043,7 @@ impl ApplicationHandler for App<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::style::{Enhancements, ShadowMode, Style, ZOOM_RANGE};
+    use drafter_render::style::{Enhancements, ShadowMode, Style, ZOOM_RANGE};
 
     #[test]
     fn drag_turns_the_object_and_clamps_at_the_poles() {
@@ -1108,7 +1109,7 @@ mod tests {
             seen.push(options.style);
         }
         assert_eq!(options.style, Style::default());
-        seen.sort_by_key(|&s| crate::style::shader_index(s));
+        seen.sort_by_key(|&s| drafter_render::style::shader_index(s));
         assert_eq!(seen.len(), 7);
         seen.dedup();
         assert_eq!(seen.len(), 7, "every style once");

@@ -1,5 +1,5 @@
 //! The editing panel of `drafter view` and the on-screen projector handles (Lux et al. 2013 §4),
-//! drawn with egui over the frame by the viewer's own wgpu device.
+//! drawn with egui over the frame by the renderer's own wgpu device.
 //!
 //! [`show`] is the panel as a function of plain data ([`PanelView`]) returning what the user asked
 //! for ([`PanelAction`]); the window applies the actions through the same editor calls as the keys,
