@@ -9,8 +9,9 @@ For each CAD model built here with CadQuery (plate, bushing, bracket, gear, six 
    --json``); the time is the ``ms`` of its JSON.
 3. The same direction goes to CadQuery's exporter: ``cq.exporters.export(shape, 'x.svg',
    opt={'projectionDir': d, 'showHidden': True, ...})``, timed as a whole. drafter's camera looks
-   from ``d = (cos el sin az, sin el, cos el cos az)`` (``viewer/src/camera.rs`` ``view_rotation``)
-   and OpenCascade's projector's axis points to the viewer, so ``projectionDir = d``.
+   from ``d = (cos el sin az, sin el, cos el cos az)`` (``crates/drafter-scene/src/camera.rs``
+   ``view_rotation``) and OpenCascade's projector's axis points to the viewer, so
+   ``projectionDir = d``.
    The exporter's algorithm is run once more here (the same HLRBRep_Algo, projector, edge
    compounds and 1e-3 GCPnts_QuasiUniformDeflection) to keep the kinds of edges apart: sharp,
    smooth (Rg1, visible only, as the exporter draws) and outlines; its polylines are checked to be
