@@ -33,259 +33,178 @@ use serde_json::Value;
 /// An object's members that the types here do not name, or its `extensions`, as JSON.
 pub type Members = serde_json::Map<String, Value>;
 
-/// The top-level glTF object.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Root {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub accessors: Option<Vec<Accessor>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub asset: Option<Asset>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_views: Option<Vec<BufferView>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffers: Option<Vec<Buffer>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions_required: Option<Vec<String>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions_used: Option<Vec<String>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub images: Option<Vec<Image>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub materials: Option<Vec<Material>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub meshes: Option<Vec<Mesh>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub nodes: Option<Vec<Node>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scene: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scenes: Option<Vec<Scene>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub textures: Option<Vec<Texture>>,
-    /// Animations, cameras, samplers, skins and members a later glTF adds.
-    #[serde(flatten)]
-    pub other: Members,
+/// A glTF object type: each named member an `Option` (absent stays absent when written back),
+/// written in camelCase, and every other member in `other`.
+macro_rules! object {
+    ($(#[$meta:meta])* $name:ident { $($(#[$member:meta])* $field:ident: $ty:ty,)* }) => {
+        $(#[$meta])*
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(rename_all = "camelCase")]
+        pub struct $name {
+            $($(#[$member])* #[serde(default, skip_serializing_if = "Option::is_none")] pub $field: Option<$ty>,)*
+            /// The members not named above, as JSON.
+            #[serde(flatten)]
+            pub other: Members,
+        }
+    };
 }
 
-/// `asset`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Asset {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub generator: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub version: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// The top-level glTF object (animations, cameras, samplers, skins and members a later glTF
+    /// adds are in `other`).
+    Root {
+        accessors: Vec<Accessor>,
+        asset: Asset,
+        buffer_views: Vec<BufferView>,
+        buffers: Vec<Buffer>,
+        extensions: Members,
+        extensions_required: Vec<String>,
+        extensions_used: Vec<String>,
+        extras: Value,
+        images: Vec<Image>,
+        materials: Vec<Material>,
+        meshes: Vec<Mesh>,
+        nodes: Vec<Node>,
+        scene: u32,
+        scenes: Vec<Scene>,
+        textures: Vec<Texture>,
+    }
 }
 
-/// An entry of `scenes`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Scene {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub nodes: Option<Vec<u32>>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// `asset`.
+    Asset {
+        generator: String,
+        version: String,
+    }
 }
 
-/// An entry of `nodes` (its transform is in `other`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Node {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub children: Option<Vec<u32>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mesh: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `scenes`.
+    Scene {
+        name: String,
+        nodes: Vec<u32>,
+    }
 }
 
-/// An entry of `meshes`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Mesh {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub primitives: Option<Vec<Primitive>>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `nodes` (its transform is in `other`).
+    Node {
+        children: Vec<u32>,
+        extensions: Members,
+        extras: Value,
+        mesh: u32,
+        name: String,
+    }
 }
 
-/// An entry of a mesh's `primitives` (its morph `targets` are in `other`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Primitive {
-    /// Attribute name → accessor index.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub attributes: Option<BTreeMap<String, u32>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub indices: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub material: Option<u32>,
-    /// The mode's code ([`Mode::from_code`]); absent means triangles.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mode: Option<u64>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `meshes`.
+    Mesh {
+        extensions: Members,
+        extras: Value,
+        name: String,
+        primitives: Vec<Primitive>,
+    }
 }
 
-/// An entry of `accessors` (`min`, `max` and `sparse` are in `other`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Accessor {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_view: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub byte_offset: Option<u64>,
-    /// The `componentType` code ([`crate::accessor::ComponentType::from_code`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub component_type: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub count: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub normalized: Option<bool>,
-    /// `"SCALAR"`, `"VEC3"`, … ([`crate::accessor::components`]).
-    #[serde(default, rename = "type", skip_serializing_if = "Option::is_none")]
-    pub kind: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of a mesh's `primitives` (its morph `targets` are in `other`).
+    Primitive {
+        /// Attribute name → accessor index.
+        attributes: BTreeMap<String, u32>,
+        extensions: Members,
+        extras: Value,
+        indices: u32,
+        material: u32,
+        /// The mode's code ([`Mode::from_code`]); absent means triangles.
+        mode: u64,
+    }
 }
 
-/// An entry of `bufferViews`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct BufferView {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub byte_length: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub byte_offset: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub byte_stride: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    /// [`crate::accessor::ARRAY_BUFFER`] or [`crate::accessor::ELEMENT_ARRAY_BUFFER`].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub target: Option<u32>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `accessors` (`min`, `max` and `sparse` are in `other`).
+    Accessor {
+        buffer_view: u32,
+        byte_offset: u64,
+        /// The `componentType` code ([`crate::accessor::ComponentType::from_code`]).
+        component_type: u64,
+        count: u64,
+        extensions: Members,
+        extras: Value,
+        name: String,
+        normalized: bool,
+        /// `"SCALAR"`, `"VEC3"`, … ([`crate::accessor::components`]).
+        #[serde(rename = "type")]
+        kind: String,
+    }
 }
 
-/// An entry of `buffers`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Buffer {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub byte_length: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub uri: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `bufferViews`.
+    BufferView {
+        buffer: u32,
+        byte_length: u64,
+        byte_offset: u64,
+        byte_stride: u64,
+        extensions: Members,
+        extras: Value,
+        name: String,
+        /// [`crate::accessor::ARRAY_BUFFER`] or [`crate::accessor::ELEMENT_ARRAY_BUFFER`].
+        target: u32,
+    }
 }
 
-/// An entry of `images`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Image {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_view: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mime_type: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub uri: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `buffers`.
+    Buffer {
+        byte_length: u64,
+        extensions: Members,
+        extras: Value,
+        name: String,
+        uri: String,
+    }
 }
 
-/// An entry of `textures`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Texture {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sampler: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub source: Option<u32>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `images`.
+    Image {
+        buffer_view: u32,
+        extensions: Members,
+        extras: Value,
+        mime_type: String,
+        name: String,
+        uri: String,
+    }
 }
 
-/// An entry of `materials` (its factors and textures are in `other`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct Material {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extensions: Option<Members>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extras: Option<Value>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `textures`.
+    Texture {
+        extensions: Members,
+        extras: Value,
+        name: String,
+        sampler: u32,
+        source: u32,
+    }
 }
 
-/// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads
-/// (accessor indices); `lineStrings` and the rest are in `other`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct EdgeVisibility {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub silhouette_normals: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub visibility: Option<u32>,
-    #[serde(flatten)]
-    pub other: Members,
+object! {
+    /// An entry of `materials` (its factors and textures are in `other`).
+    Material {
+        extensions: Members,
+        extras: Value,
+        name: String,
+    }
+}
+
+object! {
+    /// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads
+    /// (accessor indices); `lineStrings` and the rest are in `other`.
+    EdgeVisibility {
+        silhouette_normals: u32,
+        visibility: u32,
+    }
 }
 
 /// The slice in an optional array member (empty when the member is absent).

@@ -523,7 +523,7 @@ pub struct ByteSections {
 }
 
 /// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns. The JSON is read as
-/// the JSON tree the writer holds, and counted by the writer's own [`sections_of`], so that a bake's
+/// the JSON tree the writer holds, and counted by the writer's own `sections_of`, so that a bake's
 /// report and `drafter inspect` count alike by construction.
 pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<ByteSections, FormatError> {
     let decoded = plain(bytes)?;
