@@ -110,6 +110,14 @@ fn an_unbaked_model_is_baked_in_memory_and_draws_the_lines_of_its_bake() {
         let run =
             common::run(&[&["draw", baked.to_str().unwrap(), "-o", baked_svg.to_str().unwrap()][..], args].concat());
         assert!(run.status.success(), "{name}: {}", String::from_utf8_lossy(&run.stderr));
+        // A drawing shades nothing with lookup textures: it neither bakes nor decodes them, nor notes them.
+        for out in [&plain, &run] {
+            assert!(
+                !String::from_utf8_lossy(&out.stderr).contains("textures"),
+                "{name}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
         let (a, b) = (std::fs::read_to_string(&plain_svg).unwrap(), std::fs::read_to_string(&baked_svg).unwrap());
         let strokes = path_data(&a);
         assert!(strokes.len() > 20, "{name}: lines drawn ({})", strokes.len());

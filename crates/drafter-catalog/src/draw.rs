@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use drafter_draw::sheet::{self, Angle, Axis, Scale, SheetOptions, SheetSize, ViewKind};
 use drafter_draw::{DrawOptions, LineStyle};
-use drafter_scene::{Hierarchies, LoadError, Model, View};
+use drafter_scene::{LoadError, Model, View};
 use serde::{Deserialize, Serialize};
 
 use crate::batch::{CacheUse, Observer, Permit, Record, Scheduling, Status, Summary};
@@ -390,13 +390,15 @@ pub fn load(path: &Path, bytes: Vec<u8>, limits: &drafter_io::Limits) -> Result<
         other => Error::Input(other.to_string()),
     };
     if is_baked(path, &bytes) {
-        return Ok((Model::load_bytes_with(path, &bytes, limits, Hierarchies::Never).map_err(bad)?, false));
+        return Ok((Model::load_bytes_for_drawing(path, &bytes, limits).map_err(bad)?, false));
     }
-    let config = drafter_bake::BakeConfig::default();
+    // The drawing reads the bake's edges, not its lookup textures.
+    let mut config = drafter_bake::BakeConfig::default();
+    config.textures.enabled = false;
     let baked = crate::job::bake_bytes(path, bytes, &config, limits, &mut |_| {})?;
     // The default container is one self-contained .glb, named as `drafter bake` would name it.
     let name = path.with_extension("baked.glb");
-    Ok((Model::load_bytes_with(&name, &baked.written.main, limits, Hierarchies::Never).map_err(bad)?, true))
+    Ok((Model::load_bytes_for_drawing(&name, &baked.written.main, limits).map_err(bad)?, true))
 }
 
 /// Whether `bytes` carry `DRAFTER_illustration` data (a compressed GLB decoded first, as the model

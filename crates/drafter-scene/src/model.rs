@@ -162,6 +162,23 @@ impl Model {
         limits: &drafter_io::Limits,
         hierarchies: Hierarchies,
     ) -> Result<Model, LoadError> {
+        Self::load_bytes_inner(path, bytes, limits, hierarchies, true)
+    }
+
+    /// What a line drawing reads: [`Self::load_bytes_within`] with no silhouette hierarchies built
+    /// ([`Hierarchies::Never`]) and no lookup textures decoded (a drawing shades nothing with them,
+    /// so it neither pays for their PNGs nor notes where they came from).
+    pub fn load_bytes_for_drawing(path: &Path, bytes: &[u8], limits: &drafter_io::Limits) -> Result<Model, LoadError> {
+        Self::load_bytes_inner(path, bytes, limits, Hierarchies::Never, false)
+    }
+
+    fn load_bytes_inner(
+        path: &Path,
+        bytes: &[u8],
+        limits: &drafter_io::Limits,
+        hierarchies: Hierarchies,
+        lookups: bool,
+    ) -> Result<Model, LoadError> {
         // A compressed GLB (EXT_meshopt_compression) is decoded once, and everything below reads
         // the plain bytes; a stream that does not decode is reported by the import.
         let plain = drafter_format::meshopt::decompress_glb(bytes).ok().flatten();
@@ -175,11 +192,15 @@ impl Model {
         let mut model = Model::build(&imported.scene, baked.as_ref(), &normal_sets, hierarchies)
             .ok_or_else(|| LoadError::Empty(path.display().to_string()))?;
         model.diagnostics = imported.diagnostics;
-        if let Some(record) = baked.as_ref().and_then(|b| b.root.textures.as_ref()) {
+        if let Some(record) = baked.as_ref().and_then(|b| b.root.textures.as_ref()).filter(|_| lookups) {
             let external = drafter_format::external_buffers(path);
             let (lookups, notices) = BakedLookups::read(Some(record), bytes, &external);
             model.notices.extend(notices);
             model.set_lookups(lookups);
+        }
+        if !lookups {
+            // The procedural fallbacks `build` noted are not the drawing's business either.
+            model.notices.retain(|n| !n.starts_with(crate::lookups::NOTICE_PREFIX));
         }
         Ok(model)
     }
