@@ -194,7 +194,8 @@ impl Default for LinesStage {
 
 /// Default of [`TexturesStage::styles`]: every scene-wide style of the viewer that reads a lookup,
 /// except `metal` (baked only for metal parts, or when listed).
-pub const DEFAULT_TEXTURE_STYLES: [&str; 5] = ["gradient", "cel", "gooch", "goochel", "hatch"];
+pub const DEFAULT_TEXTURE_STYLES: [PartStyle; 5] =
+    [PartStyle::Gradient, PartStyle::Cel, PartStyle::Gooch, PartStyle::Goochel, PartStyle::Hatch];
 
 /// Default of [`TexturesStage::metallic_threshold`]: a material at least half metallic is metal.
 pub const DEFAULT_METALLIC_THRESHOLD: f32 = 0.5;
@@ -208,8 +209,8 @@ pub struct TexturesStage {
     /// Styles a viewer may apply to the whole scene; the lookups they read are baked (`gradient`:
     /// γ atlas, `cel`: cel atlas, `gooch`: cool-to-warm map, `goochel`: both, `hatch`: hatching,
     /// `metal`: metal bands and highlights, `phong`: none). Part style hints and metal parts add to
-    /// them. Default [`DEFAULT_TEXTURE_STYLES`]; each one of [`PartStyle::ALL`].
-    pub styles: Vec<String>,
+    /// them. Default [`DEFAULT_TEXTURE_STYLES`].
+    pub styles: Vec<PartStyle>,
     /// A part without a style hint whose material's metallic factor is at least this is metal and
     /// gets the metal textures baked. Default [`DEFAULT_METALLIC_THRESHOLD`] (0.5); range [0, ∞),
     /// above 1 turns detection from materials off.
@@ -230,7 +231,7 @@ impl Default for TexturesStage {
     fn default() -> Self {
         Self {
             enabled: true,
-            styles: DEFAULT_TEXTURE_STYLES.iter().map(|s| (*s).to_owned()).collect(),
+            styles: DEFAULT_TEXTURE_STYLES.to_vec(),
             metallic_threshold: DEFAULT_METALLIC_THRESHOLD,
             metal: MetalOptions::default(),
             cool_to_warm: CoolToWarmOptions::default(),
@@ -243,12 +244,6 @@ impl Default for TexturesStage {
 impl TexturesStage {
     /// Checks every option against its documented range; errors name the key.
     pub fn validate(&self) -> Result<(), String> {
-        for style in &self.styles {
-            if style.parse::<PartStyle>().is_err() {
-                let names = PartStyle::ALL.map(PartStyle::name).join(", ");
-                return Err(format!("textures.styles: {style:?} is not one of {names}"));
-            }
-        }
         if !(self.metallic_threshold.is_finite() && self.metallic_threshold >= 0.0) {
             return Err(format!("textures.metallic_threshold = {} must be finite and >= 0", self.metallic_threshold));
         }
@@ -346,7 +341,7 @@ struct LinesSection {
 #[serde(deny_unknown_fields)]
 struct TexturesSection {
     enabled: Option<bool>,
-    styles: Option<Vec<String>>,
+    styles: Option<Vec<PartStyle>>,
     metallic_threshold: Option<f32>,
     metal: Option<MetalOptions>,
     cool_to_warm: Option<CoolToWarmOptions>,
@@ -583,7 +578,7 @@ mod tests {
              [textures.cel]\nsteps = 2\n",
         )
         .unwrap();
-        assert_eq!(c.textures.styles, ["gooch"]);
+        assert_eq!(c.textures.styles, [PartStyle::Gooch]);
         assert_eq!(c.textures.metallic_threshold, 0.9);
         assert!(c.textures.cool_to_warm.splash_back);
         assert_eq!(c.textures.cool_to_warm.alpha, drafter_textures::cool_warm::DEFAULT_COOL_MIX);

@@ -104,9 +104,7 @@ pub(crate) fn request(records: &[PartRecord], metal: &[u32], stage: &TexturesSta
     if !stage.enabled {
         return TextureRequest::default();
     }
-    let uses = |style: PartStyle| {
-        stage.styles.iter().any(|s| s == style.name()) || records.iter().any(|r| r.style == Some(style))
-    };
+    let uses = |style: PartStyle| stage.styles.contains(&style) || records.iter().any(|r| r.style == Some(style));
     let gamma_curves =
         if uses(PartStyle::Gradient) { records.iter().map(|r| r.gradient.transfer).collect() } else { Vec::new() };
     TextureRequest {
@@ -128,8 +126,8 @@ const MEMO_ENTRIES: usize = 8;
 /// [`bake`], remembered for the process: the images are a function of the request, the metal parts
 /// and the threshold alone (the stage's own determinism), so a process that bakes many files (a
 /// batch, the Python package) computes and encodes each distinct set once. The lookup key is the
-/// arguments' `Debug` text, which lists every option. On a small part the stage is most of the bake
-/// (9 of 13 ms for a 318-triangle OFF file on the 2-core machine); the bytes written do not change.
+/// arguments' `Debug` text, which lists every option. On a small part the stage is most of the bake;
+/// the bytes written do not change.
 pub(crate) fn bake_memoized(
     request: &TextureRequest,
     metal_parts: Vec<u32>,
@@ -289,8 +287,8 @@ mod tests {
         }
     }
 
-    fn stage(styles: &[&str]) -> TexturesStage {
-        TexturesStage { styles: styles.iter().map(|s| (*s).to_owned()).collect(), ..TexturesStage::default() }
+    fn stage(styles: &[PartStyle]) -> TexturesStage {
+        TexturesStage { styles: styles.to_vec(), ..TexturesStage::default() }
     }
 
     #[test]
@@ -301,19 +299,19 @@ mod tests {
             record(2, TransferCurve::Smoothstep, None),
         ];
         // Scene styles only phong; one part hinted hatch: the halftone only.
-        let r = request(&records, &[], &stage(&["phong"]));
+        let r = request(&records, &[], &stage(&[PartStyle::Phong]));
         assert_eq!(r.hatching, Some(HatchingOptions::default()));
         assert!(r.metal.is_none() && r.cool_to_warm.is_empty() && r.gamma_curves.is_empty() && r.cel_tables.is_empty());
         // Gradient: the curves of all parts (one atlas row per distinct curve), part order.
-        let r = request(&records, &[], &stage(&["gradient"]));
+        let r = request(&records, &[], &stage(&[PartStyle::Gradient]));
         assert_eq!(r.distinct_gamma_curves(), [TransferCurve::Smoothstep, TransferCurve::Identity]);
         // Goochel reads the cel table and the cool-to-warm map; a metal part brings the metal textures.
-        let r = request(&records, &[2], &stage(&["goochel"]));
+        let r = request(&records, &[2], &stage(&[PartStyle::Goochel]));
         assert_eq!(r.cel_tables.len(), 1);
         assert_eq!(r.cool_to_warm.len(), 1);
         assert!(r.metal.is_some());
         // Off: nothing, whatever the parts say.
-        let off = TexturesStage { enabled: false, ..stage(&["gradient", "metal"]) };
+        let off = TexturesStage { enabled: false, ..stage(&[PartStyle::Gradient, PartStyle::Metal]) };
         assert!(request(&records, &[2], &off).is_empty());
     }
 
