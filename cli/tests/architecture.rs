@@ -5,7 +5,7 @@
 //! from every member's Cargo.toml and, past the workspace, from Cargo.lock: stage crates depend on
 //! drafter-core only; the CPU scene and the drawings reach no GPU or window crate; the renderer
 //! (drafter-render) and the browser build (drafter-web) reach no window crate; only the desktop app
-//! (drafter-app) and the CLI name a window crate.
+//! (drafter-app) and the CLI may name a window crate.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
