@@ -9,7 +9,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use drafter_draw::{self as drawing, DrawOptions, Fill, Hidden, LineStyle};
+use drafter_catalog::draw::{Fill, Hidden, Smooth, Style};
+use drafter_draw::{self as drawing, DrawOptions, LineStyle};
 use drafter_scene::{Model, View};
 
 use crate::cmd::out;
@@ -42,22 +43,22 @@ pub struct Args {
     #[arg(long)]
     pub ortho: bool,
     /// Lines hidden by surfaces: left out, dashed or thin solid, in a group of their own.
-    #[arg(long, value_enum, default_value_t = HiddenArg::None)]
-    pub hidden: HiddenArg,
+    #[arg(long, value_enum, default_value_t = Hidden::None)]
+    pub hidden: Hidden,
     /// Tangent edges (the borders between the input's CAD faces that meet below the crease angle: a
     /// fillet meeting a plane): thin solid lines of their own class `tangent`, thin dashed, or left
     /// out; where one is this view's outline it is drawn as a silhouette whatever this says.
-    #[arg(long, value_enum, default_value_t = SmoothArg::Thin)]
-    pub smooth: SmoothArg,
+    #[arg(long, value_enum, default_value_t = Smooth::Thin)]
+    pub smooth: Smooth,
     /// Line widths and dashes: ISO 128 (one wide visible width, 0.5 mm; hidden lines narrow,
     /// 0.25 mm, dashed 3 mm on and 0.75 mm off), or Gooch et al.'s illustration weights in pixels
     /// (silhouettes 1.6, boundaries 1.2, creases 0.9, hidden 0.6 grey).
-    #[arg(long, value_enum, default_value_t = StyleArg::Iso128)]
-    pub style: StyleArg,
+    #[arg(long, value_enum, default_value_t = Style::Iso128)]
+    pub style: Style,
     /// Part fills under the lines, painted farthest part first: none, each part's area in a flat
     /// grey, or its gradient bands (Lux et al. 2013) as grey regions.
-    #[arg(long, value_enum, default_value_t = FillArg::None)]
-    pub fill: FillArg,
+    #[arg(long, value_enum, default_value_t = Fill::None)]
+    pub fill: Fill,
     /// Pieces shorter than this many pixels are dropped and end points closer than it joined.
     #[arg(long, value_name = "PX", default_value_t = 0.05, allow_negative_numbers = true)]
     pub tolerance: f64,
@@ -81,72 +82,6 @@ impl Args {
     /// options are then checked against an empty name, which only titles and default units read).
     pub fn file(&self) -> &Path {
         self.inputs.first().map_or(Path::new(""), PathBuf::as_path)
-    }
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum HiddenArg {
-    None,
-    Dashed,
-    Solid,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum SmoothArg {
-    None,
-    Thin,
-    Dashed,
-}
-
-impl From<SmoothArg> for drawing::Smooth {
-    fn from(s: SmoothArg) -> drawing::Smooth {
-        match s {
-            SmoothArg::None => drawing::Smooth::None,
-            SmoothArg::Thin => drawing::Smooth::Thin,
-            SmoothArg::Dashed => drawing::Smooth::Dashed,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum StyleArg {
-    Iso128,
-    Gooch,
-}
-
-impl From<StyleArg> for LineStyle {
-    fn from(s: StyleArg) -> LineStyle {
-        match s {
-            StyleArg::Iso128 => LineStyle::Iso128,
-            StyleArg::Gooch => LineStyle::Gooch,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum FillArg {
-    None,
-    Flat,
-    Bands,
-}
-
-impl From<FillArg> for Fill {
-    fn from(f: FillArg) -> Fill {
-        match f {
-            FillArg::None => Fill::None,
-            FillArg::Flat => Fill::Flat,
-            FillArg::Bands => Fill::Bands,
-        }
-    }
-}
-
-impl From<HiddenArg> for Hidden {
-    fn from(h: HiddenArg) -> Hidden {
-        match h {
-            HiddenArg::None => Hidden::None,
-            HiddenArg::Dashed => Hidden::Dashed,
-            HiddenArg::Solid => Hidden::Solid,
-        }
     }
 }
 

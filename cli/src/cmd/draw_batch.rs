@@ -63,56 +63,17 @@ pub fn is_catalog(args: &Args) -> bool {
         || args.inputs.first().is_some_and(|p| p.is_dir())
 }
 
-impl From<crate::cmd::draw::HiddenArg> for draw::Hidden {
-    fn from(h: crate::cmd::draw::HiddenArg) -> Self {
-        match h {
-            crate::cmd::draw::HiddenArg::None => Self::None,
-            crate::cmd::draw::HiddenArg::Dashed => Self::Dashed,
-            crate::cmd::draw::HiddenArg::Solid => Self::Solid,
-        }
-    }
-}
-
-impl From<crate::cmd::draw::SmoothArg> for draw::Smooth {
-    fn from(s: crate::cmd::draw::SmoothArg) -> Self {
-        match s {
-            crate::cmd::draw::SmoothArg::None => Self::None,
-            crate::cmd::draw::SmoothArg::Thin => Self::Thin,
-            crate::cmd::draw::SmoothArg::Dashed => Self::Dashed,
-        }
-    }
-}
-
-impl From<crate::cmd::draw::StyleArg> for draw::Style {
-    fn from(s: crate::cmd::draw::StyleArg) -> Self {
-        match s {
-            crate::cmd::draw::StyleArg::Iso128 => Self::Iso128,
-            crate::cmd::draw::StyleArg::Gooch => Self::Gooch,
-        }
-    }
-}
-
-impl From<crate::cmd::draw::FillArg> for draw::Fill {
-    fn from(f: crate::cmd::draw::FillArg) -> Self {
-        match f {
-            crate::cmd::draw::FillArg::None => Self::None,
-            crate::cmd::draw::FillArg::Flat => Self::Flat,
-            crate::cmd::draw::FillArg::Bands => Self::Bands,
-        }
-    }
-}
-
 /// The drawing's options from the command line as drafter-catalog's plain value.
 pub fn spec(args: &Args) -> DrawSpec {
     DrawSpec {
-        hidden: args.hidden.into(),
-        smooth: args.smooth.into(),
-        style: args.style.into(),
+        hidden: args.hidden,
+        smooth: args.smooth,
+        style: args.style,
         tolerance_px: args.tolerance,
         size: args.size,
         view: args.view,
         orthographic: args.ortho,
-        fill: args.fill.into(),
+        fill: args.fill,
         sheet: args.sheet.spec(),
     }
 }

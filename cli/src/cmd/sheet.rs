@@ -30,8 +30,8 @@ pub struct SheetArgs {
     /// Where the views go around the front view: first angle (ISO method E, the default, as ISO
     /// practice: the top view below, the right view to the left) or third angle (ASME: the top
     /// view above, the right view to the right).
-    #[arg(long, value_enum, default_value_t = ProjectionArg::First)]
-    pub projection: ProjectionArg,
+    #[arg(long, value_enum, default_value_t = drafter_catalog::draw::Projection::First)]
+    pub projection: drafter_catalog::draw::Projection,
     /// The scale of every view, PAPER:REAL (1:2 draws 2 mm of the model as 1 mm); by default the
     /// largest of the ISO 5455 series (..., 5:1, 2:1, 1:1, 1:2, 1:5, 1:10, 1:20, ...) at which the
     /// views fit. A scale at which they do not fit is refused.
@@ -47,7 +47,7 @@ pub struct SheetArgs {
     /// The length of one model unit, for the scale: m, cm, mm or in. Default: m for glTF and GLB
     /// (the glTF specification's unit), mm for OBJ, STL, OFF and PLY (what CAD programs export).
     #[arg(long, value_enum)]
-    pub units: Option<UnitArg>,
+    pub units: Option<drafter_catalog::draw::Units>,
     /// The title block's date (any text, as 2026-12-01); left empty by default so that a sheet's
     /// bytes depend only on its input.
     #[arg(long, value_name = "TEXT")]
@@ -69,40 +69,6 @@ pub struct SheetArgs {
     pub uncut: Option<String>,
 }
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum ProjectionArg {
-    First,
-    Third,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum UnitArg {
-    M,
-    Cm,
-    Mm,
-    In,
-}
-
-impl From<ProjectionArg> for drafter_catalog::draw::Projection {
-    fn from(p: ProjectionArg) -> Self {
-        match p {
-            ProjectionArg::First => Self::First,
-            ProjectionArg::Third => Self::Third,
-        }
-    }
-}
-
-impl From<UnitArg> for drafter_catalog::draw::Units {
-    fn from(u: UnitArg) -> Self {
-        match u {
-            UnitArg::M => Self::M,
-            UnitArg::Cm => Self::Cm,
-            UnitArg::Mm => Self::Mm,
-            UnitArg::In => Self::In,
-        }
-    }
-}
-
 impl SheetArgs {
     /// The sheet's options as drafter-catalog's plain value (what a catalog and Python draw with).
     pub fn spec(&self) -> Option<drafter_catalog::draw::SheetSpec> {
@@ -110,11 +76,11 @@ impl SheetArgs {
         Some(drafter_catalog::draw::SheetSpec {
             size,
             views: vec![self.views.clone()],
-            projection: self.projection.into(),
+            projection: self.projection,
             scale: self.scale.clone(),
             up: self.up.clone(),
             front: self.front.clone(),
-            units: self.units.map(Into::into),
+            units: self.units,
             date: self.date.clone(),
             title: self.title.clone(),
             section: self.section.clone(),

@@ -86,6 +86,7 @@ impl Format {
 
 /// Lines hidden by surfaces (drafter-draw's `Hidden`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Hidden {
     #[default]
@@ -96,6 +97,7 @@ pub enum Hidden {
 
 /// Tangent edges (drafter-draw's `Smooth`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Smooth {
     None,
@@ -106,6 +108,7 @@ pub enum Smooth {
 
 /// Pens (drafter-draw's `LineStyle`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Style {
     #[default]
@@ -115,6 +118,7 @@ pub enum Style {
 
 /// Part fills under one view's lines (drafter-draw's `Fill`; not on a sheet).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Fill {
     #[default]
@@ -125,6 +129,7 @@ pub enum Fill {
 
 /// Where a sheet's views go around the front view.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Projection {
     #[default]
@@ -134,12 +139,52 @@ pub enum Projection {
 
 /// The length of one model unit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Units {
     M,
     Cm,
     Mm,
     In,
+}
+
+impl From<Hidden> for drafter_draw::Hidden {
+    fn from(h: Hidden) -> Self {
+        match h {
+            Hidden::None => Self::None,
+            Hidden::Dashed => Self::Dashed,
+            Hidden::Solid => Self::Solid,
+        }
+    }
+}
+
+impl From<Smooth> for drafter_draw::Smooth {
+    fn from(s: Smooth) -> Self {
+        match s {
+            Smooth::None => Self::None,
+            Smooth::Thin => Self::Thin,
+            Smooth::Dashed => Self::Dashed,
+        }
+    }
+}
+
+impl From<Style> for LineStyle {
+    fn from(s: Style) -> Self {
+        match s {
+            Style::Iso128 => Self::Iso128,
+            Style::Gooch => Self::Gooch,
+        }
+    }
+}
+
+impl From<Fill> for drafter_draw::Fill {
+    fn from(f: Fill) -> Self {
+        match f {
+            Fill::None => Self::None,
+            Fill::Flat => Self::Flat,
+            Fill::Bands => Self::Bands,
+        }
+    }
 }
 
 impl Units {
@@ -273,20 +318,7 @@ impl DrawSpec {
                 self.tolerance_px
             )));
         }
-        let hidden = match self.hidden {
-            Hidden::None => drafter_draw::Hidden::None,
-            Hidden::Dashed => drafter_draw::Hidden::Dashed,
-            Hidden::Solid => drafter_draw::Hidden::Solid,
-        };
-        let smooth = match self.smooth {
-            Smooth::None => drafter_draw::Smooth::None,
-            Smooth::Thin => drafter_draw::Smooth::Thin,
-            Smooth::Dashed => drafter_draw::Smooth::Dashed,
-        };
-        let style = match self.style {
-            Style::Iso128 => LineStyle::Iso128,
-            Style::Gooch => LineStyle::Gooch,
-        };
+        let (hidden, smooth, style) = (self.hidden.into(), self.smooth.into(), LineStyle::from(self.style));
         let mut canonical = self.clone();
         let plan = match &self.sheet {
             None => {
@@ -310,11 +342,7 @@ impl DrawSpec {
                     orthographic: self.orthographic,
                     hidden,
                     tolerance_px: self.tolerance_px,
-                    fill: match self.fill {
-                        Fill::None => drafter_draw::Fill::None,
-                        Fill::Flat => drafter_draw::Fill::Flat,
-                        Fill::Bands => drafter_draw::Fill::Bands,
-                    },
+                    fill: self.fill.into(),
                     smooth,
                     ..DrawOptions::default()
                 })
