@@ -37,8 +37,8 @@ pub struct Args {
     #[arg(long)]
     pub lines: bool,
     /// Drop shadow on the ground plane.
-    #[arg(long, value_enum, default_value_t = ShadowArg::None)]
-    pub shadow: ShadowArg,
+    #[arg(long, value_enum, default_value_t = ShadowMode::None)]
+    pub shadow: ShadowMode,
     /// Orthographic projection instead of perspective.
     #[arg(long)]
     pub ortho: bool,
@@ -67,25 +67,6 @@ pub struct Args {
     pub max_triangles: u64,
 }
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum ShadowArg {
-    None,
-    Hard,
-    Penumbra,
-    Soft,
-}
-
-impl From<ShadowArg> for ShadowMode {
-    fn from(s: ShadowArg) -> ShadowMode {
-        match s {
-            ShadowArg::None => ShadowMode::None,
-            ShadowArg::Hard => ShadowMode::Hard,
-            ShadowArg::Penumbra => ShadowMode::Penumbra,
-            ShadowArg::Soft => ShadowMode::Soft,
-        }
-    }
-}
-
 pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("{s:?}: {e}"));
@@ -110,7 +91,7 @@ impl Args {
             orthographic: self.ortho,
             enhancements: if self.edges { Enhancements::ALL } else { Enhancements::default() },
             lines: self.lines,
-            shadow: self.shadow.into(),
+            shadow: self.shadow,
             cel_steps: self.cel_steps,
             splash_back: self.splash_back,
             selected_part: self.select,

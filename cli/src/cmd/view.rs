@@ -13,8 +13,9 @@ use anyhow::Result;
 use drafter_app::window::WindowError;
 use drafter_render::{Enhancements, RenderOptions, View};
 
-use crate::cmd::render::{ShadowArg, load};
+use crate::cmd::render::load;
 use crate::exit::BadInput;
+use drafter_render::ShadowMode;
 
 /// `drafter view --help`'s text after the options: the window's keys, the editing gestures, saving
 /// and exporting (the README's "Editing the illustration" has the long form).
@@ -64,8 +65,8 @@ pub struct Args {
     #[arg(long)]
     pub lines: bool,
     /// Start with this drop shadow.
-    #[arg(long, value_enum, default_value_t = ShadowArg::None)]
-    pub shadow: ShadowArg,
+    #[arg(long, value_enum, default_value_t = ShadowMode::None)]
+    pub shadow: ShadowMode,
     /// Start with an orthographic camera.
     #[arg(long)]
     pub ortho: bool,
@@ -83,7 +84,7 @@ pub fn run(args: Args) -> Result<()> {
         orthographic: args.ortho,
         enhancements: if args.edges { Enhancements::ALL } else { Enhancements::default() },
         lines: args.lines,
-        shadow: args.shadow.into(),
+        shadow: args.shadow,
         ..RenderOptions::default()
     };
     options.validate().map_err(BadInput)?;

@@ -12,6 +12,7 @@ pub use drafter_scene::style::{
 
 /// The drop shadow under the model (Gooch et al. 1999, §5.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ShadowMode {
     /// No shadow (the default).
     #[default]
