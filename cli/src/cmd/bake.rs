@@ -78,10 +78,10 @@ pub struct Args {
     pub textures_out: Option<PathBuf>,
     /// How the scene is cut into parts (overrides the config file).
     #[arg(long, value_enum)]
-    pub segment: Option<SegmentArg>,
+    pub segment: Option<SegmentMode>,
     /// Oriented-box method (overrides the config file).
     #[arg(long, value_enum)]
-    pub obb: Option<ObbArg>,
+    pub obb: Option<ObbMethod>,
     /// Compress the file with EXT_meshopt_compression (triangles reordered for the codecs, shading
     /// normals as bytes with KHR_mesh_quantization, positions exact; .glb only; readers need the
     /// extensions: three.js with MeshoptDecoder, CesiumJS, drafter). Same as `[output] compress = "meshopt"` in the
@@ -111,23 +111,6 @@ pub struct Args {
     /// List every finding of every mesh instead of one line per kind.
     #[arg(long, short)]
     pub verbose: bool,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum SegmentArg {
-    Auto,
-    Nodes,
-    Components,
-    Regions,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum ObbArg {
-    Aabb,
-    Pca,
-    Hull,
-    Default,
-    Optimal,
 }
 
 /// The largest `--threads` accepted.
@@ -166,21 +149,10 @@ fn config_from_args(args: &Args) -> Result<BakeConfig> {
         config.apply_toml(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
     }
     if let Some(mode) = args.segment {
-        config.segment.mode = match mode {
-            SegmentArg::Auto => SegmentMode::Auto,
-            SegmentArg::Nodes => SegmentMode::Nodes,
-            SegmentArg::Components => SegmentMode::Components,
-            SegmentArg::Regions => SegmentMode::Regions,
-        };
+        config.segment.mode = mode;
     }
     if let Some(method) = args.obb {
-        config.obb.method = match method {
-            ObbArg::Aabb => ObbMethod::Aabb,
-            ObbArg::Pca => ObbMethod::Pca,
-            ObbArg::Hull => ObbMethod::Hull,
-            ObbArg::Default => ObbMethod::Default,
-            ObbArg::Optimal => ObbMethod::Optimal,
-        };
+        config.obb.method = method;
     }
     if args.compress {
         config.compress = drafter_bake::Compression::Meshopt;

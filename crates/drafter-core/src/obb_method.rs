@@ -8,6 +8,7 @@ use crate::ParamError;
 
 /// How to orient a box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum ObbMethod {
     /// World axis-aligned box.

@@ -204,6 +204,7 @@ pub const DEFAULT_MAX_ABSORBED_FRACTION: f64 = 0.01;
 
 /// How the scene is cut into parts. See the crate docs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum SegmentMode {
     /// Each mesh instance is one part.
