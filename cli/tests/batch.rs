@@ -1,4 +1,4 @@
-//! `drafter bake` of folders and manifests (issue 48): every output byte-identical to a single bake,
+//! `drafter bake` of folders and manifests: every output byte-identical to a single bake,
 //! hostile inputs mixed in reported one by one with exit 4, the cache's hits, misses and damaged
 //! entries, and Ctrl-C at random points of a 200-file batch leaving no partial file and a
 //! consistent cache.
@@ -470,7 +470,7 @@ fn utf8(path: &Path) -> &str {
     path.to_str().expect("a UTF-8 path")
 }
 
-/// `[k/n] name: ...` lines on a pipe, and the notes a single bake prints (issue 56).
+/// `[k/n] name: ...` lines on a pipe, and the notes a single bake prints.
 #[test]
 fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
     let dir = common::scratch("batch-pipe");
@@ -501,7 +501,7 @@ fn a_batch_on_a_pipe_prints_a_line_per_file_with_the_bakes_notes() {
 }
 
 /// An output found up to date by its receipt still counts as a use of its cache entry, so
-/// eviction keeps the set in use (issue 56: bake A, bake B, rebake A, evict: A was gone).
+/// eviction keeps the set in use (bake A, bake B, rebake A, evict: A was gone).
 #[test]
 fn eviction_keeps_an_entry_whose_output_was_up_to_date() {
     let dir = common::scratch("batch-evict-lru");
@@ -534,7 +534,7 @@ fn eviction_keeps_an_entry_whose_output_was_up_to_date() {
 }
 
 /// A file over the whole memory budget runs alone, and the summary and the report say so
-/// (issue 56: the summary said "at most 50 MB estimated at once" of a 579 MB file).
+/// (the summary said "at most 50 MB estimated at once" of a 579 MB file).
 #[test]
 fn a_file_over_the_memory_budget_runs_alone_and_the_report_says_so() {
     let dir = common::scratch("batch-over-budget");
@@ -557,7 +557,7 @@ fn a_file_over_the_memory_budget_runs_alone_and_the_report_says_so() {
 }
 
 /// A refusal replayed from a cache names the input of this run, not the path of the machine (or
-/// folder) that first refused it (issue 56).
+/// folder) that first refused it.
 #[test]
 fn a_cached_refusal_names_this_runs_path() {
     let dir = common::scratch("batch-refusal-path");
@@ -580,7 +580,7 @@ fn a_cached_refusal_names_this_runs_path() {
 }
 
 /// The report counts a .gltf with its buffers, and names the build and the configuration that
-/// made the files (issue 56).
+/// made the files.
 #[test]
 fn the_report_counts_a_gltfs_buffers_and_names_the_build_and_config() {
     let dir = common::scratch("batch-report-bytes");
@@ -627,7 +627,7 @@ fn as_unprivileged(cmd: &mut std::process::Command) -> std::process::Command {
 }
 
 /// A read-only output folder is refused before any bake, with one line and exit 3; a subfolder
-/// that cannot be listed fails alone, by its own path, and the others are baked (issue 56).
+/// that cannot be listed fails alone, by its own path, and the others are baked.
 #[test]
 fn a_read_only_output_and_an_unreadable_subfolder_are_named_up_front() {
     use std::os::unix::fs::PermissionsExt;

@@ -1,5 +1,5 @@
-//! A batch writes nothing outside its output folder and its cache, whatever the paths it is given
-//! (issue 56): manifest entries through `..` and `../..`, absolute entries, a folder reached through
+//! A batch writes nothing outside its output folder and its cache, whatever the paths it is given:
+//! manifest entries through `..` and `../..`, absolute entries, a folder reached through
 //! a symbolic link, a symbolic link planted inside the output folder or the cache, an output folder
 //! whose parent is a link, and outputs whose names collide. Each run compares a snapshot of the
 //! whole tree (every file's bytes, every link's target) before and after, the output folder and the

@@ -1,7 +1,7 @@
 //! `drafter inspect --json` over every model of ../shared/models, checked against the counts in its
 //! README (computed independently with trimesh): triangles (instanced for glTF, facets for STL),
 //! and for single-mesh files the welded boundary / non-manifold edge and component counts. The
-//! Draco-compressed samples are read like the rest (issue 61).
+//! Draco-compressed samples are read like the rest.
 
 mod common;
 
@@ -14,7 +14,7 @@ struct Row {
     boundary: Option<u64>,
     nonmanifold: Option<u64>,
     components: Option<u64>,
-    /// Draco-compressed (KHR_draco_mesh_compression): decoded on import (issue 61), so checked as
+    /// Draco-compressed (KHR_draco_mesh_compression): decoded on import, so checked as
     /// any other row; `readme_parser_reads_known_rows` holds the parser to finding them.
     needs_draco: bool,
 }

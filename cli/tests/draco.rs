@@ -1,4 +1,4 @@
-//! `drafter bake` of the Draco-compressed Khronos samples in ../shared/models (issue 61): each bakes
+//! `drafter bake` of the Draco-compressed Khronos samples in ../shared/models: each bakes
 //! to the triangles of its uncompressed sibling (per mesh, every triangle matched with the same
 //! winding and positions within the stream's quantization step), the same part structure (per
 //! node, the parts' triangle counts), no trace of the extension, and a file the Khronos validator

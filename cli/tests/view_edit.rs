@@ -1,4 +1,4 @@
-//! The scripted editing session of issue 15: `drafter view` in a real window on a virtual X display
+//! The scripted editing session: `drafter view` in a real window on a virtual X display
 //! (Xvfb), driven by xdotool as a user would — select two parts (click, shift-click), drag the
 //! anchor with the anchor tool, raise q twice, save, quit — then `drafter inspect` shows the new
 //! values, the file reads back with only those two part records changed, and a headless render of

@@ -255,7 +255,7 @@ fn drafter_web_writes_a_folder_for_a_static_host() {
     assert!(stderr.contains("scripts/web"), "{stderr}");
 }
 
-// The page as a product (issue 60): each test below failed before its fix.
+// The page as a product: each test below failed before its fix.
 
 /// `node web.mjs probe` on the built page: the page's state after the actions in `args`.
 fn probe(file: &Path, args: &[&str]) -> Value {

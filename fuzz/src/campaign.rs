@@ -36,9 +36,9 @@ pub struct Options {
     pub threads: usize,
     /// The targets to run.
     pub targets: Vec<Target>,
-    /// A case running longer is a finding (issue 21: 20 s).
+    /// A case running longer is a finding (20 s).
     pub time_budget: Duration,
-    /// A case raising peak RSS by more is a finding (issue 21: 1 GB for inputs under 1 MB).
+    /// A case raising peak RSS by more is a finding (1 GB for inputs under 1 MB).
     pub memory_budget: u64,
     /// Where findings are saved (`<out>/<target>/<kind>-<hash>.<ext>` plus a `.txt`); `None` keeps
     /// them in memory only.

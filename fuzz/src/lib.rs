@@ -1,4 +1,4 @@
-//! A stable, in-process mutation fuzzer for drafter's hostile-input contract (issue 21): no panic,
+//! A stable, in-process mutation fuzzer for drafter's hostile-input contract: no panic,
 //! no internal error, no runaway time or memory on any input.
 //!
 //! # How it works

@@ -13,7 +13,7 @@
 //!   duplicated (textually: a `Value` cannot hold two); a value buried under 64 to 5,000 arrays; array
 //!   elements removed, duplicated or swapped; a sparse block or a missing `bufferView` on an
 //!   accessor; `componentType`, `type`, `byteStride` and `mode` set to their neighbours;
-//! * glTF structure (issue 47; half of the JSON edits): a member glTF requires removed (an image's
+//! * glTF structure (half of the JSON edits): a member glTF requires removed (an image's
 //!   `uri` or `bufferView`, an accessor's `count`...), an object emptied (`{}` for an image), a
 //!   reference pointed into another array's range, entries of a top-level array dropped,
 //!   duplicated or cut off, a member's type changed (a number as a string, an object as an array).
@@ -551,7 +551,7 @@ pub fn mutate_json_text(text: &[u8], rng: &mut Rng) -> Vec<u8> {
         Some(Step::Key(k)) => Some(k.clone()),
         _ => None,
     };
-    // Half of the edits change the document's shape (issue 47): a member glTF requires removed,
+    // Half of the edits change the document's shape: a member glTF requires removed,
     // an object emptied, a reference pointed into another array, entries dropped or duplicated, a
     // member's type changed. The rest change one value.
     if rng.below(2) == 0 {
@@ -770,7 +770,7 @@ fn accessor_edit(doc: &mut Value, rng: &mut Rng) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// glTF structure (issue 47)
+// glTF structure
 
 /// The members glTF 2.0 requires of an object, by its kind ([`kind_of`]). For an image, one of
 /// `uri` and `bufferView`, and `mimeType` with a view; for a camera, `type` and the member it names.

@@ -65,7 +65,7 @@ pub fn corpus(repo: &Path, max_bytes: usize) -> anyhow::Result<Corpus> {
     }
 
     // Committed seeds of what nothing in the workspace writes: a Draco-compressed glTF
-    // (KHR_draco_mesh_compression, issue 61; fuzz/seeds/draco-cylinder.py says how it was made),
+    // (KHR_draco_mesh_compression; fuzz/seeds/draco-cylinder.py says how it was made),
     // mutated as a GLB and as a .gltf with a data URI.
     let committed = repo.join("fuzz/seeds");
     let mut committed_files: Vec<_> = std::fs::read_dir(&committed)
@@ -318,8 +318,8 @@ const PNG: &[u8] = &[
     0xd2, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
 ];
 
-/// A small glTF with every part of the format the gltf crate models and the samples do not have
-/// (issue 47): images by URI and by buffer view, textures, a sampler, a textured material with a
+/// A small glTF with every part of the format the gltf crate models and the samples do not have:
+/// images by URI and by buffer view, textures, a sampler, a textured material with a
 /// KHR_texture_transform, both camera types, a skin with its joint attributes, an animation, a
 /// sparse accessor and strided data; as .gltf (data URIs) and as .glb.
 fn features(corpus: &mut Corpus) {

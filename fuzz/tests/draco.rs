@@ -1,5 +1,5 @@
 //! The smoke run (`tests/smoke.rs`: seed 0x5eed, 300 cases per target) mutates the Draco seed
-//! (fuzz/seeds/draco-cylinder.glb, issue 61) as a GLB and as a .gltf, so every `cargo test` feeds
+//! (fuzz/seeds/draco-cylinder.glb) as a GLB and as a .gltf, so every `cargo test` feeds
 //! mutated Draco streams to the importer: a seed the campaign never picked would test nothing.
 
 use std::path::Path;

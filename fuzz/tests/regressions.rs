@@ -3,7 +3,7 @@
 //! bakes, or reads and loads), or `rejected` with a typed input error whose message contains the
 //! given words (what the CLI reports as exit 2, one line). A panic or an internal error fails, and so
 //! does a file the list does not name or a name without a file, and one that raises the process's
-//! peak RSS by more than [`PEAK_GROWTH_LIMIT`] (Linux; the blow-ups of issue 21 took gigabytes).
+//! peak RSS by more than [`PEAK_GROWTH_LIMIT`] (Linux; the blow-ups it once found took gigabytes).
 
 use std::collections::BTreeMap;
 use std::path::Path;

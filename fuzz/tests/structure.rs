@@ -8,7 +8,7 @@
 //! budget (`tests/smoke.rs`: seed 0x5eed, 300 cases per target, seeds up to 64 KB), and the importer
 //! to refusing it as input: some case has an image without a source; every such case is refused or
 //! accepted, never a panic; at least one is refused for that image, naming it, and is accepted once
-//! the image is given a source. That last case is one the importer before issue 47 took as far as
+//! the image is given a source. That last case is one an earlier importer took as far as
 //! asking every image's source (the file is otherwise good and no earlier image names a file, which
 //! would have stopped the question), where the gltf crate panics on it (drafter-io's
 //! `what_the_gltf_crate_unwraps_is_refused_by_its_place` shows the panic).

@@ -296,7 +296,7 @@ pub struct PartsReport {
     pub cases: serde_json::Map<String, serde_json::Value>,
     /// Frame time with 1000 parts over the time with 10, per layout and style.
     pub ratios: serde_json::Map<String, serde_json::Value>,
-    /// What an illustrator's edit of all 1000 parts at once costs (issue 15's budget: 1 ms).
+    /// What an illustrator's edit of all 1000 parts at once costs (the editing budget: 1 ms).
     pub edit: EditCost,
 }
 

@@ -1,5 +1,5 @@
 //! `drafter bench draw FILE [--views N] [--tolerances LIST] [--size WxH] [--ortho] [--brute-samples N]
-//! [--json]`: time against accuracy of `drafter draw` (issue 45).
+//! [--json]`: time against accuracy of `drafter draw`.
 //!
 //! For each view (azimuths spread evenly around the model at one elevation) the drawing is made at
 //! every tolerance, hidden lines included, and timed (the fastest of three). Each drawing is compared

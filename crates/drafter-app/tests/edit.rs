@@ -1,4 +1,4 @@
-//! The editing session's ways out, on the baked sample assembly (issue 15): a save rewrites only
+//! The editing session's ways out, on the baked sample assembly: a save rewrites only
 //! the edited part records of the file (the binary chunk and every other JSON byte unchanged) and
 //! reloads to the same parameters; the exported overrides, re-baked from the source model, give
 //! the same part records as the saved file.

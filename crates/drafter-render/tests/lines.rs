@@ -1,4 +1,4 @@
-//! The lines pass draws exactly the silhouettes drafter-lines' brute force selects (issue 6: "the
+//! The lines pass draws exactly the silhouettes drafter-lines' brute force selects ("the
 //! lines pass draws exactly the edges the brute-force test selects for that camera"), and picking
 //! reads the part under a pixel.
 //!

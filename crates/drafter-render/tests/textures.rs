@@ -1,4 +1,4 @@
-//! The G-buffer uses the lookup textures a baked file embeds (issue 6: "uses lines, normals and
+//! The G-buffer uses the lookup textures a baked file embeds ("uses lines, normals and
 //! textures as they land"): the loader decodes exactly the texels drafter-textures generates for the
 //! bake's options, every baked lookup changes the image when its texels change, and a file without
 //! textures falls back to the procedural lookups with a notice.

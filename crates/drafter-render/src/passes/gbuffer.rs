@@ -322,7 +322,7 @@ impl GBufferPass {
         });
         // No pipeline yet: each frame's [`Self::specialise`] compiles the one it draws with. Compiling
         // the every-style pipeline up front cost a browser's first frame a compile it never used
-        // (issue 60: a WebGL2 link on a CPU rasteriser is hundreds of milliseconds).
+        // (a WebGL2 link on a CPU rasteriser is hundreds of milliseconds).
         GBufferPass {
             bind_group_layout,
             module,

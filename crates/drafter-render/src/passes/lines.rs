@@ -1,4 +1,4 @@
-//! Lines pass (issue 6, item 3): the baked hard edges and this frame's silhouettes, drawn as
+//! Lines pass: the baked hard edges and this frame's silhouettes, drawn as
 //! screen-space quads over the display output.
 //!
 //! # How it works
