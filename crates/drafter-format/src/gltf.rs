@@ -34,7 +34,10 @@ use serde_json::Value;
 pub type Members = serde_json::Map<String, Value>;
 
 /// A glTF object type: each named member an `Option` (absent stays absent when written back),
-/// written in camelCase, and every other member in `other`.
+/// written in camelCase, and every other member in `other`. Indices are `u64`, as the importer's
+/// gltf-json takes any unsigned number for one: a document that passed it (and so a baked file that
+/// passes its members through) reads here too, and a reference out of range is the reader's to
+/// refuse where it follows it.
 macro_rules! object {
     ($(#[$meta:meta])* $name:ident { $($(#[$member:meta])* $field:ident: $ty:ty,)* }) => {
         $(#[$meta])*
@@ -65,7 +68,7 @@ object! {
         materials: Vec<Material>,
         meshes: Vec<Mesh>,
         nodes: Vec<Node>,
-        scene: u32,
+        scene: u64,
         scenes: Vec<Scene>,
         textures: Vec<Texture>,
     }
@@ -83,17 +86,17 @@ object! {
     /// An entry of `scenes`.
     Scene {
         name: String,
-        nodes: Vec<u32>,
+        nodes: Vec<u64>,
     }
 }
 
 object! {
     /// An entry of `nodes` (its transform is in `other`).
     Node {
-        children: Vec<u32>,
+        children: Vec<u64>,
         extensions: Members,
         extras: Value,
-        mesh: u32,
+        mesh: u64,
         name: String,
     }
 }
@@ -112,11 +115,11 @@ object! {
     /// An entry of a mesh's `primitives` (its morph `targets` are in `other`).
     Primitive {
         /// Attribute name → accessor index.
-        attributes: BTreeMap<String, u32>,
+        attributes: BTreeMap<String, u64>,
         extensions: Members,
         extras: Value,
-        indices: u32,
-        material: u32,
+        indices: u64,
+        material: u64,
         /// The mode's code ([`Mode::from_code`]); absent means triangles.
         mode: u64,
     }
@@ -125,7 +128,7 @@ object! {
 object! {
     /// An entry of `accessors` (`min`, `max` and `sparse` are in `other`).
     Accessor {
-        buffer_view: u32,
+        buffer_view: u64,
         byte_offset: u64,
         /// The `componentType` code ([`crate::accessor::ComponentType::from_code`]).
         component_type: u64,
@@ -143,7 +146,7 @@ object! {
 object! {
     /// An entry of `bufferViews`.
     BufferView {
-        buffer: u32,
+        buffer: u64,
         byte_length: u64,
         byte_offset: u64,
         byte_stride: u64,
@@ -151,7 +154,7 @@ object! {
         extras: Value,
         name: String,
         /// [`crate::accessor::ARRAY_BUFFER`] or [`crate::accessor::ELEMENT_ARRAY_BUFFER`].
-        target: u32,
+        target: u64,
     }
 }
 
@@ -169,7 +172,7 @@ object! {
 object! {
     /// An entry of `images`.
     Image {
-        buffer_view: u32,
+        buffer_view: u64,
         extensions: Members,
         extras: Value,
         mime_type: String,
@@ -184,8 +187,8 @@ object! {
         extensions: Members,
         extras: Value,
         name: String,
-        sampler: u32,
-        source: u32,
+        sampler: u64,
+        source: u64,
     }
 }
 
@@ -202,8 +205,8 @@ object! {
     /// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads
     /// (accessor indices); `lineStrings` and the rest are in `other`.
     EdgeVisibility {
-        silhouette_normals: u32,
-        visibility: u32,
+        silhouette_normals: u64,
+        visibility: u64,
     }
 }
 
@@ -257,8 +260,8 @@ impl Root {
     }
 
     /// The `count` of accessor `index`; `None` when there is no such accessor or it has no count.
-    pub fn accessor_count(&self, index: u32) -> Option<u64> {
-        self.accessors().get(index as usize)?.count
+    pub fn accessor_count(&self, index: u64) -> Option<u64> {
+        self.accessors().get(usize::try_from(index).ok()?)?.count
     }
 
     /// Triangles the document's primitives list, every mesh once ([`Primitive::triangle_count`]).
@@ -288,7 +291,7 @@ impl Mesh {
 
 impl Primitive {
     /// The accessor of attribute `name` (`"POSITION"`, `"NORMAL"`, `"_ENHANCED_NORMAL"`, …).
-    pub fn attribute(&self, name: &str) -> Option<u32> {
+    pub fn attribute(&self, name: &str) -> Option<u64> {
         self.attributes.as_ref()?.get(name).copied()
     }
 
@@ -300,7 +303,7 @@ impl Primitive {
     /// Triangles the primitive lists by [`triangle_count`], its accessors' counts looked up in
     /// `root` (an accessor that is missing or has no count counts 0).
     pub fn triangle_count(&self, root: &Root) -> u64 {
-        let count = |accessor: u32| root.accessor_count(accessor).unwrap_or(0);
+        let count = |accessor: u64| root.accessor_count(accessor).unwrap_or(0);
         triangle_count(self.mode, self.indices.map(count), self.attribute("POSITION").map(count))
     }
 }
@@ -416,6 +419,14 @@ mod tests {
         assert_eq!((root.accessor_count(0), root.accessor_count(1)), (None, None));
         assert_eq!((root.asset.as_ref(), root.meshes()[0].primitives().len()), (None, 0));
         assert_eq!(Root::from_slice(b"{}").expect("empty").listed_triangles(), 0);
+        // An index past 32 bits (the importer takes it; the writer passes it through) reads, and
+        // counts as a missing accessor.
+        let root = Root::from_slice(
+            br#"{"accessors": [{"bufferView": 4294967296, "count": 3}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 4294967296}}]}]}"#,
+        )
+        .expect("read");
+        assert_eq!((root.accessors()[0].buffer_view, root.listed_triangles()), (Some(1 << 32), 0));
     }
 
     #[test]

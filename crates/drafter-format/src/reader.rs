@@ -118,12 +118,12 @@ pub fn read_textures(
                 .get(texture as usize)
                 .and_then(|t| t.source)
                 .ok_or_else(|| bad("missing, or no source"))?;
-            let image = doc.images().get(source as usize).ok_or_else(|| bad("image missing"))?;
+            let image = doc.images().get(at(source)).ok_or_else(|| bad("image missing"))?;
             if image.mime_type.as_deref() != Some("image/png") {
                 return Err(bad("image is not image/png"));
             }
             let view = image.buffer_view.ok_or_else(|| bad("image has no bufferView"))?;
-            let view = doc.buffer_views().get(view as usize).ok_or_else(|| bad("bufferView missing"))?;
+            let view = doc.buffer_views().get(at(view)).ok_or_else(|| bad("bufferView missing"))?;
             let start = view.byte_offset.unwrap_or(0) as usize;
             let length = view.byte_length.ok_or_else(|| bad("no byteLength"))? as usize;
             let png = buffer
@@ -150,6 +150,11 @@ fn load_buffer(
         },
         None => None,
     })
+}
+
+/// A glTF index as a position in its array (`usize::MAX`, found nowhere, when it does not fit).
+fn at(index: u64) -> usize {
+    usize::try_from(index).unwrap_or(usize::MAX)
 }
 
 /// The bytes of the buffer file `uri`, loaded by `external`.
@@ -209,7 +214,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     values.into_iter().map(|v| u8::try_from(v).map_err(|_| bad(what))).collect()
                 };
                 let silhouette_normals = match edges.silhouette_normals {
-                    Some(a) => read_unit_vec3s(&doc, a as usize, data()?)?,
+                    Some(a) => read_unit_vec3s(&doc, at(a), data()?)?,
                     None => StoredNormals::default(),
                 };
                 let hard_edge_classes = match ours.as_ref().and_then(|e| e.hard_edge_classes) {
@@ -221,7 +226,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     m as u32,
                     p as u32,
                     PrimitiveEdges {
-                        visibility: narrow(scalars(&doc, visibility as usize, data()?)?, "visibility above 8 bits")?,
+                        visibility: narrow(scalars(&doc, at(visibility), data()?)?, "visibility above 8 bits")?,
                         silhouette_normals,
                         hard_edge_classes,
                     },
@@ -360,8 +365,8 @@ pub fn read_normal_sets(
                 );
             }
             let data = buffer.as_deref().unwrap_or_default();
-            let normal = read_vec3s(&doc, normal_accessor as usize, data)?;
-            let other = read_vec3s(&doc, other_accessor as usize, data)?;
+            let normal = read_vec3s(&doc, at(normal_accessor), data)?;
+            let other = read_vec3s(&doc, at(other_accessor), data)?;
             if normal.len() != other.len() {
                 return Err(bad(&format!("NORMAL has {} entries but {name} has {}", normal.len(), other.len())));
             }
@@ -433,7 +438,7 @@ fn accessor_in<'a>(
     }
     let component = a.component_type.and_then(ComponentType::from_code).ok_or_else(|| bad("no valid componentType"))?;
     let normalized = a.normalized.unwrap_or(false);
-    let view_index = a.buffer_view.ok_or_else(|| bad("no bufferView"))? as usize;
+    let view_index = at(a.buffer_view.ok_or_else(|| bad("no bufferView"))?);
     let view = doc.buffer_views().get(view_index).ok_or_else(|| bad("bufferView missing"))?;
     let count = a.count.ok_or_else(|| bad("no count"))?;
     let view_length = view.byte_length.ok_or_else(|| bad("bufferView has no byteLength"))?;

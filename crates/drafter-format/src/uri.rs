@@ -182,12 +182,12 @@ pub fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path
             }
         };
         let length = Some(bytes.len() as u64);
-        let buffer = u32::try_from(buffers.len()).ok();
+        let buffer = Some(buffers.len() as u64);
         buffers.push(bytes);
         root.buffers.get_or_insert_default().push(crate::gltf::Buffer { byte_length: length, ..Default::default() });
         let views = root.buffer_views.get_or_insert_default();
         views.push(crate::gltf::BufferView { buffer, byte_length: length, ..Default::default() });
-        let view = u32::try_from(views.len() - 1).ok();
+        let view = Some(views.len() as u64 - 1);
         if let Some(image) = root.images.as_mut().and_then(|images| images.get_mut(i)) {
             image.uri = None;
             image.buffer_view = view;
