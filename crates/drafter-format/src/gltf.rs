@@ -33,23 +33,82 @@ use serde_json::Value;
 /// An object's members that the types here do not name, or its `extensions`, as JSON.
 pub type Members = serde_json::Map<String, Value>;
 
-/// A glTF object type: each named member an `Option` (absent stays absent when written back),
-/// written in camelCase, and every other member in `other`. Indices are `u64`, as the importer's
-/// gltf-json takes any unsigned number for one: a document that passed it (and so a baked file that
-/// passes its members through) reads here too, and a reference out of range is the reader's to
-/// refuse where it follows it.
+/// A glTF object type: each named member an `Option` (absent stays absent when written back; a
+/// JSON `null` reads as absent), written in camelCase unless given its key (`kind as "type"`), and
+/// every other member in `other`. Indices are `u64`, as the importer's gltf-json takes any unsigned
+/// number for one: a document that passed it (and so a baked file that passes its members through)
+/// reads here too, and a reference out of range is the reader's to refuse where it follows it.
+///
+/// Written out rather than derived with `#[serde(flatten)]`: flatten buffers every member and
+/// deserializes each type through its own copy of that machinery, which made the browser's module
+/// tens of kilobytes larger; here an object is read as a JSON map once and each named member taken
+/// out of it, and written as that map again (sorted, as the writer's documents are).
 macro_rules! object {
-    ($(#[$meta:meta])* $name:ident { $($(#[$member:meta])* $field:ident: $ty:ty,)* }) => {
+    ($(#[$meta:meta])* $name:ident { $($(#[$member:meta])* $field:ident $(as $key:literal)?: $ty:ty,)* }) => {
         $(#[$meta])*
-        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-        #[serde(rename_all = "camelCase")]
+        #[derive(Clone, Debug, Default, PartialEq)]
         pub struct $name {
-            $($(#[$member])* #[serde(default, skip_serializing_if = "Option::is_none")] pub $field: Option<$ty>,)*
+            $($(#[$member])* pub $field: Option<$ty>,)*
             /// The members not named above, as JSON.
-            #[serde(flatten)]
             pub other: Members,
         }
+
+        impl Serialize for $name {
+            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                let mut map = self.other.clone();
+                $(if let Some(value) = &self.$field {
+                    let value = serde_json::to_value(value).map_err(serde::ser::Error::custom)?;
+                    map.insert(member_key!($field $(, $key)?), value);
+                })*
+                map.serialize(serializer)
+            }
+        }
+
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                let mut other = Members::deserialize(deserializer)?;
+                Ok($name {
+                    $($field: take(&mut other, &member_key!($field $(, $key)?)).map_err(serde::de::Error::custom)?,)*
+                    other,
+                })
+            }
+        }
     };
+}
+
+/// A member's key: its own, or the field's name in camelCase.
+macro_rules! member_key {
+    ($field:ident) => {
+        camel_case(stringify!($field))
+    };
+    ($field:ident, $key:literal) => {
+        String::from($key)
+    };
+}
+
+/// `buffer_views` → `bufferViews`.
+fn camel_case(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    let mut upper = false;
+    for c in name.chars() {
+        if c == '_' {
+            upper = true;
+        } else if upper {
+            out.extend(c.to_uppercase());
+            upper = false;
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Member `key` taken out of `members` and read as a `T`; absent or `null` is `None`.
+fn take<T: DeserializeOwned>(members: &mut Members, key: &str) -> Result<Option<T>, String> {
+    match members.remove(key) {
+        None | Some(Value::Null) => Ok(None),
+        Some(value) => serde_json::from_value(value).map(Some).map_err(|e| format!("`{key}`: {e}")),
+    }
 }
 
 object! {
@@ -138,8 +197,7 @@ object! {
         name: String,
         normalized: bool,
         /// `"SCALAR"`, `"VEC3"`, … ([`crate::accessor::components`]).
-        #[serde(rename = "type")]
-        kind: String,
+        kind as "type": String,
     }
 }
 
