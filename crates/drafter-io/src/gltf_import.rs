@@ -294,20 +294,59 @@ fn check_what_the_crate_unwraps(root: &gltf::json::Root) -> Result<(), ParseErro
     Ok(())
 }
 
-/// Images the source names by a file URI, moved into buffers of their own by drafter-format
-/// (`uri::embed_image_files`: a buffer view and a MIME type instead of the URI), so that the baked
-/// file, which is written elsewhere and passes the source's images through, does not point at files
-/// that are not beside it. An image file that cannot be read (the same rules as buffers: inside the
-/// folder) or is neither PNG nor JPEG keeps its URI, with a note. Called only where some image names
-/// a file (the text is parsed again there, so most inputs skip it).
+/// Images the source names by a file URI, moved into buffers of their own (a buffer view and a
+/// MIME type instead of the URI), so that the baked file, which is written elsewhere and passes
+/// the source's images through, does not point at files that are not beside it. An image file
+/// that cannot be read (the same rules as buffers: inside the folder) or is neither PNG nor JPEG
+/// keeps its URI, with a note. Called only where some image names a file (the text is parsed
+/// again here, so most inputs skip it).
 fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, diagnostics: &mut Diagnostics) -> String {
-    let (json, kept) = drafter_format::uri::embed_image_files(json, buffers, folder);
+    let is_file_uri = |image: &serde_json::Value| image["uri"].as_str().is_some_and(|u| !u.starts_with("data:"));
+    let Ok(mut root) = serde_json::from_str::<serde_json::Value>(&json) else { return json };
+    let mut kept = Vec::new();
+    for i in 0..root["images"].as_array().map_or(0, Vec::len) {
+        if !is_file_uri(&root["images"][i]) {
+            continue;
+        }
+        let uri = root["images"][i]["uri"].as_str().unwrap_or_default().to_owned();
+        let mime = match read_buffer_uri(folder, &uri) {
+            Ok(bytes) if bytes.starts_with(b"\x89PNG\r\n\x1a\n") => Ok(("image/png", bytes)),
+            Ok(bytes) if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) => Ok(("image/jpeg", bytes)),
+            Ok(_) => Err("neither PNG nor JPEG".to_owned()),
+            Err(e) => Err(e),
+        };
+        let (mime, bytes) = match mime {
+            Ok(found) => found,
+            Err(why) => {
+                kept.push(format!("/images/{i} ({uri}): {why}"));
+                continue;
+            }
+        };
+        let buffer = buffers.len();
+        let length = bytes.len();
+        buffers.push(bytes);
+        let push = |root: &mut serde_json::Value, key: &str, item: serde_json::Value| -> usize {
+            if !root[key].is_array() {
+                root[key] = serde_json::Value::Array(Vec::new());
+            }
+            let list = root[key].as_array_mut().expect("an array");
+            list.push(item);
+            list.len() - 1
+        };
+        push(&mut root, "buffers", serde_json::json!({"byteLength": length}));
+        let view = push(&mut root, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": length}));
+        if let Some(image) = root["images"][i].as_object_mut() {
+            image.remove("uri");
+            image.insert("bufferView".into(), view.into());
+            image.insert("mimeType".into(), mime.into());
+        }
+    }
     if let Some(first) = kept.first() {
         diagnostics.push(DiagnosticKind::Output, kept.len(), || {
             format!("{first}; the image keeps its URI, which the baked file's folder may not have")
         });
     }
-    json
+    root.to_string()
 }
 
 fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Result<Vec<Vec<u8>>, ParseError> {

@@ -12,14 +12,15 @@ pub mod upscale;
 
 /// The WGSL of a pass: the shared files it names, then its own source. `shared.wgsl` holds what
 /// every pass that draws the scene declares (the `Frame` and `Instance` structs, the tables);
-/// `fullscreen.wgsl` the full-screen triangle of the image passes. So each is written once.
+/// `fullscreen.wgsl` the full-screen triangle of the image passes. So each is written once. The
+/// sources embedded are build.rs's copies without comments (same lines).
 macro_rules! shader_source {
     ($file:literal $(, $shared:literal)*) => {
         wgpu::ShaderModuleDescriptor {
             label: Some($file),
             source: wgpu::ShaderSource::Wgsl(std::borrow::Cow::Borrowed(concat!(
-                $(include_str!($shared), "\n",)*
-                include_str!($file)
+                $(include_str!(concat!(env!("OUT_DIR"), "/", $shared)), "\n",)*
+                include_str!(concat!(env!("OUT_DIR"), "/", $file))
             ))),
         }
     };
