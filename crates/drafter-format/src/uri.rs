@@ -158,78 +158,9 @@ pub fn file_uris(json: &[u8]) -> (Vec<String>, Vec<String>) {
     (files(doc.buffers), files(doc.images))
 }
 
-/// Images that a glTF's JSON names by a file URI, moved into buffers of their own: each image
-/// file that [`read_buffer_uri`] reads from `folder` (the rules of buffers: inside the folder) and
-/// that is a PNG or a JPEG is appended to `buffers`, with a buffer and a buffer view for it, and
-/// the image gets that view and its MIME type instead of the URI. Returns the document (written
-/// with sorted members, everything else as it was) and, for each image that keeps its URI, its
-/// place, URI and why; JSON that is not a glTF document comes back as it is.
-pub fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path) -> (String, Vec<String>) {
-    let Ok(mut root) = crate::gltf::Root::from_slice(json.as_bytes()) else { return (json, Vec::new()) };
-    let mut kept = Vec::new();
-    for i in 0..root.images().len() {
-        let Some(uri) = root.images()[i].uri.clone().filter(|u| !u.starts_with("data:")) else { continue };
-        let (mime, bytes) = match read_buffer_uri(folder, &uri) {
-            Ok(bytes) if bytes.starts_with(b"\x89PNG\r\n\x1a\n") => ("image/png", bytes),
-            Ok(bytes) if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) => ("image/jpeg", bytes),
-            Ok(_) => {
-                kept.push(format!("/images/{i} ({uri}): neither PNG nor JPEG"));
-                continue;
-            }
-            Err(why) => {
-                kept.push(format!("/images/{i} ({uri}): {why}"));
-                continue;
-            }
-        };
-        let length = Some(bytes.len() as u64);
-        let buffer = Some(buffers.len() as u64);
-        buffers.push(bytes);
-        root.buffers.get_or_insert_default().push(crate::gltf::Buffer { byte_length: length, ..Default::default() });
-        let views = root.buffer_views.get_or_insert_default();
-        views.push(crate::gltf::BufferView { buffer, byte_length: length, ..Default::default() });
-        let view = Some(views.len() as u64 - 1);
-        if let Some(image) = root.images.as_mut().and_then(|images| images.get_mut(i)) {
-            image.uri = None;
-            image.buffer_view = view;
-            image.mime_type = Some(mime.to_owned());
-        }
-    }
-    match serde_json::to_value(&root) {
-        Ok(value) => (value.to_string(), kept),
-        Err(_) => (json, kept),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn image_files_move_into_buffers_and_the_rest_keep_their_uri() {
-        let folder = std::env::temp_dir().join(format!("drafter-embed-{}", std::process::id()));
-        std::fs::create_dir_all(&folder).unwrap();
-        std::fs::write(folder.join("a.png"), b"\x89PNG\r\n\x1a\nrest").unwrap();
-        std::fs::write(folder.join("b.txt"), b"text").unwrap();
-        let json = r#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":4,"uri":"m.bin"}],
-            "images":[{"uri":"a.png","name":"a"},{"uri":"data:image/png;base64,AA=="},{"uri":"b.txt"},
-            {"uri":"../c.png"}],"zUnknown":[1.0]}"#;
-        let mut buffers = vec![vec![0; 4]];
-        let (out, kept) = embed_image_files(json.to_owned(), &mut buffers, &folder);
-        std::fs::remove_dir_all(&folder).unwrap();
-        assert_eq!(
-            out,
-            r#"{"asset":{"version":"2.0"},"bufferViews":[{"buffer":1,"byteLength":12}],"#.to_owned()
-                + r#""buffers":[{"byteLength":4,"uri":"m.bin"},{"byteLength":12}],"#
-                + r#""images":[{"bufferView":0,"mimeType":"image/png","name":"a"},"#
-                + r#"{"uri":"data:image/png;base64,AA=="},{"uri":"b.txt"},{"uri":"../c.png"}],"zUnknown":[1.0]}"#
-        );
-        assert_eq!(buffers.len(), 2);
-        assert_eq!(kept.len(), 2);
-        assert!(kept[0].starts_with("/images/2 (b.txt): neither PNG nor JPEG"), "{kept:?}");
-        assert!(kept[1].starts_with("/images/3 (../c.png): "), "{kept:?}");
-        let (same, none) = embed_image_files("not json".to_owned(), &mut buffers, Path::new("."));
-        assert_eq!((same.as_str(), none.len()), ("not json", 0));
-    }
 
     #[test]
     fn uris_stay_inside_the_folder() {
