@@ -176,16 +176,29 @@ fn a_drag_turns_the_view_and_a_key_switches_the_style() {
     assert!(json["ok"] == true, "{json}");
 }
 
+/// The page reports when each step of its first frame ended, in order. How long they take is the
+/// benchmark's business (`tools/browser-test/first-frame.mjs`, docs/web.md), not a test's: a busy
+/// machine makes every step slower.
 #[test]
-fn the_sample_reaches_its_first_frame_within_3_s() {
+fn the_sample_reaches_its_first_frame_and_says_when_each_step_ended() {
     let json = web(
         "shots",
         &sample(),
         &["--out", common::scratch("web-first-frame").to_str().expect("utf-8"), "--styles", "gradient"],
     );
     assert!(json["ok"] == true, "{json}");
-    let first = json["timings"]["firstFrame"].as_f64().expect("timings.firstFrame");
-    assert!(first < 3000.0, "first frame after {first:.0} ms: {json}");
+    let marks = ["wasmReady", "viewerCreated", "modelLoaded", "firstFrame"];
+    let at: Vec<f64> = marks
+        .iter()
+        .map(|m| json["timings"][m].as_f64().unwrap_or_else(|| panic!("timings.{m} missing: {json}")))
+        .collect();
+    assert!(at[0] > 0.0 && at.windows(2).all(|w| w[0] <= w[1]), "marks {marks:?} out of order: {at:?}: {json}");
+    let fetched = json["timings"]["fileFetched"].as_f64().expect("timings.fileFetched");
+    assert!(fetched <= at[2], "the file was read before it was fetched: {json}");
+    for step in ["surface", "renderer"] {
+        assert!(json["startup"][step].as_f64().is_some_and(|v| v >= 0.0), "startup.{step}: {json}");
+    }
+    println!("first frame of the sample at {:.0} ms (not judged here): {}", at[3], json["timings"]);
 }
 
 #[test]
