@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Catalog bakes side by side on one machine (issue 48), every figure from the same run:
+"""Catalog bakes side by side on one machine, every figure from the same run:
 
   - the shared models as a serial loop of single bakes, as `xargs -P2` of single bakes, and as one
     `drafter bake DIR -o OUT` (cold), in interleaved rounds; the batch's peak memory against --memory;

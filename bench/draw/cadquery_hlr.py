@@ -1,4 +1,4 @@
-"""`drafter draw` against OpenCascade's hidden-line removal (CadQuery's SVG export), issue 45.
+"""`drafter draw` against OpenCascade's hidden-line removal (CadQuery's SVG export).
 
 For each CAD model built here with CadQuery (plate, bushing, bracket, gear, six assemblies):
 
@@ -634,7 +634,7 @@ def main():
               f"{pct(r['vis_ref_in_ours'])} / {pct(r['vis_common_ref_in_ours'])} | {pct(r['vis_ours_in_ref'])} | "
               f"{pct(r['hid_ref_in_ours'])} | {pct(r['hid_ours_in_ref'])} | {r['drafter_ms']:.0f} | "
               f"{r['occ_export_ms']:.0f} ({r['occ_hlr_ms']:.0f}) |")
-    # Issue 58's figures: within 1 px, both ways, every view; speed as the median ratio of
+    # The figures the drawing is held to: within 1 px, both ways, every view; speed as the median ratio of
     # OpenCascade's export (in this process) to drafter draw as a process (load, draw, write).
     def worst(key):
         values = [(r[key], r["model"]) for r in rows if r.get(key) is not None]

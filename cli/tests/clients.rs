@@ -279,7 +279,7 @@ impl Sides {
     }
 }
 
-/// Issue 49: silhouettes of one mesh under transformed nodes. The cylinder lies along the mesh's X
+/// Silhouettes of one mesh under transformed nodes. The cylinder lies along the mesh's X
 /// axis and every node stands it up, so that its outlines are upright on screen: rotated (120°
 /// about (1, 1, 1)), instanced twice (stood up, and upside down), mirrored (determinant −1) and
 /// scaled unevenly. `silhouetteNormals` are in the mesh's space, as every glTF vertex attribute;

@@ -303,7 +303,7 @@ fn malformed_json_names_the_line() {
         &write(&dir, "wrongtype.gltf", &common::gltf_triangle(|j| j["accessors"][0]["type"] = "VEC9".into())),
         "/accessors/0",
     );
-    // Issue 47: an image `{}` made the gltf crate panic (gltf-1.4.1 src/image.rs:128), exit 1.
+    // An image `{}` made the gltf crate panic (gltf-1.4.1 src/image.rs:128), exit 1.
     let empty_image = common::gltf_triangle(|j| j["images"] = serde_json::json!([{"uri": "x.png"}, {}]));
     assert_rejected(&write(&dir, "image.gltf", &empty_image), "/images/1: an image needs a uri or a bufferView");
 }

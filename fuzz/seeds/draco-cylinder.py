@@ -7,7 +7,7 @@ script is its Draco form, made with Google's transcoder (Debian's `draco` 1.5.5)
 
 (positions 11 bits, texture coordinates 10, normals 8 (octahedral), colors 8; indices as bytes).
 The fuzzer mutates it (fuzz/src/seeds.rs) and crates/drafter-format/tests/draco.rs checks its
-decoding against this definition (issue 61)."""
+decoding against this definition."""
 import json, math, struct
 
 SEGMENTS = 12

@@ -1,4 +1,4 @@
-//! Issue 47: an `images` entry with neither `uri` nor `bufferView` made the gltf crate panic
+//! An `images` entry with neither `uri` nor `bufferView` made the gltf crate panic
 //! (gltf-1.4.1 `src/image.rs:128`, "called `Option::unwrap()` on a `None` value"), and the smoke
 //! run did not reach it: no glTF or GLB seed had an image (the samples have none; the baked files,
 //! which do, are the `baked` target's, whose readers do not use the gltf crate), and the mutators

@@ -1,6 +1,6 @@
 """Shared fixtures: the repository, ../shared/models (required: a missing corpus fails, never
 skips), the drafter CLI to compare bytes with (DRAFTER_BIN, else target/release or target/debug),
-and the hostile path set of issue 56 with a snapshot of a whole folder tree."""
+and a hostile path set (names with `..`, spaces, links, non-UTF-8 bytes) with a snapshot of a whole folder tree."""
 
 import hashlib
 import os
@@ -83,7 +83,7 @@ def changes_outside(before: dict, after: dict, allowed) -> list:
 
 
 def hostile_tree(root: pathlib.Path) -> list:
-    """The hostile path set of issue 56 under ``root`` (which must have no symbolic link above it),
+    """The hostile path set under ``root`` (which must have no symbolic link above it),
     as cases ``(name, inputs, manifests, out_dir)`` for one batch each, all through the cache
     ``root/cache``. Inputs live in ``root/models``; nothing outside each case's output folder and
     the cache may change:

@@ -111,7 +111,7 @@ def test_bake_many_matches_the_cli_batch(cli, models, tmp_path):
     assert not [p for p in (tmp_path / "py").rglob("*") if p.name.startswith(".")], "no temporary file left"
 
 
-# Issue 56: the rough edges of the package, each against what it did before.
+# The rough edges of the package, each against what it once did.
 
 
 def many_small_files(folder: pathlib.Path, count: int) -> pathlib.Path:

@@ -1,4 +1,4 @@
-"""drafter.draw and drafter.draw_many against the CLI (issue 59): the same bytes, the same errors,
+"""drafter.draw and drafter.draw_many against the CLI: the same bytes, the same errors,
 the cache's hits with the bytes of a drawing, nothing written outside the output folder."""
 
 import os

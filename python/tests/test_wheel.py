@@ -1,4 +1,4 @@
-"""The wheel (issue 56): built by maturin (`maturin build --release`, the symbols stripped:
+"""The wheel: built by maturin (`maturin build --release`, the symbols stripped:
 `strip = true` in pyproject.toml), installed into a fresh virtual environment with no network
 (`pip install --no-index`: the wheel needs nothing else; Ray is an extra), its extension at most
 20 MB, and the installed package bakes the sample to the bytes of the package under test.

@@ -67,7 +67,7 @@ async function settle(page, timeoutMs, loads) {
     .waitForFunction(
       (loads) => {
         const v = document.getElementById('viewer');
-        // (A page without `loads`, as before issue 60, settles on its state alone.)
+        // (A page without `loads`, an older build, settles on its state alone.)
         const newer = loads === undefined || v.loads === undefined || v.loads > loads || v.state === 'error';
         return ['ready', 'error', 'empty'].includes(v?.state) && newer;
       },

@@ -368,7 +368,7 @@ fn panics(f: impl FnOnce()) -> bool {
     panicked
 }
 
-/// Issue 47: what gltf-json's validation lets through but the gltf crate unwraps is refused before
+/// What gltf-json's validation lets through but the gltf crate unwraps is refused before
 /// the crate is asked, with one line naming the file and the JSON pointer (the CLI's exit 2). Each
 /// document passes the crate's own validation, and the crate's accessor panics on it, which is why
 /// the importer must check first.

@@ -66,7 +66,7 @@ pub(crate) fn decode_orientation_metadata(
     num_values: usize,
 ) -> Result<Vec<bool>, Err> {
     let count = reader.read_u32()? as usize;
-    // drafter (issue 61): at most one orientation per value. Unchecked, a hostile u32 made this
+    // drafter's patch: at most one orientation per value. Unchecked, a hostile u32 made this
     // loop run and allocate up to 2^32 times (40 s and 4 GB for a 2 KB stream).
     if count > num_values {
         return Err(Err::MalformedAttribute(
