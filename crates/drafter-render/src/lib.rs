@@ -25,9 +25,8 @@
 //! controls the window and the browser page share (the orbit, the zoom and pan, what a key does)
 //! are pure functions here, in [`controls`], tested without a display.
 //!
-//! Frame times (`drafter bench render`, lavapipe, 1600×1200, ratio to Phong in the same run): every
-//! style 1.00–1.03×; edges 1.4×; soft shadow 1.1×; full illustration (gradient, edges, soft shadow)
-//! 1.5× on the sample assembly and on GearboxAssy (646k triangles).
+//! What each style, the edges and the shadows cost against a Phong frame is the benchmark's to say
+//! (`drafter bench render FILE` prints the ratios; docs/usage.md, docs/bench.md).
 //!
 //! # Use
 //! ```no_run
