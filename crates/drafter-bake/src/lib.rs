@@ -288,10 +288,9 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
 
     let start = begin(Stage::Lines);
     let (primitive_edges, mesh_silhouettes, lines_summary) = if config.lines.enabled {
-        let (edges, silhouettes, summary, line_diagnostics) =
-            compute_lines(&written_scene, &splits, topologies, &parts, &canonical, &vertex_data, &config.lines);
-        diagnostics.extend(line_diagnostics);
-        (edges, silhouettes, Some(summary))
+        let lines = compute_lines(&written_scene, &splits, topologies, &parts, &canonical, &vertex_data, &config.lines);
+        diagnostics.extend(lines.diagnostics);
+        (lines.primitive_edges, lines.mesh_silhouettes, Some(lines.summary))
     } else {
         (vec![Vec::new(); scene.meshes.len()], vec![None; scene.meshes.len()], None)
     };
@@ -537,7 +536,27 @@ fn compute_normals(
     (data, summary, diagnostics)
 }
 
-type LinesResult = (Vec<Vec<Option<PrimitiveEdges>>>, Vec<Option<MeshSilhouettes>>, LinesSummary, Vec<Diagnostic>);
+/// What the lines stage gives the writer, indexed by mesh: the two arrays are the ones
+/// `drafter_format::BakeOutput` takes, an unused or empty mesh holding no edges and no silhouettes.
+struct LinesResult {
+    /// Per mesh, per group (primitive): its edge visibility, hard edge classes and silhouette normals;
+    /// `None` for a primitive with no visible edge.
+    primitive_edges: Vec<Vec<Option<PrimitiveEdges>>>,
+    /// Per mesh: the silhouette candidates and the hierarchies stored over them.
+    mesh_silhouettes: Vec<Option<MeshSilhouettes>>,
+    summary: LinesSummary,
+    diagnostics: Vec<Diagnostic>,
+}
+
+/// The lines of one unique mesh, before they are gathered into a [`LinesResult`].
+#[derive(Clone)]
+struct MeshLines {
+    /// Per group of the mesh, as [`LinesResult::primitive_edges`].
+    edges: Vec<Option<PrimitiveEdges>>,
+    silhouettes: Option<MeshSilhouettes>,
+    counts: drafter_lines::EdgeClassCounts,
+    diagnostics: Vec<Diagnostic>,
+}
 
 /// Edges of every mesh used by an instance: classes (with part borders from the segmentation),
 /// the per-primitive encoding and the silhouette index. `splits` gives, for meshes whose groups were
@@ -585,7 +604,12 @@ fn compute_lines(
                         count: 1,
                         first_example: format!("mesh {m}: lines skipped: {e}"),
                     };
-                    return Some((Vec::new(), None, drafter_lines::EdgeClassCounts::default(), vec![d]));
+                    return Some(MeshLines {
+                        edges: Vec::new(),
+                        silhouettes: None,
+                        counts: drafter_lines::EdgeClassCounts::default(),
+                        diagnostics: vec![d],
+                    });
                 }
             };
             let mut diagnostics = feature.diagnostics();
@@ -636,7 +660,7 @@ fn compute_lines(
             // Nor the topology (53 MB on the dragon), which no later stage reads.
             drop(owned_topology);
             let silhouettes = silhouettes_of(mesh, &edges, vertex_data[m].as_ref(), stage.hierarchies);
-            Some((edges, silhouettes, counts, diagnostics))
+            Some(MeshLines { edges, silhouettes, counts, diagnostics })
         })
         .collect();
     copy_to_repeats(&mut results, canonical);
@@ -646,7 +670,7 @@ fn compute_lines(
     let mut diagnostics = Vec::new();
     for r in results {
         match r {
-            Some((edges, silhouettes, counts, d)) => {
+            Some(MeshLines { edges, silhouettes, counts, diagnostics: d }) => {
                 summary.meshes += 1;
                 let e = &mut summary.edges;
                 e.boundary += counts.boundary;
@@ -674,7 +698,7 @@ fn compute_lines(
             }
         }
     }
-    (all_edges, all_silhouettes, summary, diagnostics)
+    LinesResult { primitive_edges: all_edges, mesh_silhouettes: all_silhouettes, summary, diagnostics }
 }
 
 /// The input face of each triangle of `mesh`: the glTF primitive its group was read from (the
