@@ -1,19 +1,31 @@
-//! The glTF 2.0 document as drafter reads it, typed: [`Root`] and the objects below it, the
-//! primitive modes and the one rule for how many triangles a primitive lists.
+//! The glTF 2.0 document as drafter reads and writes it, typed: [`Root`] and the objects below
+//! it, the primitive modes and the one rule for how many triangles a primitive lists.
 //!
-//! **Typed, and lossless.** Each object types the members drafter reads (indices, counts, URIs,
-//! names, modes: integers and strings, which serialize back to the same text); every other member
-//! (transforms, `min`/`max`, `sparse`, materials' factors, members a later glTF adds) is kept as
-//! JSON in the object's `other`, and `extensions` and `extras` as they are, so a document read here
-//! and written again loses nothing. Members the spec requires are `Option`s all the same, so a
-//! reader names what is missing where it needs it instead of refusing the whole document; a
-//! member of the wrong JSON type is refused when the document is read. Serialize through
-//! `serde_json::Value` (`to_value`, then text) to get the sorted member order the writer's
-//! documents have: serde writes a struct's fields in declaration order.
+//! **Typed, and lossless.** Each object types the members drafter reads or writes (indices,
+//! counts, URIs, names, modes, GL codes: integers and strings, which write back to the same
+//! text; numbers that may be floats, as `min`/`max`, a node's `matrix` and a material's factors,
+//! as JSON, so that a passed-through number keeps its text); every other member (translations,
+//! textures of materials, members a later glTF adds) is kept as JSON in the object's `other`, and
+//! `extensions` and `extras` as they are, so a document read here and written again loses
+//! nothing but the `null`s of named members, which read as absent. Members the spec requires are
+//! `Option`s all the same, so a reader names what is missing where it needs it instead of
+//! refusing the whole document; a member of the wrong JSON type is refused when the document is
+//! read.
+//!
+//! **Written as sorted JSON.** An object becomes a `serde_json::Value` by moving its members into
+//! its `other` map ([`IntoJson`]; `Value::from(root)`), whose keys are sorted, and that is written
+//! as text: the member order every document drafter writes has (serde would write a struct's
+//! fields in declaration order). The `Serialize` impls go the same way.
+//!
+//! **The owner of the document's JSON.** The writer (`doc.rs`, `writer.rs`), the codecs
+//! (`meshopt.rs`, `draco.rs`) and the importer edit these objects, never a `Value` tree; the one
+//! walk of JSON left is inside extensions whose accessor references this layer does not type
+//! ([`Extensible::visit_extension_indices`]: `DRAFTER_illustration`'s records, the edges'
+//! `lineStrings`, `EXT_mesh_gpu_instancing`'s attributes), here.
 //!
 //! **Why not gltf-json's `Root`.** The importer reads its input through the gltf crate, whose
-//! validation it wants; this layer is for the readers of baked files and of inputs before an
-//! import (a batch's memory estimate) and, later, the writer's pass-through. gltf-json drops the
+//! validation it wants; this layer is for the writer's pass-through of that input, the readers
+//! of baked files and of inputs before an import (a batch's memory estimate). gltf-json drops the
 //! members of core objects it does not know (its `Root`, `Node`, `Mesh` have no catch-all: a
 //! document written back loses them), serializes fields in declaration order rather than sorted,
 //! and requires `asset` and every required member up front; here an unknown member survives and a
@@ -29,6 +41,8 @@ use std::collections::BTreeMap;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+
+use crate::accessor::ComponentType;
 
 /// An object's members that the types here do not name, or its `extensions`, as JSON.
 pub type Members = serde_json::Map<String, Value>;
@@ -53,14 +67,26 @@ macro_rules! object {
             pub other: Members,
         }
 
+        impl From<$name> for Value {
+            /// The object as a JSON map: its other members, and each named member that is set.
+            fn from(object: $name) -> Value {
+                let mut map = object.other;
+                $(if let Some(value) = object.$field {
+                    map.insert(member_key!($field $(, $key)?), IntoJson::into_json(value));
+                })*
+                Value::Object(map)
+            }
+        }
+
+        impl IntoJson for $name {
+            fn into_json(self) -> Value {
+                Value::from(self)
+            }
+        }
+
         impl Serialize for $name {
             fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-                let mut map = self.other.clone();
-                $(if let Some(value) = &self.$field {
-                    let value = serde_json::to_value(value).map_err(serde::ser::Error::custom)?;
-                    map.insert(member_key!($field $(, $key)?), value);
-                })*
-                map.serialize(serializer)
+                Value::from(self.clone()).serialize(serializer)
             }
         }
 
@@ -111,11 +137,60 @@ fn take<T: DeserializeOwned>(members: &mut Members, key: &str) -> Result<Option<
     }
 }
 
+/// A typed member's JSON, moved into a `serde_json::Value` without serde's serializer (whose
+/// copy for every member type made the browser's module tens of kilobytes larger): the values
+/// `serde_json::to_value` gives, so a document written through it has the same text.
+pub trait IntoJson {
+    fn into_json(self) -> Value;
+}
+
+impl IntoJson for u64 {
+    fn into_json(self) -> Value {
+        Value::from(self)
+    }
+}
+
+impl IntoJson for bool {
+    fn into_json(self) -> Value {
+        Value::Bool(self)
+    }
+}
+
+impl IntoJson for String {
+    fn into_json(self) -> Value {
+        Value::String(self)
+    }
+}
+
+impl IntoJson for Value {
+    fn into_json(self) -> Value {
+        self
+    }
+}
+
+impl IntoJson for Members {
+    fn into_json(self) -> Value {
+        Value::Object(self)
+    }
+}
+
+impl<T: IntoJson> IntoJson for Vec<T> {
+    fn into_json(self) -> Value {
+        Value::Array(self.into_iter().map(IntoJson::into_json).collect())
+    }
+}
+
+impl<T: IntoJson> IntoJson for BTreeMap<String, T> {
+    fn into_json(self) -> Value {
+        Value::Object(self.into_iter().map(|(k, v)| (k, v.into_json())).collect())
+    }
+}
+
 object! {
-    /// The top-level glTF object (animations, cameras, samplers, skins and members a later glTF
-    /// adds are in `other`).
+    /// The top-level glTF object (cameras and members a later glTF adds are in `other`).
     Root {
         accessors: Vec<Accessor>,
+        animations: Vec<Animation>,
         asset: Asset,
         buffer_views: Vec<BufferView>,
         buffers: Vec<Buffer>,
@@ -127,8 +202,10 @@ object! {
         materials: Vec<Material>,
         meshes: Vec<Mesh>,
         nodes: Vec<Node>,
+        samplers: Vec<Sampler>,
         scene: u64,
         scenes: Vec<Scene>,
+        skins: Vec<Skin>,
         textures: Vec<Texture>,
     }
 }
@@ -150,11 +227,13 @@ object! {
 }
 
 object! {
-    /// An entry of `nodes` (its transform is in `other`).
+    /// An entry of `nodes` (`translation`, `rotation` and `scale` are in `other`).
     Node {
         children: Vec<u64>,
         extensions: Members,
         extras: Value,
+        /// 16 numbers, column-major; JSON, so that a passed-through matrix keeps its text.
+        matrix: Value,
         mesh: u64,
         name: String,
     }
@@ -171,7 +250,7 @@ object! {
 }
 
 object! {
-    /// An entry of a mesh's `primitives` (its morph `targets` are in `other`).
+    /// An entry of a mesh's `primitives`.
     Primitive {
         /// Attribute name → accessor index.
         attributes: BTreeMap<String, u64>,
@@ -181,11 +260,13 @@ object! {
         material: u64,
         /// The mode's code ([`Mode::from_code`]); absent means triangles.
         mode: u64,
+        /// Morph targets: attribute name → accessor index, each.
+        targets: Vec<BTreeMap<String, u64>>,
     }
 }
 
 object! {
-    /// An entry of `accessors` (`min`, `max` and `sparse` are in `other`).
+    /// An entry of `accessors`.
     Accessor {
         buffer_view: u64,
         byte_offset: u64,
@@ -194,10 +275,29 @@ object! {
         count: u64,
         extensions: Members,
         extras: Value,
+        /// One number per component; JSON, so that passed-through bounds keep their text.
+        max: Value,
+        min: Value,
         name: String,
         normalized: bool,
+        sparse: Sparse,
         /// `"SCALAR"`, `"VEC3"`, … ([`crate::accessor::components`]).
         kind as "type": String,
+    }
+}
+
+object! {
+    /// An accessor's `sparse` (its `count` and the component type of its indices are in `other`).
+    Sparse {
+        indices: SparseArray,
+        values: SparseArray,
+    }
+}
+
+object! {
+    /// The `indices` or the `values` of a sparse accessor (their `byteOffset` is in `other`).
+    SparseArray {
+        buffer_view: u64,
     }
 }
 
@@ -251,20 +351,98 @@ object! {
 }
 
 object! {
-    /// An entry of `materials` (its factors and textures are in `other`).
-    Material {
+    /// An entry of `samplers`, its GL filter and wrap codes.
+    Sampler {
         extensions: Members,
         extras: Value,
+        mag_filter: u64,
+        min_filter: u64,
         name: String,
+        wrap_s: u64,
+        wrap_t: u64,
     }
 }
 
 object! {
-    /// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads
-    /// (accessor indices); `lineStrings` and the rest are in `other`.
+    /// An entry of `materials` (its textures and other factors are in `other`).
+    Material {
+        extensions: Members,
+        extras: Value,
+        name: String,
+        pbr_metallic_roughness: PbrMetallicRoughness,
+    }
+}
+
+object! {
+    /// A material's `pbrMetallicRoughness` (its textures are in `other`). The factors are JSON, so
+    /// that passed-through numbers keep their text.
+    PbrMetallicRoughness {
+        base_color_factor: Value,
+        metallic_factor: Value,
+        roughness_factor: Value,
+    }
+}
+
+object! {
+    /// An entry of `skins` (its joints are in `other`).
+    Skin {
+        inverse_bind_matrices: u64,
+    }
+}
+
+object! {
+    /// An entry of `animations` (its channels are in `other`).
+    Animation {
+        samplers: Vec<AnimationSampler>,
+    }
+}
+
+object! {
+    /// An entry of an animation's `samplers`: the accessors of its keyframe times and values.
+    AnimationSampler {
+        input: u64,
+        output: u64,
+    }
+}
+
+object! {
+    /// The members of `EXT_mesh_primitive_edge_visibility` on a primitive that drafter reads and
+    /// writes (accessor indices, the edges' material); `lineStrings` and the rest are in `other`.
     EdgeVisibility {
+        material: u64,
         silhouette_normals: u64,
         visibility: u64,
+    }
+}
+
+object! {
+    /// `EXT_meshopt_compression` on a buffer view: where its encoded stream lies and how it
+    /// decodes (`filter` absent: `NONE`).
+    MeshoptBufferView {
+        buffer: u64,
+        byte_length: u64,
+        byte_offset: u64,
+        byte_stride: u64,
+        count: u64,
+        filter: String,
+        mode: String,
+    }
+}
+
+object! {
+    /// `EXT_meshopt_compression` on a buffer: `fallback` marks the buffer without data that the
+    /// decoded views point into.
+    MeshoptBuffer {
+        fallback: bool,
+    }
+}
+
+object! {
+    /// `KHR_draco_mesh_compression` on a primitive: the buffer view of its stream, and the stream's
+    /// attribute id of each attribute it holds.
+    DracoPrimitive {
+        attributes: BTreeMap<String, u64>,
+        buffer_view: u64,
     }
 }
 
@@ -322,6 +500,46 @@ impl Root {
         self.accessors().get(usize::try_from(index).ok()?)?.count
     }
 
+    /// Calls `f` on every accessor reference of the document: glTF 2.0's (primitives' attributes,
+    /// indices and morph targets, skins, animation samplers), `EXT_mesh_gpu_instancing`'s, and
+    /// those under the keys that `primitive_extensions` and `mesh_extensions` list for each named
+    /// extension of a primitive or a mesh.
+    pub fn visit_accessor_refs(
+        &mut self,
+        primitive_extensions: &[(&str, &[&str])],
+        mesh_extensions: &[(&str, &[&str])],
+        f: &mut dyn FnMut(&mut u64),
+    ) {
+        for mesh in self.meshes.iter_mut().flatten() {
+            for primitive in mesh.primitives.iter_mut().flatten() {
+                primitive.attributes.iter_mut().flat_map(BTreeMap::values_mut).for_each(&mut *f);
+                primitive.indices.iter_mut().for_each(&mut *f);
+                for target in primitive.targets.iter_mut().flatten() {
+                    target.values_mut().for_each(&mut *f);
+                }
+                for (name, keys) in primitive_extensions {
+                    primitive.visit_extension_indices(name, keys, f);
+                }
+            }
+            for (name, keys) in mesh_extensions {
+                mesh.visit_extension_indices(name, keys, f);
+            }
+        }
+        for skin in self.skins.iter_mut().flatten() {
+            skin.inverse_bind_matrices.iter_mut().for_each(&mut *f);
+        }
+        for animation in self.animations.iter_mut().flatten() {
+            for sampler in animation.samplers.iter_mut().flatten() {
+                sampler.input.iter_mut().chain(&mut sampler.output).for_each(&mut *f);
+            }
+        }
+        for node in self.nodes.iter_mut().flatten() {
+            let instancing = node.extensions.as_mut().and_then(|e| e.get_mut("EXT_mesh_gpu_instancing"));
+            let attributes = instancing.and_then(|e| e.get_mut("attributes")).and_then(Value::as_object_mut);
+            attributes.into_iter().flat_map(|a| a.values_mut()).for_each(|a| visit_index(a, f));
+        }
+    }
+
     /// Triangles the document's primitives list, every mesh once ([`Primitive::triangle_count`]).
     pub fn listed_triangles(&self) -> u64 {
         let primitives = self.meshes().iter().flat_map(Mesh::primitives);
@@ -329,10 +547,127 @@ impl Root {
     }
 }
 
+impl Accessor {
+    /// An accessor of `count` elements of `kind` (`"SCALAR"`, `"VEC3"`, …), each of `component`s,
+    /// in buffer view `view`.
+    pub fn new(view: usize, component: ComponentType, count: usize, kind: &str) -> Self {
+        Accessor {
+            buffer_view: Some(view as u64),
+            component_type: Some(u64::from(component.code())),
+            count: Some(count as u64),
+            kind: Some(kind.to_owned()),
+            ..Accessor::default()
+        }
+    }
+
+    /// The component type; `None` when absent or not one of glTF's.
+    pub fn component(&self) -> Option<ComponentType> {
+        ComponentType::from_code(self.component_type?)
+    }
+}
+
 impl Node {
     /// The node's extension `name` decoded as `T`; `None` when it has none.
     pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
         extension(&self.extensions, name)
+    }
+}
+
+/// The objects whose `extensions` the writer edits.
+pub trait Extensible {
+    /// The object's `extensions`.
+    fn extensions_slot(&mut self) -> &mut Option<Members>;
+
+    /// The object's `extensions`, to read.
+    fn extensions_ref(&self) -> Option<&Members>;
+
+    /// Calls `f` on every unsigned integer under one of `keys` anywhere inside extension `name`
+    /// (read only; see [`Extensible::visit_extension_indices`]).
+    fn extension_indices(&self, name: &str, keys: &[&str], f: &mut dyn FnMut(u64)) {
+        if let Some(extension) = self.extensions_ref().and_then(|e| e.get(name)) {
+            read_keys(extension, keys, f);
+        }
+    }
+
+    /// Sets extension `name` to `value` (replacing one of that name), creating `extensions`.
+    fn set_extension(&mut self, name: &str, value: Value) {
+        self.extensions_slot().get_or_insert_default().insert(name.to_owned(), value);
+    }
+
+    /// Removes extension `name`, and `extensions` when none is left; the removed extension.
+    fn remove_extension(&mut self, name: &str) -> Option<Value> {
+        let slot = self.extensions_slot();
+        let removed = slot.as_mut()?.remove(name);
+        if slot.as_ref().is_some_and(Members::is_empty) {
+            *slot = None;
+        }
+        removed
+    }
+
+    /// Calls `f` on every unsigned integer under one of `keys` anywhere inside extension `name`
+    /// (an extension whose accessor references this layer does not type, as `DRAFTER_illustration`'s
+    /// records or `EXT_mesh_primitive_edge_visibility`'s `lineStrings`).
+    fn visit_extension_indices(&mut self, name: &str, keys: &[&str], f: &mut dyn FnMut(&mut u64)) {
+        if let Some(extension) = self.extensions_slot().as_mut().and_then(|e| e.get_mut(name)) {
+            visit_keys(extension, keys, f);
+        }
+    }
+}
+
+macro_rules! extensible {
+    ($($name:ident),*) => {
+        $(impl Extensible for $name {
+            fn extensions_slot(&mut self) -> &mut Option<Members> {
+                &mut self.extensions
+            }
+
+            fn extensions_ref(&self) -> Option<&Members> {
+                self.extensions.as_ref()
+            }
+        })*
+    };
+}
+
+extensible!(Root, Node, Mesh, Primitive, BufferView, Buffer);
+
+/// Calls `f` on every unsigned integer under one of `keys` in the tree `value`.
+fn visit_keys(value: &mut Value, keys: &[&str], f: &mut dyn FnMut(&mut u64)) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map.iter_mut() {
+                if keys.contains(&k.as_str()) && v.is_u64() {
+                    visit_index(v, f);
+                } else {
+                    visit_keys(v, keys, f);
+                }
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(|v| visit_keys(v, keys, f)),
+        _ => {}
+    }
+}
+
+/// Calls `f` on every unsigned integer under one of `keys` in the tree `value`.
+fn read_keys(value: &Value, keys: &[&str], f: &mut dyn FnMut(u64)) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                match v.as_u64() {
+                    Some(index) if keys.contains(&k.as_str()) => f(index),
+                    _ => read_keys(v, keys, f),
+                }
+            }
+        }
+        Value::Array(items) => items.iter().for_each(|v| read_keys(v, keys, f)),
+        _ => {}
+    }
+}
+
+/// Calls `f` on `value` if it is an unsigned integer, and stores what `f` leaves.
+fn visit_index(value: &mut Value, f: &mut dyn FnMut(&mut u64)) {
+    if let Some(mut index) = value.as_u64() {
+        f(&mut index);
+        *value = index.into();
     }
 }
 

@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use crate::FormatError;
 use crate::accessor::{self, ComponentType, Layout, LayoutError};
-use crate::gltf::{EdgeVisibility, Root};
+use crate::gltf::{EdgeVisibility, Extensible, Root};
 
 /// `bytes`, or the plain GLB they decode to when they use `EXT_meshopt_compression` (see
 /// `crate::meshopt`): every reader here takes compressed and plain files alike.
@@ -528,77 +528,71 @@ pub struct ByteSections {
 }
 
 /// [`ByteSections`] of a .glb, or of a .gltf whose buffer `external` returns. The JSON is read as
-/// the JSON tree the writer holds, and counted by the writer's own `sections_of`, so that a bake's
-/// report and `drafter inspect` count alike by construction.
+/// the typed document the writer holds, and counted by the writer's own `sections_of`, so that a
+/// bake's report and `drafter inspect` count alike by construction.
 pub fn byte_sections(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<ByteSections, FormatError> {
     let decoded = plain(bytes)?;
     let bytes = &*decoded;
     let (json, _) = split_container(bytes)?;
-    let doc: Value = serde_json::from_slice(json)?;
-    let external_bytes = match doc.pointer("/buffers/0/uri").and_then(Value::as_str) {
+    let doc = Root::from_slice(json)?;
+    let external_bytes = match doc.buffers().first().and_then(|b| b.uri.as_deref()) {
         Some(uri) => external_buffer(uri, external)?.len() as u64,
         None => 0,
     };
-    let empty = serde_json::Map::new();
-    Ok(sections_of(doc.as_object().unwrap_or(&empty), json.len() as u64, bytes.len() as u64 + external_bytes))
+    Ok(sections_of(&doc).sized(json.len() as u64, bytes.len() as u64 + external_bytes))
 }
 
-/// [`ByteSections`] of the document `doc`, whose JSON takes `json` bytes of a file (or a .glb and
-/// its .bin) of `total` bytes. The writer calls this on the document it has just serialised, so the
-/// bake's report does not parse the file back.
-pub(crate) fn sections_of(doc: &serde_json::Map<String, Value>, json: u64, total: u64) -> ByteSections {
-    let views = doc.get("bufferViews").and_then(Value::as_array).map_or(&[][..], Vec::as_slice);
+/// [`ByteSections`] of the document `doc`, its JSON and its total still 0 ([`ByteSections::sized`]
+/// gives them). The writer calls this on the document it serialises, so the bake's report does not
+/// parse the file back.
+pub(crate) fn sections_of(doc: &Root) -> ByteSections {
+    let views = doc.buffer_views();
     let mut counted = vec![false; views.len()];
     let mut count_view = |view: Option<u64>, into: &mut u64| {
         if let Some(v) = view.map(|v| v as usize).filter(|&v| v < views.len())
             && !std::mem::replace(&mut counted[v], true)
         {
-            *into += views[v].get("byteLength").and_then(Value::as_u64).unwrap_or(0);
+            *into += views[v].byte_length.unwrap_or(0);
         }
     };
-    let view_of = |accessor: &Value| {
-        accessor.as_u64().and_then(|a| doc.get("accessors")?.get(a as usize)?.get("bufferView")?.as_u64())
-    };
-    let mut s = ByteSections { json, total, ..Default::default() };
+    let view_of = |accessor: u64| doc.accessors().get(accessor as usize)?.buffer_view;
+    let mut s = ByteSections::default();
     let enhanced = crate::ext::ENHANCED_NORMAL_ATTRIBUTE;
-    for mesh in doc.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
-        for prim in mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
-            for (name, accessor) in prim.get("attributes").and_then(Value::as_object).into_iter().flatten() {
+    for mesh in doc.meshes() {
+        for prim in mesh.primitives() {
+            for (name, &accessor) in prim.attributes.iter().flatten() {
                 let into = if name == "NORMAL" || name == enhanced { &mut s.normals } else { &mut s.geometry };
                 count_view(view_of(accessor), into);
             }
-            if let Some(indices) = prim.get("indices") {
+            if let Some(indices) = prim.indices {
                 count_view(view_of(indices), &mut s.geometry);
             }
-            if let Some(e) = prim.pointer(&format!("/extensions/{EDGE_VISIBILITY_EXTENSION}")) {
-                for key in ["visibility", "silhouetteNormals"] {
-                    if let Some(a) = e.get(key) {
-                        count_view(view_of(a), &mut s.khronos_edges);
-                    }
-                }
-            }
-            if let Some(e) = prim.pointer(&format!("/extensions/{EXTENSION}")) {
-                for key in ["partLabels", "hardEdgeClasses"] {
-                    if let Some(a) = e.get(key) {
-                        count_view(view_of(a), &mut s.labels);
-                    }
-                }
-            }
+            let edge_keys = ["visibility", "silhouetteNormals"];
+            prim.extension_indices(EDGE_VISIBILITY_EXTENSION, &edge_keys, &mut |a| {
+                count_view(view_of(a), &mut s.khronos_edges)
+            });
+            prim.extension_indices(EXTENSION, &["partLabels", "hardEdgeClasses"], &mut |a| {
+                count_view(view_of(a), &mut s.labels)
+            });
         }
-        if let Some(sil) = mesh.pointer(&format!("/extensions/{EXTENSION}/silhouettes")) {
-            for hierarchy in ["gaussMap", "coneBvh"] {
-                for (key, a) in sil.get(hierarchy).and_then(Value::as_object).into_iter().flatten() {
-                    if !matches!(key.as_str(), "base" | "maxDepth" | "overlap" | "normalLevel" | "leafSize") {
-                        count_view(view_of(a), &mut s.hierarchies);
-                    }
-                }
-            }
-        }
+        let hierarchy_keys = ["nodeCaps", "nodes", "nodeBoxes", "nodeCones", "splits", "splitStarts"];
+        mesh.extension_indices(EXTENSION, &hierarchy_keys, &mut |a| count_view(view_of(a), &mut s.hierarchies));
     }
-    for image in doc.get("images").and_then(Value::as_array).map_or(&[][..], Vec::as_slice) {
-        count_view(image.get("bufferView").and_then(Value::as_u64), &mut s.textures);
+    for image in doc.images() {
+        count_view(image.buffer_view, &mut s.textures);
     }
-    let named = s.geometry + s.normals + s.khronos_edges + s.labels + s.hierarchies + s.textures + s.json;
-    s.other = s.total.saturating_sub(named);
     s
+}
+
+impl ByteSections {
+    /// The sections with the JSON's bytes `json` and the file's (or the .glb's and its .bin's)
+    /// `total`, and what no section names as `other`.
+    pub(crate) fn sized(mut self, json: u64, total: u64) -> Self {
+        let s = &mut self;
+        s.json = json;
+        s.total = total;
+        let named = s.geometry + s.normals + s.khronos_edges + s.labels + s.hierarchies + s.textures + s.json;
+        s.other = s.total.saturating_sub(named);
+        self
+    }
 }

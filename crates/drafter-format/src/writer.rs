@@ -8,7 +8,7 @@
 
 use drafter_core::{Mesh, Scene, TriangleGroup};
 use rayon::prelude::*;
-use serde_json::{Map, Value, json};
+use serde_json::Value;
 
 use crate::FormatError;
 use crate::accessor::{ComponentType, ELEMENT_ARRAY_BUFFER};
@@ -17,6 +17,7 @@ use crate::ext::{
     ConeBvhRecord, EDGE_VISIBILITY_EXTENSION, ENHANCED_NORMAL_ATTRIBUTE, EXTENSION, GaussMapRecord, MeshExtension,
     NodeExtensionRef, PartRecord, PrimitiveExtension, RootExtension, SilhouettesRecord, TexturesRecord,
 };
+use crate::gltf::{self, Extensible};
 
 /// The most vertices a primitive may have for 16-bit indices: glTF forbids the index 65535 (the
 /// primitive-restart value of UNSIGNED_SHORT), so indices run 0..=65534. The bake splits every
@@ -87,13 +88,13 @@ pub struct SamplerDesc {
 
 impl SamplerDesc {
     /// The glTF sampler object.
-    fn to_json(self) -> Value {
-        const NEAREST: u32 = 9728;
-        const LINEAR: u32 = 9729;
-        const NEAREST_MIPMAP_NEAREST: u32 = 9984;
-        const LINEAR_MIPMAP_LINEAR: u32 = 9987;
-        const CLAMP_TO_EDGE: u32 = 33071;
-        const REPEAT: u32 = 10497;
+    fn to_gltf(self) -> gltf::Sampler {
+        const NEAREST: u64 = 9728;
+        const LINEAR: u64 = 9729;
+        const NEAREST_MIPMAP_NEAREST: u64 = 9984;
+        const LINEAR_MIPMAP_LINEAR: u64 = 9987;
+        const CLAMP_TO_EDGE: u64 = 33071;
+        const REPEAT: u64 = 10497;
         let wrap = |repeat: bool| if repeat { REPEAT } else { CLAMP_TO_EDGE };
         let (mag, min) = match (self.linear, self.mipmaps) {
             (true, true) => (LINEAR, LINEAR_MIPMAP_LINEAR),
@@ -101,7 +102,13 @@ impl SamplerDesc {
             (false, true) => (NEAREST, NEAREST_MIPMAP_NEAREST),
             (false, false) => (NEAREST, NEAREST),
         };
-        json!({"magFilter": mag, "minFilter": min, "wrapS": wrap(self.repeat_u), "wrapT": wrap(self.repeat_v)})
+        gltf::Sampler {
+            mag_filter: Some(mag),
+            min_filter: Some(min),
+            wrap_s: Some(wrap(self.repeat_u)),
+            wrap_t: Some(wrap(self.repeat_v)),
+            ..gltf::Sampler::default()
+        }
     }
 }
 
@@ -303,7 +310,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     // (`node_extension` below): as a JSON tree beside the rest they were most of the writer's
     // memory and time on assemblies of many parts (20,000 one-triangle objects: a 435 MB peak,
     // 328 MB this way; docs/bench.md, "Many parts").
-    let mut node_parts: Vec<Option<&[PartRecord]>> = vec![None; doc.array("nodes").len()];
+    let mut node_parts: Vec<Option<&[PartRecord]>> = vec![None; doc.root.nodes().len()];
     for (i, parts) in out.instance_parts.iter().enumerate() {
         let slot = node_parts
             .get_mut(node_of(i))
@@ -387,8 +394,7 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
                 continue;
             }
             let ext = serde_json::to_value(PrimitiveExtension { part_labels, enhanced_normal, hard_edge_classes })?;
-            let prim = primitive_mut(&mut doc, m, primitive)?;
-            extension_slot(prim).insert(EXTENSION.into(), ext);
+            primitive_mut(&mut doc, m, primitive)?.set_extension(EXTENSION, ext);
         }
         if let Some(sil) = &out.mesh_silhouettes[m] {
             write_silhouettes(&mut doc, m, sil, &out.primitive_edges[m])?;
@@ -421,17 +427,20 @@ fn write_edges(
     edges: &PrimitiveEdges,
     edge_material: &mut Option<usize>,
 ) -> Result<Option<u32>, FormatError> {
-    let visibility = doc.push_typed_scalars(ComponentType::U8.code(), &edges.visibility, edges.visibility.len());
-    let material = *edge_material.get_or_insert_with(|| doc.push_material(edge_material_json()));
-    let mut ext = json!({"visibility": visibility, "material": material});
-    if !edges.silhouette_normals.is_empty() {
-        ext["silhouetteNormals"] = doc.push_unit_vec3(&edges.silhouette_normals).into();
-    }
+    let visibility = doc.push_typed_scalars(ComponentType::U8, &edges.visibility, edges.visibility.len());
+    let material = *edge_material.get_or_insert_with(|| doc.push_material(edges_material()));
+    let silhouette_normals =
+        (!edges.silhouette_normals.is_empty()).then(|| doc.push_unit_vec3(&edges.silhouette_normals) as u64);
+    let ext = gltf::EdgeVisibility {
+        material: Some(material as u64),
+        silhouette_normals,
+        visibility: Some(visibility as u64),
+        ..gltf::EdgeVisibility::default()
+    };
     let hard_edge_classes = (!edges.hard_edge_classes.is_empty()).then(|| {
-        doc.push_typed_scalars(ComponentType::U8.code(), &edges.hard_edge_classes, edges.hard_edge_classes.len()) as u32
+        doc.push_typed_scalars(ComponentType::U8, &edges.hard_edge_classes, edges.hard_edge_classes.len()) as u32
     });
-    let prim = primitive_mut(doc, m, primitive)?;
-    extension_slot(prim).insert(EDGE_VISIBILITY_EXTENSION.into(), ext);
+    primitive_mut(doc, m, primitive)?.set_extension(EDGE_VISIBILITY_EXTENSION, Value::from(ext));
     doc.use_extension(EDGE_VISIBILITY_EXTENSION);
     Ok(hard_edge_classes)
 }
@@ -452,9 +461,7 @@ fn write_silhouettes(
     }
     let record = silhouettes_record(doc, sil);
     let ext = serde_json::to_value(MeshExtension { silhouettes: Some(record) })?;
-    let mesh_json =
-        doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
-    extension_slot(mesh_json).insert(EXTENSION.into(), ext);
+    mesh_mut(doc, m)?.set_extension(EXTENSION, ext);
     Ok(())
 }
 
@@ -464,17 +471,9 @@ fn write_root(doc: &mut Doc, out: &BakeOutput) -> Result<(), FormatError> {
     if let Some(textures) = &out.textures {
         root.textures = Some(write_textures(doc, textures)?);
     }
-    let root_ext = serde_json::to_value(&root)?;
-    let root = doc.json.entry("extensions").or_insert_with(|| json!({}));
-    if !root.is_object() {
-        // The source's was `null` or another non-object (which glTF does not allow, and serde
-        // takes as "none"): left as it was, the file had no root record and did not read back
-        // (drafter-fuzz, issue 47's campaign).
-        *root = json!({});
-    }
-    if let Value::Object(map) = root {
-        map.insert(EXTENSION.into(), root_ext);
-    }
+    // A source whose `extensions` was `null` reads as one without (the typed document takes a
+    // null as absent), so the root record always has an object to go into.
+    doc.root.set_extension(EXTENSION, serde_json::to_value(&root)?);
     doc.use_extension(EXTENSION);
     Ok(())
 }
@@ -496,26 +495,32 @@ fn write_textures(doc: &mut Doc, textures: &EmbeddedTextures) -> Result<Textures
             referenced[i]
         )));
     }
-    let image_base = doc.array("images").len();
-    let texture_base = doc.array("textures").len();
-    let sampler_base = doc.array("samplers").len();
+    let image_base = doc.root.images().len();
+    let texture_base = doc.root.textures().len();
+    let sampler_base = doc.root.samplers.as_ref().map_or(0, Vec::len);
     let mut samplers: Vec<SamplerDesc> = Vec::new();
     for (i, image) in textures.images.iter().enumerate() {
         let view = doc.push_view(&image.png, None, None);
-        doc.array_mut("images").push(json!({"bufferView": view, "mimeType": "image/png", "name": image.name}));
+        doc.root.images.get_or_insert_default().push(gltf::Image {
+            buffer_view: Some(view as u64),
+            mime_type: Some("image/png".into()),
+            name: Some(image.name.clone()),
+            ..gltf::Image::default()
+        });
         let sampler = match samplers.iter().position(|s| *s == image.sampler) {
             Some(s) => s,
             None => {
                 samplers.push(image.sampler);
-                doc.array_mut("samplers").push(image.sampler.to_json());
+                doc.root.samplers.get_or_insert_default().push(image.sampler.to_gltf());
                 samplers.len() - 1
             }
         };
-        doc.array_mut("textures").push(json!({
-            "sampler": sampler_base + sampler,
-            "source": image_base + i,
-            "name": image.name
-        }));
+        doc.root.textures.get_or_insert_default().push(gltf::Texture {
+            sampler: Some((sampler_base + sampler) as u64),
+            source: Some((image_base + i) as u64),
+            name: Some(image.name.clone()),
+            ..gltf::Texture::default()
+        });
     }
     for index in record.indices_mut() {
         *index += texture_base as u32;
@@ -598,31 +603,30 @@ fn write_vertex_data(
     relaid: &Relaid,
     from_source: bool,
 ) -> Result<(), String> {
-    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?.clone();
-    if prim.get("targets").is_some() {
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
+    if prim.targets.is_some() {
         return Err("the primitive has morph targets".into());
     }
-    let mut attributes = Map::new();
+    let source = prim.attributes.clone().unwrap_or_default();
+    let mut attributes = Attributes::new();
     if from_source {
-        let source = prim.get("attributes").and_then(Value::as_object).cloned().unwrap_or_default();
-        for (name, accessor) in &source {
+        for (name, &accessor) in &source {
             if matches!(name.as_str(), "POSITION" | "NORMAL") || name == ENHANCED_NORMAL_ATTRIBUTE {
                 continue;
             }
-            let accessor = accessor.as_u64().ok_or("attribute is not an accessor index")? as usize;
-            let gathered = doc.gather_attribute(accessor, &relaid.source_local).map_err(|e| e.to_string())?;
-            attributes.insert(name.clone(), gathered.into());
+            let gathered = doc.gather_attribute(accessor as usize, &relaid.source_local).map_err(|e| e.to_string())?;
+            attributes.insert(name.clone(), gathered as u64);
         }
     } else if let Some(uv) = &relaid.uvs {
-        attributes.insert("TEXCOORD_0".into(), doc.push_vec2(uv).into());
+        attributes.insert("TEXCOORD_0".into(), doc.push_vec2(uv) as u64);
     }
-    attributes.insert("POSITION".into(), doc.push_vec3(&relaid.positions, true).into());
+    attributes.insert("POSITION".into(), doc.push_vec3(&relaid.positions, true) as u64);
     let normal = match &relaid.normals {
         RelaidNormals::Quantized(bytes) => doc.push_snorm8_attribute(bytes),
         RelaidNormals::Float(normals) => doc.push_vec3(normals, false),
     };
-    attributes.insert("NORMAL".into(), normal.into());
-    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_attribute(&relaid.enhanced).into());
+    attributes.insert("NORMAL".into(), normal as u64);
+    attributes.insert(ENHANCED_NORMAL_ATTRIBUTE.into(), doc.push_snorm8_attribute(&relaid.enhanced) as u64);
     set_triangle_list(doc, m, primitive, attributes, &relaid.triangles).map_err(|e| e.to_string())
 }
 
@@ -632,16 +636,14 @@ fn set_triangle_list(
     doc: &mut Doc,
     m: usize,
     primitive: usize,
-    attributes: Map<String, Value>,
+    attributes: Attributes,
     triangles: &[u32],
 ) -> Result<(), FormatError> {
     let indices = doc.push_scalars(triangles, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive)?;
-    prim["attributes"] = Value::Object(attributes);
-    prim["indices"] = indices.into();
-    if let Value::Object(map) = prim {
-        map.remove("mode");
-    }
+    prim.attributes = Some(attributes);
+    prim.indices = Some(indices as u64);
+    prim.mode = None;
     Ok(())
 }
 
@@ -665,23 +667,23 @@ fn write_mesh_vertices(
             .ok_or_else(|| FormatError::Inconsistent(format!("mesh {m}: a triangle outside its group's vertices")))?
     };
     let positions: Vec<[f32; 3]> = vertices.iter().map(|&v| mesh.positions[v as usize].to_array()).collect();
-    let mut attributes = json!({"POSITION": doc.push_vec3(&positions, true)});
+    let mut attributes = Attributes::from([("POSITION".to_owned(), doc.push_vec3(&positions, true) as u64)]);
     if let Some(normals) = &mesh.normals {
         // The spec requires unit normals; skip the attribute if any cannot be normalised.
         let unit: Option<Vec<[f32; 3]>> =
             vertices.iter().map(|&v| normals[v as usize].try_normalize().map(|n| n.to_array())).collect();
         if let Some(unit) = unit {
-            attributes["NORMAL"] = doc.push_vec3(&unit, false).into();
+            attributes.insert("NORMAL".into(), doc.push_vec3(&unit, false) as u64);
         }
     }
     if let Some(uvs) = &mesh.uvs {
         let uv: Vec<[f32; 2]> = vertices.iter().map(|&v| uvs[v as usize].to_array()).collect();
-        attributes["TEXCOORD_0"] = doc.push_vec2(&uv).into();
+        attributes.insert("TEXCOORD_0".into(), doc.push_vec2(&uv) as u64);
     }
     let indices = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive)?;
-    prim["attributes"] = attributes;
-    prim["indices"] = indices.into();
+    prim.attributes = Some(attributes);
+    prim.indices = Some(indices as u64);
     Ok(())
 }
 
@@ -720,22 +722,21 @@ fn gather_source_vertices(
     let range = group.start as usize..(group.start + group.count) as usize;
     let (picks, local) = first_use(&mesh.triangles[range], group.first_vertex, group.vertex_count)
         .ok_or("a triangle outside the primitive's vertices")?;
-    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?.clone();
-    if prim.get("targets").is_some() {
+    let prim = primitive_mut(doc, m, primitive).map_err(|e| e.to_string())?;
+    if prim.targets.is_some() {
         return Err("the primitive has morph targets".into());
     }
-    let source = prim.get("attributes").and_then(Value::as_object).cloned().unwrap_or_default();
-    let mut attributes = Map::new();
-    for (name, accessor) in &source {
+    let source = prim.attributes.clone().unwrap_or_default();
+    let mut attributes = Attributes::new();
+    for (name, &accessor) in &source {
         if name == "POSITION" {
             let positions: Vec<[f32; 3]> =
                 picks.iter().map(|&l| mesh.positions[(group.first_vertex + l) as usize].to_array()).collect();
-            attributes.insert(name.clone(), doc.push_vec3(&positions, true).into());
+            attributes.insert(name.clone(), doc.push_vec3(&positions, true) as u64);
             continue;
         }
-        let accessor = accessor.as_u64().ok_or("attribute is not an accessor index")? as usize;
-        let gathered = doc.gather_attribute(accessor, &picks).map_err(|e| e.to_string())?;
-        attributes.insert(name.clone(), gathered.into());
+        let gathered = doc.gather_attribute(accessor as usize, &picks).map_err(|e| e.to_string())?;
+        attributes.insert(name.clone(), gathered as u64);
     }
     set_triangle_list(doc, m, primitive, attributes, &local).map_err(|e| e.to_string())
 }
@@ -763,9 +764,8 @@ fn arrange_primitives(doc: &mut Doc, mesh: &Mesh, m: usize, from_source: bool) -
     if sources.windows(2).any(|w| w[0] > w[1]) {
         return Err(FormatError::Inconsistent(format!("mesh {m}: split groups are not in primitive order")));
     }
-    let mesh_json =
-        doc.array_mut("meshes").get_mut(m).ok_or_else(|| FormatError::Inconsistent(format!("no mesh {m}")))?;
-    let old = mesh_json.get("primitives").and_then(Value::as_array).cloned().unwrap_or_default();
+    let mesh_json = mesh_mut(doc, m)?;
+    let old = mesh_json.primitives.take().unwrap_or_default();
     let mut primitives = Vec::with_capacity(old.len() + sources.len());
     let mut primitive_of = Vec::with_capacity(sources.len());
     let mut g = 0;
@@ -783,7 +783,7 @@ fn arrange_primitives(doc: &mut Doc, mesh: &Mesh, m: usize, from_source: bool) -
     if g != sources.len() {
         return Err(FormatError::Inconsistent(format!("mesh {m} has no primitive {}", sources[g])));
     }
-    mesh_json["primitives"] = Value::Array(primitives);
+    mesh_json.primitives = Some(primitives);
     Ok(primitive_of)
 }
 
@@ -792,11 +792,23 @@ fn arrange_primitives(doc: &mut Doc, mesh: &Mesh, m: usize, from_source: bool) -
 /// their faces. Appended once after the input's materials, whose indices do not change.
 pub const EDGE_MATERIAL_NAME: &str = "drafter edges";
 
-fn edge_material_json() -> Value {
-    json!({
-        "name": EDGE_MATERIAL_NAME,
-        "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
-    })
+fn edges_material() -> gltf::Material {
+    material(EDGE_MATERIAL_NAME, [0.0, 0.0, 0.0, 1.0], 0.0, 1.0)
+}
+
+/// A material of this name and metallic-roughness factors (numbers written as `f32`s are, as the
+/// `f64` they widen to).
+fn material(name: &str, base_color: [f32; 4], metallic: f32, roughness: f32) -> gltf::Material {
+    gltf::Material {
+        name: Some(name.to_owned()),
+        pbr_metallic_roughness: Some(gltf::PbrMetallicRoughness {
+            base_color_factor: Some(Value::from(base_color.to_vec())),
+            metallic_factor: Some(Value::from(metallic)),
+            roughness_factor: Some(Value::from(roughness)),
+            ..gltf::PbrMetallicRoughness::default()
+        }),
+        ..gltf::Material::default()
+    }
 }
 
 /// The mesh's hierarchies: integer arrays in the smallest unsigned type that holds them, float
@@ -816,7 +828,7 @@ fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord
         node_cones: doc.push_f32_scalars(&b.node_cones) as u32,
         nodes: doc.push_scalars(&b.nodes, None) as u32,
         splits: (!b.splits.is_empty())
-            .then(|| doc.push_typed_scalars(ComponentType::U8.code(), &b.splits, b.splits.len()) as u32),
+            .then(|| doc.push_typed_scalars(ComponentType::U8, &b.splits, b.splits.len()) as u32),
         split_starts: doc.push_scalars(&b.split_starts, None) as u32,
     });
     SilhouettesRecord {
@@ -828,21 +840,23 @@ fn silhouettes_record(doc: &mut Doc, sil: &MeshSilhouettes) -> SilhouettesRecord
     }
 }
 
-fn extension_slot(object: &mut Value) -> &mut Map<String, Value> {
-    let extensions = &mut object["extensions"];
-    if !extensions.is_object() {
-        *extensions = json!({});
-    }
-    match extensions {
-        Value::Object(map) => map,
-        _ => unreachable!("made an object above"),
-    }
+/// A primitive's attributes: name → accessor index.
+type Attributes = std::collections::BTreeMap<String, u64>;
+
+fn mesh_mut(doc: &mut Doc, mesh: usize) -> Result<&mut gltf::Mesh, FormatError> {
+    doc.root
+        .meshes
+        .as_mut()
+        .and_then(|m| m.get_mut(mesh))
+        .ok_or_else(|| FormatError::Inconsistent(format!("no mesh {mesh}")))
 }
 
-fn primitive_mut(doc: &mut Doc, mesh: usize, primitive: usize) -> Result<&mut Value, FormatError> {
-    doc.array_mut("meshes")
-        .get_mut(mesh)
-        .and_then(|m| m.get_mut("primitives"))
+fn primitive_mut(doc: &mut Doc, mesh: usize, primitive: usize) -> Result<&mut gltf::Primitive, FormatError> {
+    doc.root
+        .meshes
+        .as_mut()
+        .and_then(|m| m.get_mut(mesh))
+        .and_then(|m| m.primitives.as_mut())
         .and_then(|p| p.get_mut(primitive))
         .ok_or_else(|| FormatError::Inconsistent(format!("mesh {mesh} has no primitive {primitive}")))
 }
@@ -857,19 +871,13 @@ fn rewrite_if_faces_dropped(
     primitive: usize,
     group: &TriangleGroup,
 ) -> Result<(), FormatError> {
-    let prim = primitive_mut(doc, m, primitive)?.clone();
-    let accessors = doc.array("accessors");
-    let count_of = |key: Option<&Value>| {
-        key.and_then(Value::as_u64)
-            .and_then(|a| accessors.get(a as usize))
-            .and_then(|a| a["count"].as_u64())
-            .unwrap_or(0)
-    };
-    let elements = match prim.get("indices") {
+    let prim = primitive_mut(doc, m, primitive)?;
+    let (indices, positions, mode) = (prim.indices, prim.attribute("POSITION"), prim.mode.unwrap_or(4));
+    let count_of = |accessor: Option<u64>| accessor.and_then(|a| doc.root.accessor_count(a)).unwrap_or(0);
+    let elements = match indices {
         Some(i) => count_of(Some(i)),
-        None => count_of(prim.get("attributes").and_then(|a| a.get("POSITION"))),
+        None => count_of(positions),
     };
-    let mode = prim.get("mode").and_then(Value::as_u64).unwrap_or(4);
     let source_triangles = if mode == 4 { elements / 3 } else { elements.saturating_sub(2) };
     if source_triangles == u64::from(group.count) {
         return Ok(());
@@ -878,10 +886,8 @@ fn rewrite_if_faces_dropped(
     let local: Vec<u32> = mesh.triangles[range].iter().flatten().map(|&v| v - group.first_vertex).collect();
     let accessor = doc.push_scalars(&local, Some(ELEMENT_ARRAY_BUFFER));
     let prim = primitive_mut(doc, m, primitive)?;
-    prim["indices"] = accessor.into();
-    if let Value::Object(map) = prim {
-        map.remove("mode");
-    }
+    prim.indices = Some(accessor as u64);
+    prim.mode = None;
     Ok(())
 }
 
@@ -893,13 +899,13 @@ fn rewrite_if_faces_dropped(
 /// and from the scenes' `nodes`, so the written file describes the scene that was baked. A graph
 /// that is already a forest is left untouched.
 fn keep_node_tree(doc: &mut Doc) {
-    let node_count = doc.array("nodes").len();
-    let indices = |v: &Value| -> Vec<Option<usize>> {
-        v.as_array().map_or(Vec::new(), |a| a.iter().map(|i| i.as_u64().map(|i| i as usize)).collect())
+    let node_count = doc.root.nodes().len();
+    let indices = |list: &Option<Vec<u64>>| -> Vec<Option<usize>> {
+        list.iter().flatten().map(|&i| usize::try_from(i).ok()).collect()
     };
-    let children: Vec<Vec<Option<usize>>> = doc.array("nodes").iter().map(|n| indices(&n["children"])).collect();
-    let scenes: Vec<Vec<Option<usize>>> = doc.array("scenes").iter().map(|s| indices(&s["nodes"])).collect();
-    let default = doc.json.get("scene").and_then(Value::as_u64).map_or(0, |s| s as usize);
+    let children: Vec<Vec<Option<usize>>> = doc.root.nodes().iter().map(|n| indices(&n.children)).collect();
+    let scenes: Vec<Vec<Option<usize>>> = doc.root.scenes.iter().flatten().map(|s| indices(&s.nodes)).collect();
+    let default = doc.root.scene.map_or(0, |s| s as usize);
     let scene_order = std::iter::once(default).chain((0..scenes.len()).filter(|&s| s != default));
     // Which entries of each `children` and scene `nodes` list lead to a node's first visit.
     let mut keep_child: Vec<Vec<bool>> = children.iter().map(|c| vec![false; c.len()]).collect();
@@ -936,23 +942,18 @@ fn keep_node_tree(doc: &mut Doc) {
     }
     // The list at `key` of `object` without its dropped entries; the key goes where none is left
     // (glTF forbids empty lists). Untouched where every entry is kept.
-    let keep_listed = |object: &mut Value, key: &str, list: &[Option<usize>], keep: &[bool]| {
+    let keep_listed = |list: &mut Option<Vec<u64>>, keep: &[bool]| {
         if keep.iter().all(|&k| k) {
             return;
         }
-        let Value::Object(map) = object else { return };
-        let kept: Vec<Value> = list.iter().zip(keep).filter(|&(_, &k)| k).map(|(&i, _)| json!(i)).collect();
-        if kept.is_empty() {
-            map.remove(key);
-        } else {
-            map.insert(key.into(), Value::Array(kept));
-        }
+        let kept: Vec<u64> = list.iter().flatten().zip(keep).filter(|&(_, &k)| k).map(|(&i, _)| i).collect();
+        *list = (!kept.is_empty()).then_some(kept);
     };
-    for (n, node) in doc.array_mut("nodes").iter_mut().enumerate() {
-        keep_listed(node, "children", &children[n], &keep_child[n]);
+    for (n, node) in doc.root.nodes.iter_mut().flatten().enumerate() {
+        keep_listed(&mut node.children, &keep_child[n]);
     }
-    for (s, scene) in doc.array_mut("scenes").iter_mut().enumerate() {
-        keep_listed(scene, "nodes", &scenes[s], &keep_root[s]);
+    for (s, scene) in doc.root.scenes.iter_mut().flatten().enumerate() {
+        keep_listed(&mut scene.nodes, &keep_root[s]);
     }
 }
 
@@ -965,23 +966,14 @@ fn keep_node_tree(doc: &mut Doc) {
 /// kept the earlier part records, whatever they had become. Either file did not read back. The
 /// accessors they named are then unreferenced, and the compaction drops them.
 fn drop_earlier_records(doc: &mut Doc) {
-    fn remove_extension(object: &mut Value, name: &str) {
-        let Value::Object(object) = object else { return };
-        let Some(Value::Object(extensions)) = object.get_mut("extensions") else { return };
-        extensions.remove(name);
-        if extensions.is_empty() {
-            object.remove("extensions");
-        }
+    for node in doc.root.nodes.iter_mut().flatten() {
+        node.remove_extension(EXTENSION);
     }
-    for node in doc.existing_mut("nodes") {
-        remove_extension(node, EXTENSION);
-    }
-    for mesh in doc.existing_mut("meshes") {
-        remove_extension(mesh, EXTENSION);
-        let Some(primitives) = mesh.get_mut("primitives").and_then(Value::as_array_mut) else { continue };
-        for primitive in primitives {
-            remove_extension(primitive, EXTENSION);
-            remove_extension(primitive, EDGE_VISIBILITY_EXTENSION);
+    for mesh in doc.root.meshes.iter_mut().flatten() {
+        mesh.remove_extension(EXTENSION);
+        for primitive in mesh.primitives.iter_mut().flatten() {
+            primitive.remove_extension(EXTENSION);
+            primitive.remove_extension(EDGE_VISIBILITY_EXTENSION);
         }
     }
 }
@@ -995,7 +987,7 @@ fn drop_earlier_records(doc: &mut Doc) {
 fn drop_emptied(doc: &mut Doc, emptied: &[Vec<usize>], notes: &mut Vec<String>) {
     let mut removed_meshes = Vec::new();
     for (m, primitives) in emptied.iter().enumerate().filter(|(_, p)| !p.is_empty()) {
-        let Some(list) = doc.array_mut("meshes").get_mut(m).and_then(|mesh| mesh["primitives"].as_array_mut()) else {
+        let Some(list) = doc.root.meshes.as_mut().and_then(|meshes| meshes.get_mut(m)?.primitives.as_mut()) else {
             continue;
         };
         let mut drop: Vec<usize> = primitives.iter().copied().filter(|&p| p < list.len()).collect();
@@ -1012,22 +1004,19 @@ fn drop_emptied(doc: &mut Doc, emptied: &[Vec<usize>], notes: &mut Vec<String>) 
     if removed_meshes.is_empty() {
         return;
     }
-    for node in doc.existing_mut("nodes") {
-        let Some(mesh) = node.get("mesh").and_then(Value::as_u64).map(|m| m as usize) else { continue };
-        if removed_meshes.binary_search(&mesh).is_ok() {
-            if let Value::Object(map) = node {
-                map.remove("mesh");
-            }
-        } else {
-            node["mesh"] = (mesh - removed_meshes.partition_point(|&r| r < mesh)).into();
-        }
+    for node in doc.root.nodes.iter_mut().flatten() {
+        let Some(mesh) = node.mesh.map(|m| m as usize) else { continue };
+        node.mesh = match removed_meshes.binary_search(&mesh) {
+            Ok(_) => None,
+            Err(removed_before) => Some((mesh - removed_before) as u64),
+        };
     }
-    let meshes = doc.array_mut("meshes");
+    let meshes = doc.root.meshes.get_or_insert_default();
     for &m in removed_meshes.iter().rev() {
         meshes.remove(m);
     }
     if meshes.is_empty() {
-        doc.json.remove("meshes");
+        doc.root.meshes = None;
     }
     notes.push(format!("{} mesh(es) without a finite face left out", removed_meshes.len()));
 }
@@ -1053,62 +1042,50 @@ pub const DEFAULT_MATERIAL_NAME: &str = "drafter default";
 /// some primitive names none), one mesh per scene mesh (one primitive per triangle group), one node
 /// per instance, one scene.
 fn synthesize(scene: &Scene) -> Doc {
-    let mut doc = Doc::new(Map::new());
-    doc.json.insert("asset".into(), json!({"version": "2.0", "generator": crate::GENERATOR}));
-    let material_json = |m: &drafter_core::Material, name: &str| {
-        json!({
-            "name": name,
-            "pbrMetallicRoughness": {
-                "baseColorFactor": m.base_color,
-                "metallicFactor": m.metallic,
-                "roughnessFactor": m.roughness
-            }
-        })
+    let mut root = gltf::Root {
+        asset: Some(gltf::Asset {
+            version: Some("2.0".into()),
+            generator: Some(crate::GENERATOR.into()),
+            ..gltf::Asset::default()
+        }),
+        ..gltf::Root::default()
     };
-    let mut materials: Vec<Value> = scene.materials.iter().map(|m| material_json(m, &m.name)).collect();
+    let material_of = |m: &drafter_core::Material, name: &str| material(name, m.base_color, m.metallic, m.roughness);
+    let mut materials: Vec<gltf::Material> = scene.materials.iter().map(|m| material_of(m, &m.name)).collect();
     let needs_default = scene.meshes.iter().flat_map(|m| &m.groups).any(|g| g.material.is_none());
     let default_material = needs_default.then(|| {
-        materials.push(material_json(&DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME));
+        materials.push(material_of(&DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME));
         materials.len() - 1
     });
-    if !materials.is_empty() {
-        doc.json.insert("materials".into(), Value::Array(materials));
-    }
+    root.materials = (!materials.is_empty()).then_some(materials);
     // Primitives get their attributes and indices from `write`, with or without a new layout.
-    let mut meshes = Vec::with_capacity(scene.meshes.len());
-    for mesh in &scene.meshes {
-        let primitives: Vec<Value> = mesh
-            .groups
-            .iter()
-            .map(|group| {
-                let mut primitive = json!({"attributes": {}});
-                if let Some(material) = group.material.map(|m| m.0 as usize).or(default_material) {
-                    primitive["material"] = material.into();
-                }
-                primitive
-            })
-            .collect();
-        let mut m = json!({"primitives": primitives});
-        if !mesh.name.is_empty() {
-            m["name"] = mesh.name.clone().into();
+    let meshes = scene.meshes.iter().map(|mesh| {
+        let primitives = mesh.groups.iter().map(|group| gltf::Primitive {
+            attributes: Some(Attributes::new()),
+            material: group.material.map(|m| m.0 as usize).or(default_material).map(|m| m as u64),
+            ..gltf::Primitive::default()
+        });
+        gltf::Mesh {
+            primitives: Some(primitives.collect()),
+            name: (!mesh.name.is_empty()).then(|| mesh.name.clone()),
+            ..gltf::Mesh::default()
         }
-        meshes.push(m);
-    }
-    doc.json.insert("meshes".into(), Value::Array(meshes));
-    let nodes: Vec<Value> = scene
+    });
+    root.meshes = Some(meshes.collect());
+    let nodes: Vec<gltf::Node> = scene
         .instances
         .iter()
-        .map(|inst| {
-            let mut node = json!({"name": inst.name, "mesh": inst.mesh.0});
-            if inst.world_from_object != glam::DMat4::IDENTITY {
-                node["matrix"] = json!(inst.world_from_object.to_cols_array());
-            }
-            node
+        .map(|inst| gltf::Node {
+            name: Some(inst.name.clone()),
+            mesh: Some(u64::from(inst.mesh.0)),
+            matrix: (inst.world_from_object != glam::DMat4::IDENTITY)
+                .then(|| Value::from(inst.world_from_object.to_cols_array().to_vec())),
+            ..gltf::Node::default()
         })
         .collect();
-    let roots: Vec<usize> = (0..nodes.len()).collect();
-    doc.json.insert("nodes".into(), Value::Array(nodes));
-    doc.json.insert("scenes".into(), json!([{"nodes": roots}]));
-    doc.json.insert("scene".into(), 0.into());
-    doc
+    let roots: Vec<u64> = (0..nodes.len() as u64).collect();
+    root.nodes = Some(nodes);
+    root.scenes = Some(vec![gltf::Scene { nodes: Some(roots), ..gltf::Scene::default() }]);
+    root.scene = Some(0);
+    Doc::new(root)
 }
