@@ -76,7 +76,9 @@
 use std::fmt;
 
 use draco_oxide_core::attribute::{Attribute, ComponentDataType};
-use serde_json::{Map, Value, json};
+use serde_json::Value;
+
+use crate::gltf::{Accessor, Buffer, BufferView, DracoPrimitive, Extensible, Root};
 
 /// The extension's name.
 pub const EXTENSION: &str = "KHR_draco_mesh_compression";
@@ -124,9 +126,8 @@ pub fn decompress(json: &[u8], buffers: &[Vec<u8>]) -> Result<Option<Decompresse
     if !mentions_extension(json) {
         return Ok(None);
     }
-    let mut doc: Value = serde_json::from_slice(json).map_err(|e| error("", format!("JSON: {e}")))?;
-    let Some(root) = doc.as_object_mut() else { return Err(error("", "the top level is not an object")) };
-    let declared_buffers = array(root, "buffers").len();
+    let mut root = Root::from_slice(json).map_err(|e| error("", format!("JSON: {e}")))?;
+    let declared_buffers = root.buffers().len();
     if declared_buffers != buffers.len() {
         return Err(error("/buffers", format!("{declared_buffers} buffers listed, {} loaded", buffers.len())));
     }
@@ -134,36 +135,29 @@ pub fn decompress(json: &[u8], buffers: &[Vec<u8>]) -> Result<Option<Decompresse
     // Accessors already written, with the stream and attribute that filled them: a second
     // primitive naming the same accessor for the same data shares it, for other data gets a copy.
     let mut filled: std::collections::HashMap<usize, (usize, Option<u64>)> = std::collections::HashMap::new();
-    let mesh_count = array(root, "meshes").len();
-    for m in 0..mesh_count {
-        let primitive_count = root["meshes"][m].get("primitives").and_then(Value::as_array).map_or(0, Vec::len);
-        for p in 0..primitive_count {
+    for m in 0..root.meshes().len() {
+        for p in 0..root.meshes()[m].primitives().len() {
             let place = format!("/meshes/{m}/primitives/{p}");
-            let Some(ext) =
-                root["meshes"][m]["primitives"][p].get("extensions").and_then(|e| e.get(EXTENSION)).cloned()
-            else {
-                continue;
-            };
-            decode_primitive(root, (m, p), &ext, buffers, &mut out, &mut filled, &place)?;
+            let Some(ext) = root.meshes()[m].primitives()[p].extension::<DracoPrimitive>(EXTENSION) else { continue };
+            let ext = ext.map_err(|e| error(&format!("{place}/extensions/{EXTENSION}"), e.to_string()))?;
+            decode_primitive(&mut root, (m, p), &ext, buffers, &mut out, &mut filled, &place)?;
         }
     }
     if out.primitives == 0 {
         return Ok(None);
     }
-    for key in ["extensionsUsed", "extensionsRequired"] {
-        if let Some(Value::Array(list)) = root.get_mut(key) {
-            list.retain(|v| v.as_str() != Some(EXTENSION));
-            if list.is_empty() {
-                root.remove(key);
+    for list in [&mut root.extensions_used, &mut root.extensions_required] {
+        if let Some(names) = list {
+            names.retain(|name| name != EXTENSION);
+            if names.is_empty() {
+                *list = None;
             }
         }
     }
     pad4(&mut out.bin);
-    root.entry("buffers").or_insert_with(|| Value::Array(Vec::new()));
-    if let Some(Value::Array(list)) = root.get_mut("buffers") {
-        list.push(json!({ "byteLength": out.bin.len() }));
-    }
-    let json = serde_json::to_string(&doc).map_err(|e| error("", format!("JSON: {e}")))?;
+    let buffer = Buffer { byte_length: Some(out.bin.len() as u64), ..Buffer::default() };
+    root.buffers.get_or_insert_default().push(buffer);
+    let json = Value::from(root).to_string();
     Ok(Some(Decompressed { json, buffer: out.bin, primitives: out.primitives, triangles: out.triangles }))
 }
 
@@ -177,14 +171,17 @@ struct Output {
 
 impl Output {
     /// Appends `bytes` as a buffer view (with `stride` when given); its index.
-    fn view(&mut self, root: &mut Map<String, Value>, bytes: &[u8], stride: Option<usize>) -> usize {
+    fn view(&mut self, root: &mut Root, bytes: &[u8], stride: Option<usize>) -> usize {
         pad4(&mut self.bin);
-        let mut view = json!({ "buffer": self.buffer, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
-        if let Some(stride) = stride {
-            view["byteStride"] = stride.into();
-        }
+        let view = BufferView {
+            buffer: Some(self.buffer as u64),
+            byte_offset: Some(self.bin.len() as u64),
+            byte_length: Some(bytes.len() as u64),
+            byte_stride: stride.map(|s| s as u64),
+            ..BufferView::default()
+        };
         self.bin.extend_from_slice(bytes);
-        let views = array_mut(root, "bufferViews");
+        let views = root.buffer_views.get_or_insert_default();
         views.push(view);
         views.len() - 1
     }
@@ -194,38 +191,22 @@ fn pad4(bin: &mut Vec<u8>) {
     bin.resize(bin.len().next_multiple_of(4), 0);
 }
 
-fn array<'a>(root: &'a Map<String, Value>, key: &str) -> &'a [Value] {
-    root.get(key).and_then(Value::as_array).map_or(&[][..], Vec::as_slice)
-}
-
-fn array_mut<'a>(root: &'a mut Map<String, Value>, key: &str) -> &'a mut Vec<Value> {
-    let entry = root.entry(key.to_owned()).or_insert_with(|| Value::Array(Vec::new()));
-    if !entry.is_array() {
-        *entry = Value::Array(Vec::new());
-    }
-    match entry {
-        Value::Array(a) => a,
-        _ => unreachable!("replaced by an array above"),
-    }
+/// Accessor `index` of `root`, to edit (it exists: claimed or pushed before).
+fn accessor_mut(root: &mut Root, index: usize) -> &mut Accessor {
+    &mut root.accessors.get_or_insert_default()[index]
 }
 
 /// The bytes of the Draco stream in buffer view `view`, checked against its buffer.
-fn stream_bytes<'a>(
-    root: &Map<String, Value>,
-    view: u64,
-    buffers: &'a [Vec<u8>],
-    place: &str,
-) -> Result<&'a [u8], DracoError> {
+fn stream_bytes<'a>(root: &Root, view: u64, buffers: &'a [Vec<u8>], place: &str) -> Result<&'a [u8], DracoError> {
     let place = format!("{place}/extensions/{EXTENSION}/bufferView");
     let v = usize::try_from(view)
         .ok()
-        .and_then(|v| array(root, "bufferViews").get(v))
+        .and_then(|v| root.buffer_views().get(v))
         .ok_or_else(|| error(&place, format!("buffer view {view} does not exist")))?;
-    let field = |key: &str| v.get(key).and_then(Value::as_u64);
-    let buffer = field("buffer").and_then(|b| usize::try_from(b).ok()).and_then(|b| buffers.get(b));
+    let buffer = v.buffer.and_then(|b| usize::try_from(b).ok()).and_then(|b| buffers.get(b));
     let Some(buffer) = buffer else { return Err(error(&place, format!("buffer view {view} names no loaded buffer"))) };
-    let offset = field("byteOffset").unwrap_or(0);
-    let length = field("byteLength").unwrap_or(0);
+    let offset = v.byte_offset.unwrap_or(0);
+    let length = v.byte_length.unwrap_or(0);
     offset
         .checked_add(length)
         .filter(|&end| end <= buffer.len() as u64)
@@ -244,9 +225,9 @@ struct AccessorType {
     components: usize,
 }
 
-fn accessor_type(accessor: &Value) -> Option<AccessorType> {
-    let component = accessor.get("componentType").and_then(Value::as_u64)?;
-    let components = match accessor.get("type")?.as_str()? {
+fn accessor_type(accessor: &Accessor) -> Option<AccessorType> {
+    let component = accessor.component_type?;
+    let components = match accessor.kind.as_deref()? {
         "SCALAR" => 1,
         "VEC2" => 2,
         "VEC3" => 3,
@@ -421,32 +402,19 @@ fn decode_guarded(stream: &[u8]) -> Result<draco_oxide_core::mesh::Mesh, String>
 
 /// Decodes the stream of primitive `(m, p)` and points its accessors at the decoded data.
 fn decode_primitive(
-    root: &mut Map<String, Value>,
+    root: &mut Root,
     (m, p): (usize, usize),
-    ext: &Value,
+    ext: &DracoPrimitive,
     buffers: &[Vec<u8>],
     out: &mut Output,
     filled: &mut std::collections::HashMap<usize, (usize, Option<u64>)>,
     place: &str,
 ) -> Result<(), DracoError> {
     let ext_place = format!("{place}/extensions/{EXTENSION}");
-    let view = ext
-        .get("bufferView")
-        .and_then(Value::as_u64)
-        .ok_or_else(|| error(&ext_place, "bufferView is missing or not an index"))?;
-    let named: Vec<(String, u64)> = match ext.get("attributes").and_then(Value::as_object) {
-        Some(map) => map
-            .iter()
-            .map(|(name, id)| {
-                id.as_u64()
-                    .map(|id| (name.clone(), id))
-                    .ok_or_else(|| error(&format!("{ext_place}/attributes/{name}"), "not an attribute id"))
-            })
-            .collect::<Result<_, _>>()?,
-        None => return Err(error(&ext_place, "attributes is missing or not an object")),
-    };
-    let prim = root["meshes"][m]["primitives"][p].clone();
-    let mode = prim.get("mode").and_then(Value::as_u64).unwrap_or(4);
+    let view = ext.buffer_view.ok_or_else(|| error(&ext_place, "bufferView is missing"))?;
+    let Some(named) = &ext.attributes else { return Err(error(&ext_place, "attributes is missing")) };
+    let prim = root.meshes()[m].primitives()[p].clone();
+    let mode = prim.mode.unwrap_or(4);
     if mode != 4 {
         // The extension allows TRIANGLE_STRIP too; no exporter in reach writes it (Babylon.js
         // refuses it as well), so it is refused rather than guessed.
@@ -458,17 +426,13 @@ fn decode_primitive(
     // The indices accessor's count, which the importer has held against --max-triangles, is the
     // face count the stream must declare; every other count is bounded by it.
     // (Without indices, POSITION's count is the corner count, as for any non-indexed primitive.)
-    let indices = prim.get("indices").and_then(Value::as_u64).and_then(|a| usize::try_from(a).ok());
+    let indices = prim.indices.and_then(|a| usize::try_from(a).ok());
     let (listed_by, counted) = match indices {
         Some(a) => ("the indices accessor", Some(a as u64)),
-        None => {
-            ("POSITION (no indices)", prim.get("attributes").and_then(|a| a.get("POSITION")).and_then(Value::as_u64))
-        }
+        None => ("POSITION (no indices)", prim.attribute("POSITION")),
     };
     let listed = counted
-        .and_then(|a| array(root, "accessors").get(usize::try_from(a).ok()?))
-        .and_then(|acc| acc.get("count"))
-        .and_then(Value::as_u64)
+        .and_then(|a| root.accessor_count(a))
         .ok_or_else(|| error(place, format!("{listed_by} names no accessor")))?;
     if counts.faces.checked_mul(3) != Some(listed) {
         return Err(error(
@@ -501,13 +465,11 @@ fn decode_primitive(
 
     // Attributes: the point count is the decoded one, the same for every attribute.
     let mut points: Option<usize> = None;
-    let mut attributes = Map::new();
-    for (name, id) in &named {
+    let mut attributes = std::collections::BTreeMap::new();
+    for (name, id) in named {
         let attr_place = format!("{place}/attributes/{name}");
         let accessor = prim
-            .get("attributes")
-            .and_then(|a| a.get(name))
-            .and_then(Value::as_u64)
+            .attribute(name)
             .and_then(|a| usize::try_from(a).ok())
             .ok_or_else(|| error(&attr_place, "the extension names an attribute the primitive does not list"))?;
         let attribute = mesh.attributes.iter().find(|a| a.get_id().as_usize() as u64 == *id).ok_or_else(|| {
@@ -518,7 +480,7 @@ fn decode_primitive(
             return Err(error(&attr_place, format!("decodes {n} points, another attribute {}", points.unwrap_or(0))));
         }
         let written = write_attribute(root, out, accessor, attribute, filled, (view as usize, Some(*id)), &attr_place)?;
-        attributes.insert(name.clone(), written.into());
+        attributes.insert(name.clone(), written as u64);
     }
     let points = points.unwrap_or(0);
     if points == 0 {
@@ -538,34 +500,25 @@ fn decode_primitive(
     let written_indices = write_indices(root, out, indices, &flat, filled, (view as usize, None), place)?;
 
     // Attributes the stream does not carry must already have one element per decoded point.
-    let all = prim.get("attributes").and_then(Value::as_object).cloned().unwrap_or_default();
-    for (name, accessor) in &all {
+    for (name, &accessor) in prim.attributes.iter().flatten() {
         if attributes.contains_key(name) {
             continue;
         }
-        let count = accessor
-            .as_u64()
-            .and_then(|a| array(root, "accessors").get(a as usize))
-            .and_then(|a| a.get("count"))
-            .and_then(Value::as_u64);
+        let count = root.accessor_count(accessor);
         if count != Some(points as u64) {
             return Err(error(
                 &format!("{place}/attributes/{name}"),
                 format!("uncompressed beside a Draco stream of {points} points, but has {count:?} elements"),
             ));
         }
-        attributes.insert(name.clone(), accessor.clone());
+        attributes.insert(name.clone(), accessor);
     }
 
-    let target = &mut root["meshes"][m]["primitives"][p];
-    target["attributes"] = Value::Object(attributes);
-    target["indices"] = written_indices.into();
-    if let Some(Value::Object(extensions)) = target.get_mut("extensions") {
-        extensions.remove(EXTENSION);
-        if extensions.is_empty() {
-            target.as_object_mut().map(|o| o.remove("extensions"));
-        }
-    }
+    let meshes = root.meshes.get_or_insert_default();
+    let target = &mut meshes[m].primitives.get_or_insert_default()[p];
+    target.attributes = Some(attributes);
+    target.indices = Some(written_indices as u64);
+    target.remove_extension(EXTENSION);
     out.primitives += 1;
     out.triangles += mesh.faces.len();
     Ok(())
@@ -574,7 +527,7 @@ fn decode_primitive(
 /// The accessor to write for `source` (an index into `accessors`) filled from `origin`: itself the
 /// first time, shared when the same data filled it before, else a copy appended.
 fn claim_accessor(
-    root: &mut Map<String, Value>,
+    root: &mut Root,
     source: usize,
     filled: &mut std::collections::HashMap<usize, (usize, Option<u64>)>,
     origin: (usize, Option<u64>),
@@ -586,8 +539,8 @@ fn claim_accessor(
         }
         Some(&before) if before == origin => (source, true),
         Some(_) => {
-            let copy = array(root, "accessors").get(source).cloned().unwrap_or_else(|| json!({}));
-            let accessors = array_mut(root, "accessors");
+            let copy = root.accessors().get(source).cloned().unwrap_or_default();
+            let accessors = root.accessors.get_or_insert_default();
             accessors.push(copy);
             let index = accessors.len() - 1;
             filled.insert(index, origin);
@@ -598,7 +551,7 @@ fn claim_accessor(
 
 /// Writes a decoded attribute into the accessor `source` describes; the accessor written.
 fn write_attribute(
-    root: &mut Map<String, Value>,
+    root: &mut Root,
     out: &mut Output,
     source: usize,
     attribute: &Attribute,
@@ -606,9 +559,8 @@ fn write_attribute(
     origin: (usize, Option<u64>),
     place: &str,
 ) -> Result<usize, DracoError> {
-    let described = array(root, "accessors")
-        .get(source)
-        .ok_or_else(|| error(place, format!("accessor {source} does not exist")))?;
+    let described =
+        root.accessors().get(source).ok_or_else(|| error(place, format!("accessor {source} does not exist")))?;
     let Some(ty) = accessor_type(described) else {
         return Err(error(place, format!("accessor {source}: a Draco attribute is SCALAR or VEC2-4 of a glTF type")));
     };
@@ -667,22 +619,20 @@ fn write_attribute(
         bytes.resize(start + stride, 0);
     }
     let view = out.view(root, &bytes, (stride != element).then_some(stride));
-    let accessor = &mut array_mut(root, "accessors")[index];
-    accessor["bufferView"] = view.into();
-    accessor["count"] = points.into();
-    if let Some(object) = accessor.as_object_mut() {
-        object.remove("byteOffset");
-        object.remove("sparse");
-    }
-    let number = |v: f64| if ty.component == 5126 { json!(v as f32) } else { json!(v as i64) };
-    accessor["min"] = Value::Array(min.into_iter().map(number).collect());
-    accessor["max"] = Value::Array(max.into_iter().map(number).collect());
+    let accessor = accessor_mut(root, index);
+    accessor.buffer_view = Some(view as u64);
+    accessor.count = Some(points as u64);
+    accessor.byte_offset = None;
+    accessor.sparse = None;
+    let number = |v: f64| if ty.component == 5126 { Value::from(v as f32) } else { Value::from(v as i64) };
+    accessor.min = Some(Value::Array(min.into_iter().map(number).collect()));
+    accessor.max = Some(Value::Array(max.into_iter().map(number).collect()));
     Ok(index)
 }
 
 /// Writes the faces into the indices accessor `source`; the accessor written.
 fn write_indices(
-    root: &mut Map<String, Value>,
+    root: &mut Root,
     out: &mut Output,
     source: Option<usize>,
     flat: &[u32],
@@ -693,8 +643,7 @@ fn write_indices(
     let largest = flat.iter().copied().max().unwrap_or(0);
     let (index, component) = match source {
         Some(source) => {
-            let component =
-                array(root, "accessors").get(source).and_then(|a| a.get("componentType")).and_then(Value::as_u64);
+            let component = root.accessors().get(source).and_then(|a| a.component_type);
             let component = match component {
                 Some(5121) if largest <= 0xff => 5121,
                 Some(5121 | 5123) if largest <= 0xffff => 5123,
@@ -713,8 +662,8 @@ fn write_indices(
             (index, component)
         }
         None => {
-            let accessors = array_mut(root, "accessors");
-            accessors.push(json!({}));
+            let accessors = root.accessors.get_or_insert_default();
+            accessors.push(Accessor::default());
             (accessors.len() - 1, if largest <= 0xffff { 5123 } else { 5125 })
         }
     };
@@ -725,18 +674,16 @@ fn write_indices(
     };
     let view = out.view(root, &bytes, None);
     let smallest = flat.iter().copied().min().unwrap_or(0);
-    let accessor = &mut array_mut(root, "accessors")[index];
-    accessor["bufferView"] = view.into();
-    accessor["componentType"] = component.into();
-    accessor["count"] = flat.len().into();
-    accessor["type"] = "SCALAR".into();
-    if let Some(object) = accessor.as_object_mut() {
-        object.remove("byteOffset");
-        object.remove("sparse");
-        object.remove("normalized");
-    }
-    accessor["min"] = json!([smallest]);
-    accessor["max"] = json!([largest]);
+    let accessor = accessor_mut(root, index);
+    accessor.buffer_view = Some(view as u64);
+    accessor.component_type = Some(component);
+    accessor.count = Some(flat.len() as u64);
+    accessor.kind = Some("SCALAR".into());
+    accessor.byte_offset = None;
+    accessor.sparse = None;
+    accessor.normalized = None;
+    accessor.min = Some(Value::from(vec![smallest]));
+    accessor.max = Some(Value::from(vec![largest]));
     Ok(index)
 }
 

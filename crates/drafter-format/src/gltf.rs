@@ -547,6 +547,20 @@ impl Root {
     }
 }
 
+impl BufferView {
+    /// The view's extension `name` decoded as `T`; `None` when it has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+}
+
+impl Buffer {
+    /// The buffer's extension `name` decoded as `T`; `None` when it has none.
+    pub fn extension<T: DeserializeOwned>(&self, name: &str) -> Option<serde_json::Result<T>> {
+        extension(&self.extensions, name)
+    }
+}
+
 impl Accessor {
     /// An accessor of `count` elements of `kind` (`"SCALAR"`, `"VEC3"`, …), each of `component`s,
     /// in buffer view `view`.
