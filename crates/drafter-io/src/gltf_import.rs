@@ -301,14 +301,12 @@ fn check_what_the_crate_unwraps(root: &gltf::json::Root) -> Result<(), ParseErro
 /// keeps its URI, with a note. Called only where some image names a file (the text is parsed
 /// again here, so most inputs skip it).
 fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, diagnostics: &mut Diagnostics) -> String {
-    let is_file_uri = |image: &serde_json::Value| image["uri"].as_str().is_some_and(|u| !u.starts_with("data:"));
-    let Ok(mut root) = serde_json::from_str::<serde_json::Value>(&json) else { return json };
+    // drafter-format's typed document, which writes back every member it does not name.
+    use drafter_format::gltf as typed;
+    let Ok(mut root) = typed::Root::from_slice(json.as_bytes()) else { return json };
     let mut kept = Vec::new();
-    for i in 0..root["images"].as_array().map_or(0, Vec::len) {
-        if !is_file_uri(&root["images"][i]) {
-            continue;
-        }
-        let uri = root["images"][i]["uri"].as_str().unwrap_or_default().to_owned();
+    for i in 0..root.images().len() {
+        let Some(uri) = root.images()[i].uri.clone().filter(|u| !u.starts_with("data:")) else { continue };
         let mime = match read_buffer_uri(folder, &uri) {
             Ok(bytes) if bytes.starts_with(b"\x89PNG\r\n\x1a\n") => Ok(("image/png", bytes)),
             Ok(bytes) if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) => Ok(("image/jpeg", bytes)),
@@ -322,23 +320,16 @@ fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, di
                 continue;
             }
         };
-        let buffer = buffers.len();
-        let length = bytes.len();
+        let (buffer, length) = (buffers.len() as u64, Some(bytes.len() as u64));
         buffers.push(bytes);
-        let push = |root: &mut serde_json::Value, key: &str, item: serde_json::Value| -> usize {
-            if !root[key].is_array() {
-                root[key] = serde_json::Value::Array(Vec::new());
-            }
-            let list = root[key].as_array_mut().expect("an array");
-            list.push(item);
-            list.len() - 1
-        };
-        push(&mut root, "buffers", serde_json::json!({"byteLength": length}));
-        let view = push(&mut root, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": length}));
-        if let Some(image) = root["images"][i].as_object_mut() {
-            image.remove("uri");
-            image.insert("bufferView".into(), view.into());
-            image.insert("mimeType".into(), mime.into());
+        root.buffers.get_or_insert_default().push(typed::Buffer { byte_length: length, ..typed::Buffer::default() });
+        let views = root.buffer_views.get_or_insert_default();
+        views.push(typed::BufferView { buffer: Some(buffer), byte_length: length, ..typed::BufferView::default() });
+        let view = Some(views.len() as u64 - 1);
+        if let Some(image) = root.images.as_mut().and_then(|images| images.get_mut(i)) {
+            image.uri = None;
+            image.buffer_view = view;
+            image.mime_type = Some(mime.to_owned());
         }
     }
     if let Some(first) = kept.first() {
@@ -346,7 +337,7 @@ fn embed_image_files(json: String, buffers: &mut Vec<Vec<u8>>, folder: &Path, di
             format!("{first}; the image keeps its URI, which the baked file's folder may not have")
         });
     }
-    root.to_string()
+    serde_json::Value::from(root).to_string()
 }
 
 fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, folder: &Path) -> Result<Vec<Vec<u8>>, ParseError> {
@@ -806,5 +797,32 @@ mod tests {
         assert_eq!(fan, vec![[1, 2, 0], [2, 3, 0]]);
         let (list, leftover) = assemble_triangles(Mode::Triangles, &[0, 1, 2, 3]);
         assert_eq!((list.len(), leftover), (1, 1));
+    }
+
+    #[test]
+    fn image_files_move_into_buffers_and_the_rest_keep_their_uri() {
+        let folder = std::env::temp_dir().join(format!("drafter-embed-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).unwrap();
+        std::fs::write(folder.join("a.png"), b"\x89PNG\r\n\x1a\nrest").unwrap();
+        std::fs::write(folder.join("b.txt"), b"text").unwrap();
+        let json = r#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":4,"uri":"m.bin"}],
+            "images":[{"uri":"a.png","name":"a"},{"uri":"data:image/png;base64,AA=="},{"uri":"b.txt"},
+            {"uri":"../c.png"}],"zUnknown":[1.0]}"#;
+        let mut buffers = vec![vec![0; 4]];
+        let mut diagnostics = Diagnostics::new();
+        let out = embed_image_files(json.to_owned(), &mut buffers, &folder, &mut diagnostics);
+        std::fs::remove_dir_all(&folder).unwrap();
+        // The document's text with sorted members, everything but the embedded image as it was.
+        assert_eq!(
+            out,
+            r#"{"asset":{"version":"2.0"},"bufferViews":[{"buffer":1,"byteLength":12}],"#.to_owned()
+                + r#""buffers":[{"byteLength":4,"uri":"m.bin"},{"byteLength":12}],"#
+                + r#""images":[{"bufferView":0,"mimeType":"image/png","name":"a"},"#
+                + r#"{"uri":"data:image/png;base64,AA=="},{"uri":"b.txt"},{"uri":"../c.png"}],"zUnknown":[1.0]}"#
+        );
+        assert_eq!(buffers.len(), 2);
+        assert!(!diagnostics.is_empty(), "the two images that keep their URI are noted");
+        let same = embed_image_files("not json".to_owned(), &mut buffers, Path::new("."), &mut diagnostics);
+        assert_eq!(same, "not json");
     }
 }
