@@ -382,3 +382,37 @@ fn only_the_app_and_the_cli_name_window_crates() {
         );
     }
 }
+
+/// The crates that build on drafter-testkit outside their tests: the benchmarks (`drafter bench`'s
+/// generated inputs and contact assemblies), the CLI, which reaches it through drafter-bench alone,
+/// and the fuzzer (its generated seeds and the seeded generator).
+const TESTKIT_TOOLS: [&str; 3] = ["drafter-bench", "drafter-fuzz", "drafter-cli"];
+
+/// drafter-testkit is a dev-dependency: any crate's tests may use it (a stage crate's included), but
+/// no crate reaches it through its normal dependencies, so nothing a bake, a drawing, the viewer, the
+/// browser page or Python links carries test fixtures.
+#[test]
+fn the_testkit_is_a_dev_dependency_only() {
+    let manifests = manifests();
+    assert!(manifests.contains_key("drafter-testkit"), "drafter-testkit is not a workspace member");
+    for (name, manifest) in &manifests {
+        if name == "drafter-testkit" || TESTKIT_TOOLS.contains(&name.as_str()) {
+            continue;
+        }
+        let mut seen = BTreeSet::new();
+        let mut stack: Vec<(&String, &str)> = manifest.normal.iter().map(|d| (d, name.as_str())).collect();
+        while let Some((dep, via)) = stack.pop() {
+            if !seen.insert(dep) {
+                continue;
+            }
+            assert!(
+                dep != "drafter-testkit",
+                "{} reaches drafter-testkit through {via}'s [dependencies]: it belongs in [dev-dependencies]",
+                manifest.path
+            );
+            if let Some(m) = manifests.get(dep.as_str()) {
+                stack.extend(m.normal.iter().map(|d| (d, dep.as_str())));
+            }
+        }
+    }
+}

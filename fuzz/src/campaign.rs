@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use drafter_bench::generate::Rng;
+use drafter_testkit::Rng;
 
 use crate::seeds::Corpus;
 use crate::{Outcome, Target, run_case};

@@ -14,7 +14,7 @@
 //! ([`campaign`]).
 //!
 //! Everything is deterministic: case `n` of target `t` under seed `s` is the same bytes on every
-//! machine (SplitMix64 from drafter-bench, seeded by `s`, `t` and `n`), so a campaign's counts
+//! machine (SplitMix64, drafter-testkit's `Rng`, seeded by `s`, `t` and `n`), so a campaign's counts
 //! reproduce exactly; only the time-boxed mode (`--minutes`) depends on the machine's speed.
 //!
 //! No nightly toolchain and no coverage feedback: this is a black-box mutator, which is what a fresh
@@ -32,7 +32,7 @@ use drafter_bake::{BakeConfig, BakeError};
 use drafter_scene::Model;
 use drafter_scene::edges::WorldView;
 
-pub use drafter_bench::generate::Rng;
+pub use drafter_testkit::Rng;
 
 /// One entry point under test; its name is the folder of its findings and regressions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]

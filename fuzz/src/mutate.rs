@@ -20,7 +20,7 @@
 //!
 //! Outputs are capped at [`MAX_OUTPUT`] bytes so that a case costs what a small input costs.
 
-use drafter_bench::generate::Rng;
+use drafter_testkit::Rng;
 use serde_json::{Map, Value, json};
 
 use crate::Target;

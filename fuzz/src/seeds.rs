@@ -1,7 +1,7 @@
 //! The seeds each target's cases start from: the repository's `samples/*.glb` (as .glb, and as
 //! .gltf with the buffer embedded as a data URI), the small files of `../shared/models` (every file
 //! up to a size limit, .gltf buffers embedded the same way), small meshes generated here in every
-//! text and binary flavour (drafter-bench's shapes written as OBJ, STL, OFF and PLY), and for the
+//! text and binary flavour (drafter-testkit's shapes written as OBJ, STL, OFF and PLY), and for the
 //! baked-file target the bakes of the samples and of two generated meshes, made in-process at start.
 
 use std::collections::BTreeMap;
@@ -10,7 +10,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use base64::Engine as _;
-use drafter_bench::generate::{self, TriMesh};
+use drafter_testkit::generate::{self, TriMesh};
 
 use crate::Target;
 

@@ -5,7 +5,6 @@
 //! internally, pass the time budget or the memory budget.
 
 use std::path::Path;
-use std::time::Duration;
 
 use drafter_fuzz::Target;
 use drafter_fuzz::campaign::{self, Options};
@@ -16,17 +15,10 @@ const CASES_PER_TARGET: u64 = 300;
 fn a_bounded_campaign_finds_nothing() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let corpus = drafter_fuzz::seeds::corpus(&repo, 64 * 1024).expect("seeds");
-    let options = Options {
-        seed: 0x5eed,
-        cases_per_target: Some(CASES_PER_TARGET),
-        duration: None,
-        threads: 1,
-        targets: Target::ALL.to_vec(),
-        time_budget: Duration::from_secs(20),
-        memory_budget: 1 << 30,
-        out: None,
-        verbose: false,
-    };
+    // The default campaign (one thread, every target, 20 s and 1 GiB per case) at a fixed seed and
+    // number of cases.
+    let options =
+        Options { seed: 0x5eed, cases_per_target: Some(CASES_PER_TARGET), duration: None, ..Options::default() };
     let report = campaign::run(&corpus, &options);
     eprint!("{}", report.table());
     for target in Target::ALL {

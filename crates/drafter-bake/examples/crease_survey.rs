@@ -9,6 +9,8 @@
 use drafter_core::Topology;
 use drafter_lines::{FaceLabels, LineOptions, classify_edges_labelled};
 
+mod common;
+
 fn main() {
     let config = drafter_bake::BakeConfig::default();
     let base = config.lines.line_options();
@@ -19,14 +21,7 @@ fn main() {
     }
     println!(" tangent edges | ms (0.8) |");
     println!("|---|---:|{}---:|---:|", "---:|".repeat(fractions.len()));
-    for path in std::env::args().skip(1) {
-        let scene = match drafter_io::import(std::path::Path::new(&path)) {
-            Ok(imported) => imported.scene,
-            Err(e) => {
-                eprintln!("{path}: {e}");
-                continue;
-            }
-        };
+    for (path, scene) in common::scenes_from_args() {
         let topologies: Vec<(Topology, Option<Vec<u32>>)> = scene
             .meshes
             .iter()

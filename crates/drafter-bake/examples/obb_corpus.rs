@@ -7,7 +7,7 @@
 //! (little-endian f64 xyz) and `index.json` for the peer comparison in `bench/peers/obb_trimesh.py`.
 //! Single-threaded, so times per part are comparable with single-threaded peers.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use drafter_bounds::{ObbMethod, ObbOptions, oriented_box};
@@ -27,20 +27,6 @@ struct PartRow {
     dump: Option<String>,
 }
 
-fn models(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).into_iter().flatten().flatten().map(|e| e.path()).collect();
-    entries.sort();
-    for p in entries {
-        if p.is_dir() {
-            if p.file_name().is_some_and(|n| n != "draco") {
-                models(&p, out);
-            }
-        } else if drafter_io::has_input_extension(&p) {
-            out.push(p);
-        }
-    }
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let flag = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).map(PathBuf::from);
@@ -48,8 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let json = flag("--json");
     let dir =
         args.first().filter(|a| !a.starts_with("--")).map_or_else(|| PathBuf::from("../shared/models"), PathBuf::from);
-    let mut files = Vec::new();
-    models(&dir, &mut files);
+    let files = drafter_testkit::models::input_files(&dir, drafter_io::has_input_extension);
     if files.is_empty() {
         return Err(format!("no models under {}", dir.display()).into());
     }

@@ -9,27 +9,22 @@ use drafter_bake::split::split_mesh;
 use drafter_core::Topology;
 use drafter_format::VertexData;
 
+mod common;
+
 fn main() {
     let config = drafter_bake::BakeConfig::default();
     println!(
         "| model | limit | primitives split | chunks | vertices | duplicated (input order) | duplicated (Morton order) |"
     );
     println!("|---|---|---|---|---|---|---|");
-    for path in std::env::args().skip(1) {
-        let scene = match drafter_io::import(std::path::Path::new(&path)) {
-            Ok(imported) => imported.scene,
-            Err(e) => {
-                eprintln!("{path}: {e}");
-                continue;
-            }
-        };
+    for (path, scene) in common::scenes_from_args() {
         // The layouts the bake's normal stage gives (what the split counts).
         let layouts: Vec<VertexData> = scene
             .meshes
             .iter()
             .map(|mesh| {
                 let topology = Topology::build(mesh, config.segment.weld);
-                let mut options = config.normals.options;
+                let mut options = config.normals.options();
                 options.crease.keep_input_seams = mesh.uvs.is_some();
                 let (normals, _) = drafter_normals::compute_normals(mesh, &topology, &options);
                 VertexData {

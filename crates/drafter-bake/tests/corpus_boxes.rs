@@ -2,52 +2,21 @@
 //! box contains every vertex of its part, and rotating a part by a random rotation gives the same box
 //! volume within 0.1%.
 
-use std::path::{Path, PathBuf};
+use drafter_testkit::models::shared_models;
 
 use drafter_bounds::{ObbOptions, oriented_box};
 use drafter_core::PartId;
 use drafter_segment::{SegmentOptions, segment};
 use glam::{DQuat, DVec3};
 
-fn shared_models() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
-    assert!(dir.join("README.md").is_file(), "the shared model corpus is missing at {}", dir.display());
-    dir
-}
-
-fn models(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).expect("dir").map(|e| e.expect("entry").path()).collect();
-    entries.sort();
-    for p in entries {
-        if p.is_dir() {
-            if p.file_name().is_some_and(|n| n != "draco") {
-                models(&p, out);
-            }
-        } else if drafter_io::has_input_extension(&p) {
-            out.push(p);
-        }
-    }
-}
-
-/// A seeded uniform random rotation (Shoemake's method), no extra crate.
+/// A seeded uniform random rotation.
 fn rotation(seed: u64) -> DQuat {
-    let mut rng = drafter_core::rng::Rng::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let mut next = || rng.unit_f64();
-    let (u1, u2, u3) = (next(), next(), next());
-    let tau = std::f64::consts::TAU;
-    DQuat::from_xyzw(
-        (1.0 - u1).sqrt() * (tau * u2).sin(),
-        (1.0 - u1).sqrt() * (tau * u2).cos(),
-        u1.sqrt() * (tau * u3).sin(),
-        u1.sqrt() * (tau * u3).cos(),
-    )
-    .normalize()
+    drafter_testkit::Rng::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1).rotation()
 }
 
 #[test]
 fn every_part_box_contains_its_points_and_survives_rotation() {
-    let mut files = Vec::new();
-    models(&shared_models(), &mut files);
+    let files = drafter_testkit::models::input_files(&shared_models(), drafter_io::has_input_extension);
     assert!(files.len() >= 40, "only {} models", files.len());
     let options = ObbOptions::default();
     let (mut parts_checked, mut rotated_checked) = (0, 0);

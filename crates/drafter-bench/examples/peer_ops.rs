@@ -20,12 +20,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use drafter_bench::generate::TriMesh;
 use drafter_bounds::{ObbMethod, ObbOptions, oriented_box};
 use drafter_core::{PartId, Topology, Weld};
 use drafter_lines::{EdgeClass, LineOptions, classify_edges};
 use drafter_normals::{EnhanceOptions, Neighborhood, Weighting, enhance_faces};
 use drafter_segment::{SegmentMode, SegmentOptions, segment};
+use drafter_testkit::generate::TriMesh;
 use serde_json::json;
 
 fn best_ms<T>(mut f: impl FnMut() -> T) -> (f64, T) {

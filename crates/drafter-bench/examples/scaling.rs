@@ -26,7 +26,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use drafter_bake::{BakeConfig, bake};
-use drafter_bench::generate::TriMesh;
+use drafter_testkit::generate::TriMesh;
 use serde_json::{Value, json};
 
 fn status_kib(field: &str) -> Option<f64> {

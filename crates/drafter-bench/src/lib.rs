@@ -1,17 +1,17 @@
 //! Speed against accuracy for every bake stage: parameter sweeps of each stage on a
-//! user's model ([`sweep`]), their charts ([`chart`], [`figures`]), and generated inputs where
-//! methods are known to fail ([`generate`], used by the stability suite in `tests/stability.rs`
-//! and by the scaling benchmark in `examples/scaling.rs`).
+//! user's model ([`sweep`]), their charts ([`chart`], [`figures`]), and the synthetic scenes of
+//! `drafter bench parts` ([`spheres`]). The generated inputs where methods are known to fail, which
+//! the stability suite (`tests/stability.rs`) and the scaling benchmark (`examples/scaling.rs`)
+//! run, and the contact assemblies of the segmentation sweep are drafter-testkit's.
 //!
 //! The CLI's `drafter bench FILE --out DIR` runs [`sweep::run`], writes [`figures::all`] as SVG and
 //! the [`sweep::SweepReport`] as JSON. Nothing here prints; progress goes through
 //! [`sweep::Progress`].
 
-pub mod assemblies;
 pub mod chart;
 pub mod figures;
-pub mod generate;
 pub mod quantization;
+pub mod spheres;
 pub mod sweep;
 
 use std::path::Path;

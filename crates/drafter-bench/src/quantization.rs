@@ -16,7 +16,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::generate::Rng;
+use drafter_testkit::Rng;
 
 /// Bits per component measured; 32 stands for f32.
 pub const QUANTIZATION_BITS: [u32; 7] = [4, 6, 8, 10, 12, 16, 32];
@@ -143,7 +143,7 @@ mod tests {
     #[test]
     fn more_bits_cost_more_bytes_and_lose_less() {
         // A 64-segment cylinder, subdivided twice: curved sides give candidates in every direction.
-        let mesh = crate::generate::cylinder(64, 2.0).subdivided().subdivided().to_mesh("cylinder");
+        let mesh = drafter_testkit::generate::cylinder(64, 2.0).subdivided().subdivided().to_mesh("cylinder");
         let topology = Topology::build(&mesh, Weld::default());
         let sweep = sweep_quantization(&[topology], 32, 7).expect("the cylinder has candidates");
         assert_eq!(sweep.points.len(), QUANTIZATION_BITS.len());

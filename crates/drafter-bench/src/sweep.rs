@@ -36,7 +36,8 @@ use drafter_segment::{FanPairing, SegmentMode, SegmentOptions, segment, segment_
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::generate::{Rng, TriMesh};
+use drafter_testkit::Rng;
+use drafter_testkit::generate::TriMesh;
 
 /// The reference of the normals accuracy: the filter run this many iterations.
 pub const CONVERGED_ITERATIONS: u32 = 160;
@@ -609,7 +610,7 @@ pub struct SegmentSweep {
     pub by_region_angle: Vec<SegmentPoint>,
     /// `auto` mode on each unique mesh alone over [`MERGE_FRACTIONS`] (parts summed).
     pub by_merge_fraction: Vec<SegmentPoint>,
-    /// `auto` mode on the generated contact family ([`crate::assemblies::contact_assemblies`]),
+    /// `auto` mode on the generated contact family ([`drafter_testkit::assemblies::contact_assemblies`]),
     /// with fans paired whole only (the earlier rule), in part, and in part with cracks glued (the
     /// defaults).
     #[serde(default)]
@@ -633,14 +634,14 @@ pub struct ContactPoint {
 
 /// [`ContactPoint`]s of the generated contact family.
 pub fn contact_accuracy() -> Vec<ContactPoint> {
-    crate::assemblies::contact_assemblies()
+    drafter_testkit::assemblies::contact_assemblies()
         .iter()
         .map(|a| {
             let (scene, truth) = a.merged();
             let measure = |fan_pairing, stitch_fraction| {
                 let options = SegmentOptions { fan_pairing, stitch_fraction, ..SegmentOptions::default() };
                 let (parts, _) = segment(&scene, &options);
-                let acc = crate::assemblies::accuracy(&parts, &truth);
+                let acc = drafter_testkit::assemblies::accuracy(&parts, &truth);
                 (acc, (acc.matched, acc.parts))
             };
             let (acc, whole) = measure(FanPairing::Whole, 0.0);

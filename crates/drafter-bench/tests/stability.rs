@@ -22,7 +22,6 @@
 
 use std::path::PathBuf;
 
-use drafter_bench::generate::{self, Rng, TriMesh};
 use drafter_bounds::{Obb, ObbMethod, ObbOptions, oriented_box};
 use drafter_core::{PartId, Topology, Weld};
 use drafter_lines::{
@@ -30,6 +29,8 @@ use drafter_lines::{
 };
 use drafter_normals::{NormalsOptions, compute_normals};
 use drafter_segment::{SegmentOptions, segment};
+use drafter_testkit::Rng;
+use drafter_testkit::generate::{self, TriMesh};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 
 /// A box may miss a point by this fraction of the points' bounding diagonal (rounding of one dot

@@ -140,11 +140,8 @@ mod tests {
 
     #[test]
     fn calipers_match_brute_force() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = drafter_core::rng::Rng::new(12345);
+        let mut next = || rng.unit_f64();
         for trial in 0..200 {
             let n = 3 + trial % 40;
             let pts: Vec<DVec2> = (0..n).map(|_| DVec2::new(next() * 3.0 - 1.0, next() - 0.5)).collect();

@@ -174,14 +174,9 @@ mod tests {
     #[test]
     fn gather_is_the_indexed_map() {
         let items: Vec<[u32; 3]> = (0..50_000u32).map(|i| [i, i.wrapping_mul(2_654_435_761), !i]).collect();
-        let mut state = 7u64;
+        let mut rng = crate::rng::Rng::new(7);
         for len in [0usize, 1, 15, 16, 17, 4095, 4097, 100_000] {
-            let order: Vec<u32> = (0..len)
-                .map(|_| {
-                    state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-                    (state >> 33) as u32 % items.len() as u32
-                })
-                .collect();
+            let order: Vec<u32> = (0..len).map(|_| rng.index(items.len()) as u32).collect();
             let expected: Vec<[u32; 3]> = order.iter().map(|&i| items[i as usize]).collect();
             assert_eq!(super::gather(&items, &order), expected, "length {len}");
         }

@@ -789,28 +789,8 @@ mod tests {
 
     /// A unit cube exported the CAD way: 4 vertices per face, nothing shared.
     fn unwelded_cube() -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let mut positions = Vec::new();
-        let mut triangles = Vec::new();
-        for axis in 0..3 {
-            for side in [0.0f32, 1.0] {
-                let base = positions.len() as u32;
-                for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
-                    let mut p = [0.0f32; 3];
-                    p[axis] = side;
-                    p[(axis + 1) % 3] = u;
-                    p[(axis + 2) % 3] = v;
-                    positions.push(Vec3::from(p));
-                }
-                if side == 0.0 {
-                    triangles.push([base, base + 2, base + 1]);
-                    triangles.push([base, base + 3, base + 2]);
-                } else {
-                    triangles.push([base, base + 1, base + 2]);
-                    triangles.push([base, base + 2, base + 3]);
-                }
-            }
-        }
-        (positions, triangles)
+        let cube = drafter_testkit::generate::unwelded_cube();
+        (cube.positions, cube.triangles)
     }
 
     #[test]

@@ -345,8 +345,8 @@ mod tests {
 
     #[test]
     fn support_points_equal_a_scan_of_every_point() {
-        let mut rng = drafter_textures::Pcg32::new(21, 4);
-        let mut r = || rng.next_signed() as f32;
+        let mut rng = drafter_core::rng::Rng::new(214);
+        let mut r = || rng.signed_f32();
         let directions = sphere_directions(SUPPORT_DIRECTIONS);
         for case in 0..60 {
             let n = [1, 7, 300, 2_000, 9_000][case % 5];
@@ -409,8 +409,8 @@ mod tests {
 
     #[test]
     fn fit_centres_the_points_and_fills_the_frame_up_to_the_margin() {
-        let mut rng = drafter_textures::Pcg32::new(15, 6);
-        let mut r = || rng.next_signed() as f32;
+        let mut rng = drafter_core::rng::Rng::new(156);
+        let mut r = || rng.signed_f32();
         for case in 0..400 {
             // Boxes of random proportions, off the origin, filled with random points; some flat.
             let scale = Vec3::new(r().abs() * 5.0 + 0.01, r().abs() * 5.0 + 0.01, r().abs() * 5.0 + 0.01)
@@ -449,11 +449,10 @@ mod tests {
         }
         let kept = hull_sample(&points);
         assert!(kept.len() <= SUPPORT_DIRECTIONS && kept.len() > 16, "{}", kept.len());
-        let mut rng = drafter_textures::Pcg32::new(15, 7);
+        let mut rng = drafter_core::rng::Rng::new(157);
         let mut worst = 0.0f32;
         for _ in 0..2000 {
-            let u = Vec3::new(rng.next_signed() as f32, rng.next_signed() as f32, rng.next_signed() as f32)
-                .normalize_or(Vec3::X);
+            let u = Vec3::new(rng.signed_f32(), rng.signed_f32(), rng.signed_f32()).normalize_or(Vec3::X);
             let all = points.iter().map(|p| p.dot(u)).fold(f32::MIN, f32::max);
             let some = kept.iter().map(|&i| points[i].dot(u)).fold(f32::MIN, f32::max);
             assert!(some <= all);

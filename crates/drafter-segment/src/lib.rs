@@ -124,7 +124,7 @@
 //! coordinates near the origin), glues no two nodes of any merged assembly here. Glued pieces are
 //! counted in a diagnostic ([`DiagnosticKind::GluedCrack`]).
 //!
-//! `tests/contacts.rs` runs this over `drafter_bench::assemblies` (generated clamped gaskets,
+//! `tests/contacts.rs` runs this over `drafter_testkit::assemblies` (generated clamped gaskets,
 //! washers under screw heads, pins pressed into holes, stacked plates, covers over casings with a
 //! gasket, each with matching, non-matching and cracked tessellation) and requires every part
 //! recovered on all of them; without gluing, a pin cracked all the way round comes out as two

@@ -1,5 +1,5 @@
 //! Parts that touch (clamped, pressed, stacked) recovered from one merged, unwelded
-//! mesh. The generated family is `drafter_bench::assemblies`; the real assemblies are every glTF
+//! mesh. The generated family is `drafter_testkit::assemblies`; the real assemblies are every glTF
 //! assembly of ../shared/models flattened into one triangle soup (the true part of a triangle is
 //! its instance). The bar: at least 99% of triangles in a part that matches one original
 //! part (`assemblies::accuracy`), and the right part count. Figures are printed; run with
@@ -12,9 +12,9 @@ mod common;
 
 use std::path::PathBuf;
 
-use drafter_bench::assemblies::{Accuracy, accuracy, contact_assemblies, flatten, flatten_solids};
 use drafter_core::{PartId, Scene};
 use drafter_segment::{Parts, SegmentMode, SegmentOptions, segment};
+use drafter_testkit::assemblies::{Accuracy, accuracy, contact_assemblies, flatten, flatten_solids};
 
 use common::load;
 
@@ -98,7 +98,7 @@ const GLTF_ASSEMBLIES: [&str; 7] = [
 ];
 
 /// Merged glTF assemblies that miss the bar against their solids
-/// ([`drafter_bench::assemblies::flatten_solids`]: an instance whose mesh holds several separate
+/// ([`drafter_testkit::assemblies::flatten_solids`]: an instance whose mesh holds several separate
 /// closed bodies counts as that many parts), and why. Against their instances all but
 /// RodAssembly miss it, since a mesh with a bearing and its balls, or four bolts, cannot be told
 /// from four parts by geometry; the figures are printed.

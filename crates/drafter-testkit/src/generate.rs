@@ -13,9 +13,12 @@
 //! | [`nonmanifold_fan`] | three or more faces on one edge |
 //! | [`open_box`] | boundary edges |
 //! | [`single_triangle`] | one face, three boundary edges, no interior |
+//! | [`unwelded_cube`] | a CAD export: no vertex shared between faces |
 
 use drafter_core::{Mesh, Scene, SourceFormat, TriangleGroup};
 use glam::{DMat4, DVec3, Vec3};
+
+use crate::Rng;
 
 /// A triangle mesh as plain arrays.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -144,6 +147,33 @@ pub fn cube() -> TriMesh {
     box_mesh(DVec3::ONE)
 }
 
+/// The cube [0, 1]³ exported the CAD way: 4 vertices per face, nothing shared (24 vertices, 12
+/// triangles, outward winding), so only a weld makes it one closed surface.
+pub fn unwelded_cube() -> TriMesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for axis in 0..3 {
+        for side in [0.0f32, 1.0] {
+            let base = positions.len() as u32;
+            for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                let mut p = [0.0f32; 3];
+                p[axis] = side;
+                p[(axis + 1) % 3] = u;
+                p[(axis + 2) % 3] = v;
+                positions.push(Vec3::from(p));
+            }
+            if side == 0.0 {
+                triangles.push([base, base + 2, base + 1]);
+                triangles.push([base, base + 3, base + 2]);
+            } else {
+                triangles.push([base, base + 1, base + 2]);
+                triangles.push([base, base + 2, base + 3]);
+            }
+        }
+    }
+    TriMesh { positions, triangles }
+}
+
 /// A paper-thin plate: 1 × 0.6 × `thickness`.
 pub fn plate(thickness: f64) -> TriMesh {
     box_mesh(DVec3::new(1.0, 0.6, thickness))
@@ -244,9 +274,6 @@ pub fn collinear_points(count: usize, a: DVec3, b: DVec3) -> Vec<DVec3> {
 pub fn coincident_points(count: usize, p: DVec3) -> Vec<DVec3> {
     vec![p; count]
 }
-
-/// The seeded generator of the generated inputs: the workspace's one (drafter-core's SplitMix64).
-pub use drafter_core::rng::Rng;
 
 #[cfg(test)]
 mod tests {

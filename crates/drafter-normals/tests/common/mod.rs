@@ -10,27 +10,8 @@ pub fn mesh(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh 
 
 /// A unit cube exported the CAD way (4 vertices per face, nothing shared) or welded (8 vertices).
 pub fn cube(welded: bool) -> Mesh {
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for axis in 0..3 {
-        for side in [0.0f32, 1.0] {
-            let base = positions.len() as u32;
-            for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
-                let mut p = [0.0f32; 3];
-                p[axis] = side;
-                p[(axis + 1) % 3] = u;
-                p[(axis + 2) % 3] = v;
-                positions.push(Vec3::from(p));
-            }
-            if side == 0.0 {
-                triangles.push([base, base + 2, base + 1]);
-                triangles.push([base, base + 3, base + 2]);
-            } else {
-                triangles.push([base, base + 1, base + 2]);
-                triangles.push([base, base + 2, base + 3]);
-            }
-        }
-    }
+    let drafter_testkit::generate::TriMesh { mut positions, mut triangles } =
+        drafter_testkit::generate::unwelded_cube();
     if welded {
         let mut unique: Vec<Vec3> = Vec::new();
         let remap: Vec<u32> = positions
@@ -93,14 +74,11 @@ pub fn plane(n: u32) -> Mesh {
     }
     let id = |x: u32, y: u32| y * (n + 1) + x;
     let mut triangles = Vec::new();
-    let mut state = 0x9e37_79b9u32;
+    let mut rng = drafter_testkit::Rng::new(0x9e37_79b9);
     for y in 0..n {
         for x in 0..n {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
             let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
-            if state & 1 == 0 {
+            if rng.below(2) == 0 {
                 triangles.push([a, b, c]);
                 triangles.push([a, c, d]);
             } else {
