@@ -14,7 +14,7 @@
 //! port of draco's decoder, bitstream 2.2: sequential and edgebreaker connectivity, every
 //! prediction scheme, quantized and octahedral attributes), pinned exactly while it is an alpha and
 //! patched in `vendor/` (below).
-//! Compared on 2026-12-06 (2-core VM, issue 61):
+//! Compared on a 2-core VM:
 //!
 //! * **Correctness.** On the Khronos sample assets' Draco variants in `../shared/models`
 //!   (GearboxAssy: 42 streams, 409,264 triangles; Buggy: 148 streams, 278,672 triangles) it gives

@@ -1,4 +1,4 @@
-//! Saving an illustrator's edits (issue 15, Lux et al. 2013 §4) back into a baked file: the edited
+//! Saving an illustrator's edits (Lux et al. 2013 §4) back into a baked file: the edited
 //! part records are rewritten in place in the JSON, and every other byte of the file stays as it
 //! was — the binary chunk, the other records, the key order and the formatting — apart from the
 //! lengths in the GLB header and the JSON chunk's padding.

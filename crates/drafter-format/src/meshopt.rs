@@ -335,8 +335,8 @@ pub fn compress_glb(glb_bytes: &[u8]) -> Result<(Vec<u8>, CompressionStats), Mes
     }
 
     // Each view's bytes, codec stride and whether it is encoded, then every view encoded at once
-    // on the thread pool (the dragon's write stage with --compress 280 → 221 ms), then the new
-    // buffer assembled in view order.
+    // on the thread pool (the views are encoded independently), then the new buffer assembled in
+    // view order.
     struct Plan<'a> {
         bytes: &'a [u8],
         stride: usize,

@@ -320,8 +320,8 @@ pub fn write(out: &BakeOutput, container: &Container) -> Result<Written, FormatE
     let node_extension =
         |n: usize| node_parts.get(n).copied().flatten().map(|parts| serde_json::to_value(NodeExtensionRef { parts }));
     let mut edge_material: Option<usize> = None;
-    // Every primitive's new layout at once, on the thread pool; the document is then written in
-    // order (the dragon's write stage 59 → 52 ms, with --compress 345 → 272 ms).
+    // Every primitive's new layout at once, on the thread pool (the layouts do not depend on the
+    // document); the document is then written in order.
     let layouts: Vec<Vec<Relaid>> = scene
         .meshes
         .par_iter()
@@ -960,8 +960,8 @@ fn keep_node_tree(doc: &mut Doc) {
 /// A source baked before carries this format's records on its nodes, meshes and primitives, and
 /// the Khronos edges on its primitives: they describe the earlier bake, so they go, and this bake
 /// writes its own where it has them (the root's record is replaced whole anyway). Left in place, a
-/// record this bake did not replace contradicted the file or was not read at all (drafter-fuzz,
-/// issue 47): a mesh without silhouette candidates now kept the earlier candidates' count over
+/// record this bake did not replace contradicted the file or was not read at all (as drafter-fuzz
+/// found): a mesh without silhouette candidates now kept the earlier candidates' count over
 /// primitives that encode none; a node that is no instance now (its parent lost its `children`)
 /// kept the earlier part records, whatever they had become. Either file did not read back. The
 /// accessors they named are then unreferenced, and the compaction drops them.

@@ -1,4 +1,4 @@
-//! `KHR_draco_mesh_compression` decoding (issue 61), checked against independent data:
+//! `KHR_draco_mesh_compression` decoding, checked against independent data:
 //!
 //! * the Khronos sample assets' Draco variants in ../shared/models against their uncompressed
 //!   siblings: every primitive's triangles, matched with the same winding and positions within the
