@@ -63,18 +63,15 @@ fn to_py(e: &drafter_catalog::Error) -> PyErr {
 }
 
 /// The configuration from TOML text (`config_toml`) or JSON text of the same tables
-/// (`config_json`, what a Python dict becomes).
+/// (`config_json`, what a Python dict becomes), each read straight into the one config type and
+/// validated as `drafter bake --config` does.
 fn config(config_toml: Option<&str>, config_json: Option<&str>) -> PyResult<BakeConfig> {
-    let text = match (config_toml, config_json) {
-        (Some(toml), _) => toml.to_owned(),
-        (None, Some(json)) => {
-            let value: serde_json::Value =
-                serde_json::from_str(json).map_err(|e| InputError::new_err(format!("config: {e}")))?;
-            toml::to_string(&value).map_err(|e| InputError::new_err(format!("config: {e}")))?
-        }
-        (None, None) => return Ok(BakeConfig::default()),
-    };
-    drafter_catalog::job::config_from_toml(&text).map_err(InputError::new_err)
+    match (config_toml, config_json) {
+        (Some(toml), _) => drafter_catalog::job::config_from_toml(toml),
+        (None, Some(json)) => drafter_catalog::job::config_from_json(json),
+        (None, None) => Ok(BakeConfig::default()),
+    }
+    .map_err(InputError::new_err)
 }
 
 /// Runs `work` on `threads` threads of its own (the global pool when `None`).

@@ -140,14 +140,21 @@ pub fn is_batch(args: &Args) -> bool {
     args.inputs.len() > 1 || !args.manifest.is_empty() || args.inputs.first().is_some_and(|p| p.is_dir())
 }
 
-/// The configuration the options ask for: `--config`, then the flags over it.
+/// The configuration the options ask for: `--config`, then the flags over it, then checked once
+/// (an error names the config file, where there is one).
 fn config_from_args(args: &Args) -> Result<BakeConfig> {
-    let mut config = BakeConfig::default();
-    if let Some(path) = &args.config {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| BadInput(format!("{}: cannot read config: {e}", path.display())))?;
-        config.apply_toml(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
-    }
+    let in_file = |e: drafter_bake::BakeError| match &args.config {
+        Some(path) => BadInput(format!("{}: {e}", path.display())),
+        None => BadInput(e.to_string()),
+    };
+    let mut config = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| BadInput(format!("{}: cannot read config: {e}", path.display())))?;
+            BakeConfig::from_toml(&text).map_err(in_file)?
+        }
+        None => BakeConfig::default(),
+    };
     if let Some(mode) = args.segment {
         config.segment.mode = mode;
     }
@@ -155,7 +162,7 @@ fn config_from_args(args: &Args) -> Result<BakeConfig> {
         config.obb.method = method;
     }
     if args.compress {
-        config.compress = drafter_bake::Compression::Meshopt;
+        config.output.compress = drafter_bake::Compression::Meshopt;
     }
     if args.no_normals {
         config.normals.enabled = false;
@@ -163,6 +170,7 @@ fn config_from_args(args: &Args) -> Result<BakeConfig> {
     if args.enhanced_in_normal {
         config.normals.enhanced_in_normal = true;
     }
+    config.validate().map_err(in_file)?;
     Ok(config)
 }
 

@@ -103,8 +103,8 @@ fn exported_overrides_rebake_to_the_saved_records() {
     let editor = edit(&original);
     let toml = editor.overrides_toml("sample.baked.glb").expect("edits to export");
     assert_eq!(toml.matches("[[part]]").count(), 2, "{toml}");
-    let mut config = drafter_bake::BakeConfig::default();
-    config.apply_toml(&toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+    let config = drafter_bake::BakeConfig::from_toml(&toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+    config.validate().unwrap_or_else(|e| panic!("{e}\n{toml}"));
     let rebaked = bake(&config);
     let edited: Vec<PartRecord> = editor.records().cloned().collect();
     assert_eq!(records(&rebaked), edited, "{toml}");

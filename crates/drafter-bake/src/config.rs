@@ -1,4 +1,5 @@
-//! Bake options, and the `--config FILE.toml` that overrides them per part.
+//! Bake options: [`BakeConfig`], every option of a bake, which is also the `--config FILE.toml` that sets
+//! them (stage options and per-part overrides):
 //!
 //! ```toml
 //! [segment]
@@ -60,41 +61,164 @@
 //! flat = 0.0                 # a flat grey in [0, 1] instead of shading (0 black, 1 white)
 //! ```
 //!
-//! Unknown keys and out-of-range values are errors that name the key. An `anchor` and `scale` that
-//! leave a part no gradient (a scale at or below 1e-12 of the anchor's largest coordinate, or either
-//! beyond `f32`) are refused when the part's projector is made.
+//! The file is this module's [`BakeConfig`], read by serde and nothing else: each table is a field
+//! (`[[part]]` the [`BakeConfig::overrides`]), a key or table left out keeps its default (each type's
+//! `Default`, through `#[serde(default)]`), and an unknown key is an error that names it
+//! (`deny_unknown_fields`). Python's `config=` mapping is the same tables as JSON
+//! ([`BakeConfig::from_json`]). Reading checks types only; [`BakeConfig::validate`] then checks every
+//! range, once, after every source of options is applied (`drafter bake`'s flags go over the file),
+//! and its errors name the key. An `anchor` and `scale` that leave a part no gradient (a scale at or
+//! below 1e-12 of the anchor's largest coordinate, or either beyond `f32`) are refused when the
+//! part's projector is made.
 
 use drafter_bounds::{GradientParams, ObbMethod, ObbOptions, TransferCurve};
 use drafter_format::{Container, InputInfo, PartStyle};
 use drafter_normals::NormalsOptions;
-use drafter_segment::{SegmentMode, SegmentOptions};
+use drafter_segment::SegmentOptions;
 use drafter_textures::{CelOptions, CoolToWarmOptions, HatchingOptions, MetalOptions};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::BakeError;
 
-/// Every option of a bake, one struct per stage.
-#[derive(Clone, Debug, serde::Serialize)]
+/// Every option of a bake, one field per table of the config file (see the module docs).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct BakeConfig {
+    /// `[segment]`: `mode` and `region_angle_deg` (drafter-segment reads no other key).
     pub segment: SegmentOptions,
-    pub normals: NormalsStage,
-    pub lines: LinesStage,
-    pub textures: TexturesStage,
+    /// `[obb]`: `method` (drafter-bounds reads no other key).
     pub obb: ObbOptions,
-    /// The gradient parameters of every part without an override.
-    pub gradient: GradientParams,
-    pub transfer: TransferCurve,
-    /// Per-part overrides, applied in order (a later one wins).
+    /// `[gradient]`: the gradient of every part without an override.
+    pub gradient: GradientOptions,
+    /// `[normals]`.
+    pub normals: NormalsStage,
+    /// `[lines]`.
+    pub lines: LinesStage,
+    /// `[textures]`.
+    pub textures: TexturesStage,
+    /// `[output]`: how the written file is compressed (also `drafter bake --compress`).
+    pub output: OutputOptions,
+    /// `[[part]]`: per-part overrides, applied in order (a later one wins).
+    #[serde(rename = "part")]
     pub overrides: Vec<PartOverride>,
-    /// Provenance written into the file.
+    /// Provenance written into the file: the input's, never the config file's.
+    #[serde(skip_deserializing)]
     pub input: InputInfo,
+    /// The file layout written: the output's name decides it, never the config file.
+    #[serde(skip_deserializing)]
     pub container: Container,
-    /// How the written file is compressed (`[output] compress`, `drafter bake --compress`).
+}
+
+impl Default for BakeConfig {
+    fn default() -> Self {
+        Self {
+            segment: SegmentOptions::default(),
+            obb: ObbOptions::default(),
+            gradient: GradientOptions::default(),
+            normals: NormalsStage::default(),
+            lines: LinesStage::default(),
+            textures: TexturesStage::default(),
+            output: OutputOptions::default(),
+            overrides: Vec::new(),
+            input: InputInfo { name: String::new(), format: String::new(), sha256: String::new() },
+            container: Container::Glb,
+        }
+    }
+}
+
+impl BakeConfig {
+    /// The options a config file's TOML text sets (see the module docs), the rest at their
+    /// defaults. Types and keys are checked here, ranges by [`BakeConfig::validate`], which the
+    /// caller runs once it has applied its own options (as `drafter bake`'s flags) over these.
+    pub fn from_toml(text: &str) -> Result<Self, BakeError> {
+        toml::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))
+    }
+
+    /// The same tables as JSON (what Python's `config=` mapping becomes); as [`BakeConfig::from_toml`].
+    pub fn from_json(text: &str) -> Result<Self, BakeError> {
+        serde_json::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))
+    }
+
+    /// Checks every option against its documented range: the one check of a config, whether it
+    /// came from a file, flags, Python or code. The error names the key (`normals.strength = 9 is
+    /// outside [0, 5]`, `part[2]: scale = -1 must be finite and > 0`).
+    pub fn validate(&self) -> Result<(), BakeError> {
+        self.check().map_err(BakeError::Config)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        degrees("segment.region_angle_deg", self.segment.region_angle_deg)?;
+        let l = &self.lines;
+        degrees("lines.crease_angle_deg", l.crease_angle_deg)?;
+        if !(l.crease_min_length.is_finite() && l.crease_min_length >= 0.0) {
+            return Err(format!("lines.crease_min_length = {} must be a fraction >= 0", l.crease_min_length));
+        }
+        degrees("lines.strong_crease_deg", l.strong_crease_deg)?;
+        let n = &self.normals;
+        if !(0.0..=MAX_STRENGTH).contains(&n.strength) {
+            return Err(format!("normals.strength = {} is outside [0, {MAX_STRENGTH}]", n.strength));
+        }
+        if n.iterations > MAX_ITERATIONS {
+            return Err(format!("normals.iterations = {} is outside 0..={MAX_ITERATIONS}", n.iterations));
+        }
+        degrees("normals.crease_angle_deg", n.crease_angle_deg)?;
+        self.textures.validate()?;
+        let gradient = self.gradient.params();
+        gradient.validate().map_err(|e| format!("gradient: {e}"))?;
+        for (i, part) in self.overrides.iter().enumerate() {
+            part.validate(&gradient).map_err(|e| format!("part[{i}]: {e}"))?;
+        }
+        Ok(())
+    }
+}
+
+/// An angle in degrees, in [0, 180].
+fn degrees(key: &str, value: impl Into<f64> + std::fmt::Display + Copy) -> Result<(), String> {
+    if (0.0..=180.0).contains(&value.into()) { Ok(()) } else { Err(format!("{key} = {value} is outside [0, 180]")) }
+}
+
+/// `[gradient]`: the gradient function's parameters and transfer curve of every part without an
+/// override (drafter-core's `gradient` module defines them).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GradientOptions {
+    /// Quantisation, the number of bands. Default [`drafter_core::gradient::DEFAULT_QUANTIZATION`]
+    /// (10); range 1..=255.
+    pub q: u32,
+    /// Fade step inside a band. Default [`drafter_core::gradient::DEFAULT_FADE_STEP`] (0.5); range
+    /// [0, 1].
+    pub f: f32,
+    /// Power applied to the intensity. Default [`drafter_core::gradient::DEFAULT_POWER`] (1.0); range
+    /// [0.01, 10].
+    pub p: f32,
+    /// The transfer curve γ. Default [`TransferCurve::Identity`].
+    pub transfer: TransferCurve,
+}
+
+impl Default for GradientOptions {
+    fn default() -> Self {
+        let GradientParams { q, f, p } = GradientParams::default();
+        Self { q, f, p, transfer: TransferCurve::default() }
+    }
+}
+
+impl GradientOptions {
+    /// The `(q, f, p)` of the gradient function.
+    pub fn params(&self) -> GradientParams {
+        GradientParams { q: self.q, f: self.f, p: self.p }
+    }
+}
+
+/// `[output]`: what is done to the written file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OutputOptions {
+    /// Its compression. Default [`Compression::None`].
     pub compress: Compression,
 }
 
 /// Compression of the written file.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Compression {
     /// Plain buffers (the default): any glTF reader opens the file.
@@ -107,44 +231,59 @@ pub enum Compression {
     Meshopt,
 }
 
-impl Default for BakeConfig {
-    fn default() -> Self {
-        Self {
-            segment: SegmentOptions::default(),
-            normals: NormalsStage::default(),
-            lines: LinesStage::default(),
-            textures: TexturesStage::default(),
-            obb: ObbOptions::default(),
-            gradient: GradientParams::default(),
-            transfer: TransferCurve::default(),
-            overrides: Vec::new(),
-            input: InputInfo { name: String::new(), format: String::new(), sha256: String::new() },
-            container: Container::Glb,
-            compress: Compression::None,
-        }
-    }
-}
+/// Upper bound of [`NormalsStage::strength`].
+pub const MAX_STRENGTH: f32 = 5.0;
+/// Upper bound of [`NormalsStage::iterations`].
+pub const MAX_ITERATIONS: u32 = 200;
 
-/// The normal stage (Cignoni et al. 2005 enhancement + crease-aware vertex normals).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+/// `[normals]`, the normal stage (Cignoni et al. 2005 enhancement + crease-aware vertex normals).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct NormalsStage {
     /// Compute and write normals. Default true.
     pub enabled: bool,
-    /// Filter and layout options (defaults: drafter-normals').
-    pub options: NormalsOptions,
+    /// `k` of `n_E = normalize(n + k(n - n_L))`. Default [`drafter_normals::DEFAULT_STRENGTH`]
+    /// (0.5); range [0, [`MAX_STRENGTH`]].
+    pub strength: f32,
+    /// Low-pass iterations. Default [`drafter_normals::DEFAULT_ITERATIONS`] (20); range
+    /// 0..=[`MAX_ITERATIONS`].
+    pub iterations: u32,
+    /// Vertex normals are not averaged across edges sharper than this. Default
+    /// [`drafter_normals::DEFAULT_CREASE_ANGLE_DEG`] (30°); range [0, 180].
+    pub crease_angle_deg: f32,
     /// Write the enhanced normals into `NORMAL` (and the crease-aware ones into
     /// `_ENHANCED_NORMAL`), so plain viewers show the enhancement. Default false.
     pub enhanced_in_normal: bool,
 }
 
-impl Default for NormalsStage {
-    fn default() -> Self {
-        Self { enabled: true, options: NormalsOptions::default(), enhanced_in_normal: false }
+impl NormalsStage {
+    /// drafter-normals' options this stage asks for (its defaults for the rest).
+    pub fn options(&self) -> NormalsOptions {
+        let mut options = NormalsOptions::default();
+        options.enhance.strength = self.strength;
+        options.enhance.iterations = self.iterations;
+        options.crease.crease_angle_deg = self.crease_angle_deg;
+        options
     }
 }
 
-/// The line stage (edge classes, EXT_mesh_primitive_edge_visibility, silhouette hierarchies).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+impl Default for NormalsStage {
+    fn default() -> Self {
+        let options = NormalsOptions::default();
+        Self {
+            enabled: true,
+            strength: options.enhance.strength,
+            iterations: options.enhance.iterations,
+            crease_angle_deg: options.crease.crease_angle_deg,
+            enhanced_in_normal: false,
+        }
+    }
+}
+
+/// `[lines]`, the line stage (edge classes, EXT_mesh_primitive_edge_visibility, silhouette
+/// hierarchies).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct LinesStage {
     /// Classify and write edges. Default true.
     pub enabled: bool,
@@ -200,9 +339,12 @@ pub const DEFAULT_TEXTURE_STYLES: [PartStyle; 5] =
 /// Default of [`TexturesStage::metallic_threshold`]: a material at least half metallic is metal.
 pub const DEFAULT_METALLIC_THRESHOLD: f32 = 0.5;
 
-/// The textures stage: which NPR lookup textures (drafter-textures) are baked and embedded as PNG.
-/// What is baked when is documented in `crate::textures`.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+/// `[textures]`, the textures stage: which NPR lookup textures (drafter-textures) are baked and
+/// embedded as PNG. What is baked when is documented in `crate::textures`. A sub-table
+/// (`[textures.cel]`) replaces that texture's options, its keys left out at drafter-textures'
+/// defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TexturesStage {
     /// Bake and embed textures. Default true.
     pub enabled: bool,
@@ -256,7 +398,7 @@ impl TexturesStage {
 }
 
 /// Which parts an override applies to.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum PartSelector {
     /// Every part with this name.
     Name(String),
@@ -264,252 +406,48 @@ pub enum PartSelector {
     Id(u32),
 }
 
-/// Per-part settings from the config file; `None` keeps the computed value.
-#[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
+/// `[[part]]`: settings of the parts it selects (by `name` or by `id`, exactly one); `None` keeps
+/// the computed value.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PartOverride {
-    #[serde(skip_deserializing, default = "default_selector")]
-    pub selector: PartSelector,
-    #[serde(default)]
-    name: Option<String>,
-    #[serde(default)]
-    id: Option<u32>,
+    /// Selects every part with this name.
+    pub name: Option<String>,
+    /// Selects the part with this id.
+    pub id: Option<u32>,
     pub method: Option<ObbMethod>,
+    /// The projector's direction: finite, not zero; made unit.
     pub direction: Option<[f64; 3]>,
+    /// The projector's anchor: finite.
     pub anchor: Option<[f64; 3]>,
+    /// The projector's scale: finite, > 0.
     pub scale: Option<f64>,
+    /// The gradient's parameters, in the ranges of [`GradientOptions`].
     pub q: Option<u32>,
     pub f: Option<f32>,
     pub p: Option<f32>,
     pub transfer: Option<TransferCurve>,
-    /// Checked against the format's styles when the TOML is read (an unknown name is a config error).
+    /// The style hint (one of the format's styles; serde refuses another name).
     pub style: Option<PartStyle>,
     /// A flat grey in [0, 1] drawn instead of the part's shading (0 black, 1 white).
     pub flat: Option<f32>,
 }
 
-fn default_selector() -> PartSelector {
-    PartSelector::Id(u32::MAX)
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FileConfig {
-    #[serde(default)]
-    segment: SegmentSection,
-    #[serde(default)]
-    obb: ObbSection,
-    #[serde(default)]
-    gradient: GradientSection,
-    #[serde(default)]
-    normals: NormalsSection,
-    #[serde(default)]
-    lines: LinesSection,
-    #[serde(default)]
-    textures: TexturesSection,
-    #[serde(default)]
-    output: OutputSection,
-    #[serde(default, rename = "part")]
-    parts: Vec<PartOverride>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct OutputSection {
-    compress: Option<Compression>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SegmentSection {
-    mode: Option<SegmentMode>,
-    region_angle_deg: Option<f64>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LinesSection {
-    enabled: Option<bool>,
-    crease_angle_deg: Option<f32>,
-    crease_min_edges: Option<u32>,
-    crease_min_length: Option<f32>,
-    strong_crease_deg: Option<f32>,
-    hierarchies: Option<bool>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TexturesSection {
-    enabled: Option<bool>,
-    styles: Option<Vec<PartStyle>>,
-    metallic_threshold: Option<f32>,
-    metal: Option<MetalOptions>,
-    cool_to_warm: Option<CoolToWarmOptions>,
-    hatching: Option<HatchingOptions>,
-    cel: Option<CelOptions>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct NormalsSection {
-    enabled: Option<bool>,
-    strength: Option<f32>,
-    iterations: Option<u32>,
-    crease_angle_deg: Option<f32>,
-    enhanced_in_normal: Option<bool>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ObbSection {
-    method: Option<ObbMethod>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct GradientSection {
-    q: Option<u32>,
-    f: Option<f32>,
-    p: Option<f32>,
-    transfer: Option<TransferCurve>,
-}
-
-impl BakeConfig {
-    /// Applies a TOML config (see the module docs) on top of `self`. Errors name the key.
-    pub fn apply_toml(&mut self, text: &str) -> Result<(), BakeError> {
-        let file: FileConfig = toml::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))?;
-        if let Some(mode) = file.segment.mode {
-            self.segment.mode = mode;
-        }
-        if let Some(c) = file.output.compress {
-            self.compress = c;
-        }
-        if let Some(angle) = file.segment.region_angle_deg {
-            if !(0.0..=180.0).contains(&angle) {
-                return Err(BakeError::Config(format!("segment.region_angle_deg = {angle} is outside [0, 180]")));
-            }
-            self.segment.region_angle_deg = angle;
-        }
-        let l = &file.lines;
-        if let Some(enabled) = l.enabled {
-            self.lines.enabled = enabled;
-        }
-        if let Some(a) = l.crease_angle_deg {
-            if !(0.0..=180.0).contains(&a) {
-                return Err(BakeError::Config(format!("lines.crease_angle_deg = {a} is outside [0, 180]")));
-            }
-            self.lines.crease_angle_deg = a;
-        }
-        if let Some(n) = l.crease_min_edges {
-            self.lines.crease_min_edges = n;
-        }
-        if let Some(f) = l.crease_min_length {
-            if !(f.is_finite() && f >= 0.0) {
-                return Err(BakeError::Config(format!("lines.crease_min_length = {f} must be a fraction >= 0")));
-            }
-            self.lines.crease_min_length = f;
-        }
-        if let Some(a) = l.strong_crease_deg {
-            if !(0.0..=180.0).contains(&a) {
-                return Err(BakeError::Config(format!("lines.strong_crease_deg = {a} is outside [0, 180]")));
-            }
-            self.lines.strong_crease_deg = a;
-        }
-        if let Some(h) = l.hierarchies {
-            self.lines.hierarchies = h;
-        }
-        let n = &file.normals;
-        if let Some(enabled) = n.enabled {
-            self.normals.enabled = enabled;
-        }
-        if let Some(k) = n.strength {
-            if !(0.0..=5.0).contains(&k) {
-                return Err(BakeError::Config(format!("normals.strength = {k} is outside [0, 5]")));
-            }
-            self.normals.options.enhance.strength = k;
-        }
-        if let Some(i) = n.iterations {
-            if i > 200 {
-                return Err(BakeError::Config(format!("normals.iterations = {i} is outside 0..=200")));
-            }
-            self.normals.options.enhance.iterations = i;
-        }
-        if let Some(a) = n.crease_angle_deg {
-            if !(0.0..=180.0).contains(&a) {
-                return Err(BakeError::Config(format!("normals.crease_angle_deg = {a} is outside [0, 180]")));
-            }
-            self.normals.options.crease.crease_angle_deg = a;
-        }
-        if let Some(e) = n.enhanced_in_normal {
-            self.normals.enhanced_in_normal = e;
-        }
-        let t = file.textures;
-        if let Some(enabled) = t.enabled {
-            self.textures.enabled = enabled;
-        }
-        if let Some(styles) = t.styles {
-            self.textures.styles = styles;
-        }
-        if let Some(threshold) = t.metallic_threshold {
-            self.textures.metallic_threshold = threshold;
-        }
-        if let Some(metal) = t.metal {
-            self.textures.metal = metal;
-        }
-        if let Some(c) = t.cool_to_warm {
-            self.textures.cool_to_warm = c;
-        }
-        if let Some(h) = t.hatching {
-            self.textures.hatching = h;
-        }
-        if let Some(c) = t.cel {
-            self.textures.cel = c;
-        }
-        self.textures.validate().map_err(BakeError::Config)?;
-        if let Some(method) = file.obb.method {
-            self.obb.method = method;
-        }
-        let g = &file.gradient;
-        self.gradient = GradientParams {
-            q: g.q.unwrap_or(self.gradient.q),
-            f: g.f.unwrap_or(self.gradient.f),
-            p: g.p.unwrap_or(self.gradient.p),
-        };
-        self.gradient.validate().map_err(|e| BakeError::Config(format!("gradient: {e}")))?;
-        if let Some(t) = g.transfer {
-            self.transfer = t;
-        }
-        for (i, mut part) in file.parts.into_iter().enumerate() {
-            let at = format!("part[{i}]");
-            part.selector = match (part.name.take(), part.id.take()) {
-                (Some(name), None) => PartSelector::Name(name),
-                (None, Some(id)) => PartSelector::Id(id),
-                _ => return Err(BakeError::Config(format!("{at}: give exactly one of `name` or `id`"))),
-            };
-            part.validate(&self.gradient).map_err(|e| BakeError::Config(format!("{at}: {e}")))?;
-            self.overrides.push(part);
-        }
-        Ok(())
-    }
-}
-
 impl PartOverride {
     /// An override selecting `selector` and changing nothing yet.
     pub fn new(selector: PartSelector) -> Self {
-        Self {
-            selector,
-            name: None,
-            id: None,
-            method: None,
-            direction: None,
-            anchor: None,
-            scale: None,
-            q: None,
-            f: None,
-            p: None,
-            transfer: None,
-            style: None,
-            flat: None,
+        match selector {
+            PartSelector::Name(name) => Self { name: Some(name), ..Self::default() },
+            PartSelector::Id(id) => Self { id: Some(id), ..Self::default() },
+        }
+    }
+
+    /// The parts it selects: by `name`, else by `id` ([`BakeConfig::validate`] refuses an override
+    /// with both or neither; with neither it selects no part).
+    pub fn selector(&self) -> PartSelector {
+        match (&self.name, self.id) {
+            (Some(name), _) => PartSelector::Name(name.clone()),
+            (None, id) => PartSelector::Id(id.unwrap_or(u32::MAX)),
         }
     }
 
@@ -519,6 +457,9 @@ impl PartOverride {
     }
 
     fn validate(&self, base: &GradientParams) -> Result<(), String> {
+        if self.name.is_some() == self.id.is_some() {
+            return Err("give exactly one of `name` or `id`".into());
+        }
         self.gradient(base).validate().map_err(|e| e.to_string())?;
         if let Some(d) = self.direction {
             let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -552,11 +493,18 @@ fn one_line(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use drafter_segment::SegmentMode;
+
+    /// The config a TOML text gives, validated.
+    fn read(text: &str) -> Result<BakeConfig, BakeError> {
+        let config = BakeConfig::from_toml(text)?;
+        config.validate()?;
+        Ok(config)
+    }
 
     #[test]
     fn full_config_parses() {
-        let mut c = BakeConfig::default();
-        c.apply_toml(
+        let c = read(
             "[segment]\nmode = \"components\"\n[obb]\nmethod = \"optimal\"\n[gradient]\nq = 7\nf = 0.715\np = 1.4\n\
              [[part]]\nname = \"gear\"\nstyle = \"metal\"\ndirection = [0.0, 0.0, 2.0]\n[[part]]\nid = 3\nq = 17\n",
         )
@@ -565,15 +513,56 @@ mod tests {
         assert_eq!(c.obb.method, ObbMethod::Optimal);
         assert_eq!((c.gradient.q, c.gradient.f, c.gradient.p), (7, 0.715, 1.4));
         assert_eq!(c.overrides.len(), 2);
-        assert_eq!(c.overrides[0].selector, PartSelector::Name("gear".into()));
-        assert_eq!(c.overrides[1].selector, PartSelector::Id(3));
+        assert_eq!(c.overrides[0].selector(), PartSelector::Name("gear".into()));
+        assert_eq!(c.overrides[1].selector(), PartSelector::Id(3));
+    }
+
+    #[test]
+    fn an_empty_file_is_the_defaults_and_every_table_reads() {
+        let text = "[segment]\nmode = \"regions\"\nregion_angle_deg = 25.0\n[obb]\nmethod = \"pca\"\n\
+                    [gradient]\nq = 7\nf = 0.6\np = 1.3\ntransfer = \"smoothstep\"\n\
+                    [normals]\nenabled = false\nstrength = 0.7\niterations = 12\ncrease_angle_deg = 40.0\nenhanced_in_normal = true\n\
+                    [lines]\nenabled = false\ncrease_angle_deg = 35.0\ncrease_min_edges = 3\ncrease_min_length = 0.02\n\
+                    strong_crease_deg = 70.0\nhierarchies = false\n[output]\ncompress = \"meshopt\"\n";
+        let json = |c: &BakeConfig| serde_json::to_value(c).unwrap();
+        assert_eq!(json(&read("").unwrap()), json(&BakeConfig::default()));
+        let c = read(text).unwrap();
+        assert_eq!((c.segment.mode, c.segment.region_angle_deg), (SegmentMode::Regions, 25.0));
+        assert_eq!(c.segment.weld, SegmentOptions::default().weld, "not a key of the file");
+        assert_eq!(c.obb, ObbOptions::with_method(ObbMethod::Pca));
+        assert_eq!(c.gradient, GradientOptions { q: 7, f: 0.6, p: 1.3, transfer: TransferCurve::Smoothstep });
+        let n = c.normals;
+        assert_eq!(
+            (n.enabled, n.strength, n.iterations, n.crease_angle_deg, n.enhanced_in_normal),
+            (false, 0.7, 12, 40.0, true)
+        );
+        assert_eq!((n.options().enhance.strength, n.options().enhance.iterations), (0.7, 12));
+        assert_eq!(n.options().crease.crease_angle_deg, 40.0);
+        let l = c.lines;
+        assert_eq!((l.enabled, l.crease_angle_deg, l.crease_min_edges), (false, 35.0, 3));
+        assert_eq!((l.crease_min_length, l.strong_crease_deg, l.hierarchies), (0.02, 70.0, false));
+        assert_eq!(c.output.compress, Compression::Meshopt);
+        // The defaults are drafter-normals' and drafter-core's own.
+        let d = BakeConfig::default();
+        assert_eq!(d.normals.options(), NormalsOptions::default());
+        assert_eq!(d.gradient.params(), GradientParams::default());
+        // The same tables as JSON give the same config.
+        let from_json = BakeConfig::from_json(
+            r#"{"segment": {"mode": "regions", "region_angle_deg": 25}, "obb": {"method": "pca"},
+                "gradient": {"q": 7, "f": 0.6, "p": 1.3, "transfer": "smoothstep"},
+                "normals": {"enabled": false, "strength": 0.7, "iterations": 12, "crease_angle_deg": 40, "enhanced_in_normal": true},
+                "lines": {"enabled": false, "crease_angle_deg": 35, "crease_min_edges": 3, "crease_min_length": 0.02,
+                          "strong_crease_deg": 70, "hierarchies": false},
+                "output": {"compress": "meshopt"}}"#,
+        )
+        .unwrap();
+        assert_eq!(json(&from_json), json(&c));
     }
 
     #[test]
     fn textures_section_parses() {
-        let mut c = BakeConfig::default();
-        assert_eq!(c.textures.styles, DEFAULT_TEXTURE_STYLES);
-        c.apply_toml(
+        assert_eq!(BakeConfig::default().textures.styles, DEFAULT_TEXTURE_STYLES);
+        let c = read(
             "[textures]\nstyles = [\"gooch\"]\nmetallic_threshold = 0.9\n[textures.cool_to_warm]\nsplash_back = true\n\
              [textures.cel]\nsteps = 2\n",
         )
@@ -582,36 +571,67 @@ mod tests {
         assert_eq!(c.textures.metallic_threshold, 0.9);
         assert!(c.textures.cool_to_warm.splash_back);
         assert_eq!(c.textures.cool_to_warm.alpha, drafter_textures::cool_warm::DEFAULT_COOL_MIX);
+        // A table replaces that texture's options: the keys it leaves out are drafter-textures'.
         assert_eq!((c.textures.cel.steps, c.textures.cel.specular), (2, false));
+        assert!(BakeConfig::default().textures.cel.specular);
         assert!(c.textures.enabled);
-        c.apply_toml("[textures]\nenabled = false\n").unwrap();
-        assert!(!c.textures.enabled);
+        assert!(!read("[textures]\nenabled = false\n").unwrap().textures.enabled);
     }
 
     #[test]
     fn errors_name_the_key() {
         let cases = [
             ("[obb]\nmethdo = \"pca\"\n", "methdo"),
-            ("[gradient]\nq = 0\n", "q"),
-            ("[gradient]\np = 99.0\n", "p"),
+            ("[obb]\nhull_tolerance = 0.1\n", "hull_tolerance"),
+            ("[segment]\nweld = \"exact\"\n", "weld"),
+            ("[gradient]\nq = 0\n", "gradient: q"),
+            ("[gradient]\np = 99.0\n", "gradient: p"),
+            ("[gradient]\ntransfer = \"sigmoid\"\n", "sigmoid"),
             ("[[part]]\nname = \"a\"\nstyle = \"neon\"\n", "style"),
-            ("[[part]]\nname = \"a\"\nid = 2\n", "exactly one"),
-            ("[[part]]\nid = 1\nscale = -1.0\n", "scale"),
-            ("[[part]]\nid = 1\ndirection = [0.0, 0.0, 0.0]\n", "direction"),
+            ("[[part]]\nname = \"a\"\nid = 2\n", "part[0]: give exactly one"),
+            ("[[part]]\nq = 2\n", "part[0]: give exactly one"),
+            ("[[part]]\nid = 1\nscale = -1.0\n", "part[0]: scale"),
+            ("[[part]]\nid = 1\n[[part]]\nid = 1\ndirection = [0.0, 0.0, 0.0]\n", "part[1]: direction"),
+            ("[[part]]\nid = 1\nflat = 1.5\n", "flat"),
+            ("[[part]]\nid = 1\nq = 300\n", "part[0]: q"),
             ("[segment]\nmode = \"blobs\"\n", "blobs"),
-            ("[normals]\nstrength = 9.0\n", "strength"),
+            ("[segment]\nregion_angle_deg = 190.0\n", "segment.region_angle_deg = 190"),
+            ("[normals]\nstrength = 9.0\n", "normals.strength = 9"),
+            ("[normals]\nstrength = nan\n", "normals.strength = NaN"),
+            ("[normals]\niterations = 201\n", "normals.iterations = 201"),
+            ("[normals]\ncrease_angle_deg = -1.0\n", "normals.crease_angle_deg"),
             ("[normals]\nsmooth = true\n", "smooth"),
+            ("[lines]\ncrease_angle_deg = 181.0\n", "lines.crease_angle_deg"),
+            ("[lines]\nstrong_crease_deg = 181.0\n", "lines.strong_crease_deg"),
+            ("[lines]\ncrease_min_length = -0.5\n", "lines.crease_min_length"),
             ("[textures]\nstyles = [\"neon\"]\n", "neon"),
             ("[textures]\nmetallic_threshold = -1.0\n", "metallic_threshold"),
             ("[textures.cel]\nsteps = 9\n", "textures.cel.steps"),
             ("[textures.metal]\nexponent = 0.0\n", "textures.metal.exponent"),
             ("[textures.hatching]\nsize = 100\n", "textures.hatching.size"),
             ("[textures]\nhatch = true\n", "hatch"),
+            ("[output]\nlevel = 3\n", "level"),
+            ("input = \"x\"\n", "input"),
+            ("container = \"gltf\"\n", "container"),
         ];
         for (text, needle) in cases {
-            let err = BakeConfig::default().apply_toml(text).unwrap_err().to_string();
+            let err = read(text).unwrap_err().to_string();
             assert!(err.contains(needle), "{text:?}: {err}");
+            assert!(err.starts_with("config: "), "{text:?}: {err}");
             assert!(!err.contains('\n'), "multi-line: {err}");
         }
+        let err = BakeConfig::from_json(r#"{"normals": {"smooth": true}}"#).unwrap_err().to_string();
+        assert!(err.contains("smooth"), "{err}");
+    }
+
+    #[test]
+    fn validate_checks_options_set_in_code_too() {
+        let mut c = BakeConfig::default();
+        assert!(c.validate().is_ok());
+        c.lines.strong_crease_deg = 200.0;
+        assert!(c.validate().unwrap_err().to_string().contains("lines.strong_crease_deg"));
+        let mut c = BakeConfig::default();
+        c.overrides.push(PartOverride { scale: Some(0.0), ..PartOverride::new(PartSelector::Id(0)) });
+        assert!(c.validate().unwrap_err().to_string().contains("part[0]: scale"));
     }
 }

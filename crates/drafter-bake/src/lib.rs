@@ -42,8 +42,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use config::{
-    BakeConfig, Compression, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, LinesStage, NormalsStage,
-    PartOverride, PartSelector, TexturesStage,
+    BakeConfig, Compression, DEFAULT_METALLIC_THRESHOLD, DEFAULT_TEXTURE_STYLES, GradientOptions, LinesStage,
+    NormalsStage, OutputOptions, PartOverride, PartSelector, TexturesStage,
 };
 pub use split::SplitSummary;
 pub use textures::{TextureReport, TexturesSummary};
@@ -229,7 +229,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     // Compressed output: triangles and vertices in the orders the codecs compress best, before
     // any stage, so that everything is computed on what the file holds (`reorder.rs`).
     let reordered;
-    let scene = if config.compress == Compression::Meshopt && config.container == Container::Glb {
+    let scene = if config.output.compress == Compression::Meshopt && config.container == Container::Glb {
         reordered = reorder::for_compression(scene);
         &reordered
     } else {
@@ -322,7 +322,7 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
         primitive_edges,
         mesh_silhouettes,
         textures: embedded,
-        quantized_normals: config.compress == Compression::Meshopt && config.container == Container::Glb,
+        quantized_normals: config.output.compress == Compression::Meshopt && config.container == Container::Glb,
     };
     let written = drafter_format::write(&output, &config.container).map_err(|e| match e {
         // The input's own JSON that cannot be carried over (a number beyond f64, nesting deeper
@@ -374,9 +374,9 @@ fn root_record(scene: &Scene, config: &BakeConfig, part_count: u32) -> RootExten
         scene_center: center.to_array(),
         part_count,
         normals: config.normals.enabled.then(|| NormalsInfo {
-            strength: f64::from(config.normals.options.enhance.strength),
-            iterations: config.normals.options.enhance.iterations,
-            crease_angle_deg: f64::from(config.normals.options.crease.crease_angle_deg),
+            strength: f64::from(config.normals.strength),
+            iterations: config.normals.iterations,
+            crease_angle_deg: f64::from(config.normals.crease_angle_deg),
             enhanced_in_normal: config.normals.enhanced_in_normal,
         }),
         textures: None,
@@ -409,7 +409,7 @@ fn compress(
     config: &BakeConfig,
     written: &mut Written,
 ) -> Result<Option<drafter_format::meshopt::CompressionStats>, BakeError> {
-    match (config.compress, &config.container) {
+    match (config.output.compress, &config.container) {
         (Compression::None, _) => Ok(None),
         (Compression::Meshopt, Container::Glb) => {
             let (main, stats) = drafter_format::meshopt::compress_glb(&written.main)
@@ -452,7 +452,7 @@ fn normals_and_split<'a>(
     // the lines stage so that its per-primitive data is per chunk. Triangles keep their order. (Timed
     // with the normals: a pass over the triangles, not a stage of its own in the progress line.)
     let (splits, split_summary) = split::split_scene(scene, &vertex_data);
-    let compressing = config.compress == Compression::Meshopt && config.container == Container::Glb;
+    let compressing = config.output.compress == Compression::Meshopt && config.container == Container::Glb;
     let mut vertex_data = vertex_data;
     let written_scene: Cow<Scene> = if splits.iter().all(Option::is_none) && !compressing {
         Cow::Borrowed(scene)
@@ -496,7 +496,7 @@ fn compute_normals(
                 return None;
             }
             let topology = &topologies[m];
-            let mut options = stage.options;
+            let mut options = stage.options();
             options.crease.keep_input_seams = mesh.uvs.is_some();
             let (normals, diagnostics) = drafter_normals::compute_normals(mesh, topology, &options);
             let (plain, enhanced) = if stage.enhanced_in_normal {
@@ -954,7 +954,7 @@ fn settings_echo(config: &BakeConfig) -> serde_json::Value {
         "normals": {"enabled": config.normals.enabled},
         "lines": {"enabled": config.lines.enabled, "creaseAngleDeg": config.lines.crease_angle_deg, "creaseMinEdges": config.lines.crease_min_edges, "creaseMinLength": config.lines.crease_min_length, "strongCreaseDeg": config.lines.strong_crease_deg, "hierarchies": config.lines.hierarchies},
         "textures": {"enabled": config.textures.enabled, "styles": config.textures.styles, "metallicThreshold": config.textures.metallic_threshold},
-        "gradient": {"q": config.gradient.q, "f": config.gradient.f, "p": config.gradient.p, "transfer": config.transfer},
+        "gradient": {"q": config.gradient.q, "f": config.gradient.f, "p": config.gradient.p, "transfer": config.gradient.transfer},
         "partOverrides": config.overrides.len(),
     })
 }
@@ -964,13 +964,13 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
     // Resolve overrides to part ids first, so a selector that matches nothing is reported.
     let mut per_part: Vec<Vec<&PartOverride>> = vec![Vec::new(); parts.len()];
     for o in &config.overrides {
-        let matched: Vec<usize> = if match &o.selector {
+        let matched: Vec<usize> = if match &o.selector() {
             PartSelector::Id(id) => (*id as usize) < parts.len(),
             PartSelector::Name(_) => true,
         } {
             {
                 (0..parts.len())
-                    .filter(|&p| match &o.selector {
+                    .filter(|&p| match &o.selector() {
                         PartSelector::Id(id) => p == *id as usize,
                         PartSelector::Name(n) => &parts.parts[p].name == n,
                     })
@@ -980,7 +980,7 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
             Default::default()
         };
         if matched.is_empty() {
-            let what = match &o.selector {
+            let what = match &o.selector() {
                 PartSelector::Id(id) => format!("id {id} (the scene has {} parts)", parts.len()),
                 PartSelector::Name(n) => format!("name {n:?}"),
             };
@@ -1011,8 +1011,8 @@ fn bound_parts(scene: &Scene, parts: &Parts, config: &BakeConfig) -> Result<Vec<
             .map_err(|e| BakeError::Internal { stage: "bounds", message: format!("part {p} ({}): {e}", part.name) })?;
             let fitted = Projector::from_obb(&obb, center);
             let mut projector = fitted;
-            let mut gradient = config.gradient;
-            let mut transfer = config.transfer;
+            let mut gradient = config.gradient.params();
+            let mut transfer = config.gradient.transfer;
             let mut style = None;
             let mut flat = None;
             for o in overrides {

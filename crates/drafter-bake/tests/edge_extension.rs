@@ -82,7 +82,8 @@ fn no_written_primitive_has_an_all_zero_bitfield() {
     let sample = include_bytes!("../../../samples/assembly.glb");
     let imported = drafter_io::import_bytes(std::path::Path::new("assembly.glb"), sample).expect("sample");
     for compress in [drafter_bake::Compression::None, drafter_bake::Compression::Meshopt] {
-        let config = drafter_bake::BakeConfig { compress, ..Default::default() };
+        let config =
+            drafter_bake::BakeConfig { output: drafter_bake::OutputOptions { compress }, ..Default::default() };
         let baked = drafter_bake::bake(&imported.scene, &config).expect("bake");
         let plain = drafter_format::meshopt::decompress_glb(&baked.written.main).expect("decode");
         let bytes = plain.as_deref().unwrap_or(&baked.written.main);

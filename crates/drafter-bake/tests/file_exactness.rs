@@ -26,7 +26,7 @@ fn model(rel: &str) -> PathBuf {
 
 fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
     let imported = drafter_io::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let config = drafter_bake::BakeConfig { compress, ..Default::default() };
+    let config = drafter_bake::BakeConfig { output: drafter_bake::OutputOptions { compress }, ..Default::default() };
     let baked = drafter_bake::bake(&imported.scene, &config).expect("bakes");
     let bytes = baked.written.main;
     if compress == drafter_bake::Compression::None {
@@ -132,7 +132,8 @@ fn compressed_files_decode_to_the_plain_data_and_stay_exact() {
     let path = model("obj/common-3d-test-models/fandisk.obj");
     let imported = drafter_io::import(&path).expect("imports");
     let bake = |compress| {
-        let config = drafter_bake::BakeConfig { compress, ..Default::default() };
+        let config =
+            drafter_bake::BakeConfig { output: drafter_bake::OutputOptions { compress }, ..Default::default() };
         drafter_bake::bake(&imported.scene, &config).expect("bakes")
     };
     let (plain, packed) = (bake(drafter_bake::Compression::None), bake(drafter_bake::Compression::Meshopt));

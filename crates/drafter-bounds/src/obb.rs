@@ -97,7 +97,9 @@ pub const DEFAULT_EXHAUSTIVE_HULL_FACES: usize = 64;
 /// Default of [`ObbOptions::optimal_budget`].
 pub const DEFAULT_OPTIMAL_BUDGET: u64 = 100_000_000;
 
-/// Options of [`oriented_box`].
+/// Options of [`oriented_box`]. serde reads `method`, the choice a user makes (a bake config's `[obb]`
+/// table, any other key refused); the other fields are tuning that reading leaves at its default, and
+/// all are written.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ObbOptions {
@@ -105,10 +107,12 @@ pub struct ObbOptions {
     pub method: ObbMethod,
     /// Relative hull tolerance (see [`crate::HullOptions::tolerance`]). Default
     /// [`DEFAULT_HULL_TOLERANCE`] (1e-10); range [0, 1e-3].
+    #[serde(skip_deserializing)]
     pub hull_tolerance: f64,
     /// `Default` method: how many of the largest distinct hull faces are tried as box face normals.
     /// Default [`DEFAULT_FACE_NORMALS`] (48); range 1..=100 000 (more = slower and tighter; `Optimal`
     /// tries all).
+    #[serde(skip_deserializing)]
     pub default_face_normals: usize,
     /// `Optimal` method: the most elementary steps (a few nanoseconds each) that each of its searches
     /// may take: face normals × hull triangles for the face search (beyond it only the largest faces are
@@ -116,6 +120,7 @@ pub struct ObbOptions {
     /// See [`ObbStats::face_search`] and [`ObbStats::edge_search`]. Default [`DEFAULT_OPTIMAL_BUDGET`]
     /// (1e8: at most about half a second per search on one core); 0 keeps only the refinement and the
     /// [`DEFAULT_FACE_NORMALS`] largest faces.
+    #[serde(skip_deserializing)]
     pub optimal_budget: u64,
 }
 

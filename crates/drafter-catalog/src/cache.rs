@@ -709,7 +709,7 @@ mod tests {
         let text = form.to_string();
         let again: serde_json::Value = serde_json::from_str(&text).expect("JSON");
         assert_eq!(again.to_string(), text, "read back and written again, the same text");
-        for stage in ["segment", "normals", "lines", "textures", "obb", "gradient", "transfer", "overrides"] {
+        for stage in ["segment", "normals", "lines", "textures", "obb", "gradient", "output", "part"] {
             assert!(form.get(stage).is_some(), "{stage} missing from {form}");
         }
         assert!(form.get("input").is_none());

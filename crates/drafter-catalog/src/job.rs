@@ -112,9 +112,18 @@ pub fn input_name(path: &Path) -> String {
     path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
-/// A config from TOML text on top of the defaults, as `--config` applies it.
+/// A config from TOML text on top of the defaults, as `--config` reads it, validated.
 pub fn config_from_toml(text: &str) -> Result<BakeConfig, String> {
-    let mut config = BakeConfig::default();
-    config.apply_toml(text).map_err(|e| e.to_string())?;
+    validated(BakeConfig::from_toml(text))
+}
+
+/// A config from the same tables as JSON (Python's `config=` mapping), validated.
+pub fn config_from_json(text: &str) -> Result<BakeConfig, String> {
+    validated(BakeConfig::from_json(text))
+}
+
+fn validated(config: Result<BakeConfig, BakeError>) -> Result<BakeConfig, String> {
+    let config = config.map_err(|e| e.to_string())?;
+    config.validate().map_err(|e| e.to_string())?;
     Ok(config)
 }

@@ -262,8 +262,11 @@ pub enum FanPairing {
     Partial,
 }
 
-/// Options of [`segment`].
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// Options of [`segment`]. serde reads `mode` and `region_angle_deg`, the choices a user makes (a bake
+/// config's `[segment]` table, any other key refused); the other fields are tuning that reading
+/// leaves at its default, and all are written.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SegmentOptions {
     /// How to cut. Default [`SegmentMode::Auto`].
     pub mode: SegmentMode,
@@ -274,30 +277,37 @@ pub struct SegmentOptions {
     /// [`SegmentMode::Auto`]: a part with fewer than this fraction of the mesh's triangles (and a
     /// small diagonal, below) may be merged into a neighbour. Default
     /// [`DEFAULT_MERGE_TRIANGLE_FRACTION`]; range 0–1, 0 turns merging off.
+    #[serde(skip_deserializing)]
     pub merge_triangle_fraction: f64,
     /// [`SegmentMode::Auto`]: a part whose bounding-box diagonal is below this fraction of the
     /// mesh's (and with few triangles, above) may be merged into a neighbour. Default
     /// [`DEFAULT_MERGE_DIAGONAL_FRACTION`]; range 0–1, 0 turns merging off.
+    #[serde(skip_deserializing)]
     pub merge_diagonal_fraction: f64,
     /// [`SegmentMode::Auto`]: a small part is near a neighbour where a vertex of its free boundary
     /// comes this close to one of the neighbour's triangles, as a fraction of the mesh's bounding
     /// diagonal. Default [`DEFAULT_TOUCH_FRACTION`]; range 0–1.
+    #[serde(skip_deserializing)]
     pub touch_fraction: f64,
     /// [`SegmentMode::Auto`]: through contacts that share no welded vertex (see the crate docs), a
     /// part takes in at most this fraction of its core component's triangles, in all, so wrong
     /// merges cost little: such a part is at least `1 / (1 + f)` its core. Merges through shared
     /// vertices are not capped. Default [`DEFAULT_MAX_ABSORBED_FRACTION`]; range 0–∞, 0 allows
     /// shared-vertex merges only.
+    #[serde(skip_deserializing)]
     pub max_absorbed_fraction: f64,
     /// [`SegmentMode::Auto`]: open pieces whose free edges lie on each other's, within this
     /// fraction of the mesh's bounding diagonal, are glued across the crack (see the crate docs,
     /// "Cracks"). Default [`DEFAULT_STITCH_FRACTION`]; 0 turns gluing off.
+    #[serde(skip_deserializing)]
     pub stitch_fraction: f64,
     /// How non-manifold fans that do not alternate are paired (all modes but `Nodes`). Default
     /// [`FanPairing::Partial`].
+    #[serde(skip_deserializing)]
     pub fan_pairing: FanPairing,
     /// How positions are welded before connectivity is derived (all modes but `Nodes`). Default
     /// [`Weld::default`]. Ignored by [`segment_with_topologies`] for meshes whose topology is given.
+    #[serde(skip_deserializing)]
     pub weld: Weld,
 }
 
