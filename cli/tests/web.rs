@@ -402,6 +402,43 @@ fn a_lost_webgpu_device_falls_back_to_webgl2() {
     assert_eq!(json["viewerState"]["style"], "gooch", "the settings were not kept: {json}");
 }
 
+/// The element reacts to its attributes after it started: shading, edges, lines, shadow and view
+/// apply to the model shown, over what the user chose by key; a value it does not know is an
+/// error on the page, as at the start.
+#[test]
+fn attributes_changed_later_apply_to_the_model_shown() {
+    let sets = ["shading=cel", "shadow=soft", "edges=off", "view=90,10"];
+    let mut args = vec!["--edges", "--lines", "--keys", "3"];
+    for set in &sets {
+        args.extend(["--set", set]);
+    }
+    let json = probe(&sample(), &args);
+    assert_eq!(json["state"], "ready", "{json}");
+    let state = &json["viewerState"];
+    assert_eq!(state["style"], "cel", "{json}");
+    assert_eq!(state["shadow"], "soft", "{json}");
+    assert_eq!(state["edges"], false, "{json}");
+    assert_eq!(state["lines"], true, "{json}");
+    assert_eq!((state["azimuth"].as_f64(), state["elevation"].as_f64()), (Some(90.0), Some(10.0)), "{json}");
+
+    let bad = probe(&sample(), &["--set", "shading=bogus"]);
+    assert_eq!(bad["state"], "error", "{bad}");
+    assert!(bad["message"].as_str().is_some_and(|m| m.contains("\"bogus\" is not one of")), "{bad}");
+    assert!(bad["consoleErrors"].as_array().is_some_and(Vec::is_empty), "{bad}");
+}
+
+/// Taken off the page, the element frees its viewer (and with it the GPU device); put back, it
+/// starts again and shows its model.
+#[test]
+fn an_element_taken_off_the_page_frees_its_viewer_and_starts_again() {
+    let json = probe(&sample(), &["--reattach"]);
+    assert_eq!(json["detached"]["viewer"], Value::Null, "the viewer was kept: {json}");
+    assert_eq!(json["detached"]["state"], "starting", "{json}");
+    assert_eq!(json["state"], "ready", "{json}");
+    assert_eq!(json["summary"]["triangles"], 10_028, "{json}");
+    assert!(json["consoleErrors"].as_array().is_some_and(Vec::is_empty), "{json}");
+}
+
 /// Pixels darker than a line's grey in every channel.
 fn dark_pixels(image: &Image) -> usize {
     image.rgba.chunks_exact(4).filter(|p| p[0].max(p[1]).max(p[2]) < 96).count()

@@ -64,7 +64,7 @@ for (const file of files) {
         wasmReady: t.wasmReady,
         surface: s.surface,
         renderer: s.renderer,
-        read: json.summary?.loadMs?.read,
+        read: json.summary?.readMs,
         firstDraw: t.firstFrame - t.modelLoaded,
       };
       rows.push(row);

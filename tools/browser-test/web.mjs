@@ -20,11 +20,14 @@
 //   bad [--max-triangles N]
 //       Loads FILE, which should be refused (or the page's parameters, --param). Prints {ok, state,
 //       message, ms, consoleErrors}; ok when the page shows an error message within the timeout.
-//   probe [--controls] [--keys K] [--reload] [--drop F1,F2,...] [--lose-device] [--help-key]
+//   probe [--controls] [--keys K] [--reload] [--drop F1,F2,...] [--lose-device] [--set NAME=VALUE]
+//         [--reattach] [--help-key]
 //       Loads FILE, then, in this order: types the keys K (one character each); sets the element's
 //       src again (a new load of FILE); drops the files F1,F2,... on the element at once (as a user
-//       selecting them); destroys the GPU device (viewer.lose_device()); presses ?. Waits for the
-//       page to settle after each. Prints {ok, state, message, notice, backend, viewerState,
+//       selecting them); destroys the GPU device (viewer.lose_device()); sets the element's
+//       attributes (--set, repeatable; an empty VALUE removes it) and waits two frames; takes the
+//       element off the page (reporting `detached`: its viewer freed, its state) and puts it back;
+//       presses ?. Waits for the page to settle after each. Prints {ok, state, message, notice, backend, viewerState,
 //       summary, layout, labels, help, consoleErrors}: layout holds the toolbar's, the canvas's and
 //       the notice's rectangles (CSS pixels) and modelTop, the first canvas row that is not
 //       background in CSS pixels from the page's top; labels the accessible name of each control;
@@ -49,12 +52,13 @@ import { startServer } from './lib/server.mjs';
 
 function parse(argv) {
   const [command, pageDir, file, ...rest] = argv;
-  const options = { backend: 'webgl2', timeout: process.env.DRAFTER_WEB_TIMEOUT ?? '120', size: '800x600', view: '35,25', shadow: 'none', param: [] };
-  const flags = ['edges', 'lines', 'no-src', 'capture', 'no-size', 'controls', 'reload', 'lose-device', 'help-key'];
+  const options = { backend: 'webgl2', timeout: process.env.DRAFTER_WEB_TIMEOUT ?? '120', size: '800x600', view: '35,25', shadow: 'none', param: [], set: [] };
+  const flags = ['edges', 'lines', 'no-src', 'capture', 'no-size', 'controls', 'reload', 'lose-device', 'help-key', 'reattach'];
   for (let i = 0; i < rest.length; i++) {
     const name = rest[i].replace(/^--/, '');
     if (flags.includes(name)) options[name] = true;
     else if (name === 'param') options.param.push(rest[++i]);
+    else if (name === 'set') options.set.push(rest[++i]);
     else options[name] = rest[++i];
   }
   if (!command || !pageDir || !file) throw new Error('usage: web.mjs shots|interact|bad|probe PAGE_DIR FILE [options]');
@@ -111,6 +115,31 @@ async function probe(page, options, file, settled, timeoutMs) {
     await page.evaluate(() => document.getElementById('viewer').viewer.lose_device());
     settled = await settle(page, timeoutMs, before);
   }
+  if (settled && options.set.length) {
+    await page.evaluate(async (pairs) => {
+      const v = document.getElementById('viewer');
+      for (const pair of pairs) {
+        const [name, ...value] = pair.split('=');
+        if (value.join('=') === '') v.removeAttribute(name);
+        else v.setAttribute(name, value.join('='));
+      }
+      await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+    }, options.set);
+  }
+  let detached = null;
+  if (settled && options.reattach) {
+    const before = await loads();
+    detached = await page.evaluate(() => {
+      const v = document.getElementById('viewer');
+      const parent = v.parentNode;
+      const next = v.nextSibling;
+      v.remove();
+      const report = { viewer: v.viewer === null ? null : 'kept', state: v.state };
+      parent.insertBefore(v, next);
+      return report;
+    });
+    settled = await settle(page, timeoutMs, before);
+  }
   if (settled && options['help-key']) {
     await page.focus('#viewer');
     await page.keyboard.press('?');
@@ -158,7 +187,7 @@ async function probe(page, options, file, settled, timeoutMs) {
       message: v.message,
       notice: !root.querySelector('.notice') || root.querySelector('.notice').hidden ? '' : v.notice,
       backend: v.viewer?.backend() ?? null,
-      viewerState: v.viewer ? JSON.parse(v.viewer.state()) : null,
+      viewerState: v.viewer ? v.viewState() : null,
       summary: v.summary,
       layout: {
         toolbar: rect(root.querySelector('.bar')),
@@ -170,7 +199,7 @@ async function probe(page, options, file, settled, timeoutMs) {
       help: { shown: Boolean(help && !help.hidden), text: help && !help.hidden ? help.textContent : '' },
     };
   });
-  return { ok: settled, ...report };
+  return { ok: settled, detached, ...report };
 }
 
 async function main() {
@@ -315,7 +344,7 @@ async function main() {
           v.draw(false);
           return v.canvas.toDataURL('image/png');
         });
-      const state = () => page.evaluate(() => JSON.parse(document.getElementById('viewer').viewer.state()));
+      const state = () => page.evaluate(() => document.getElementById('viewer').viewState());
       const before = await state();
       const firstImage = await pixels();
       // A left drag across the middle of the canvas, in steps, as a user's.

@@ -13,6 +13,10 @@
 // "webgl2"; default: either), max-triangles (default 5,000,000), controls ("none" hides the
 // toolbar), offscreen (present: nothing is drawn into the canvas, frames come from
 // viewer.capture(); for tests). A value the element does not know is an error on the page.
+// Changed later, src loads the new file, shading, edges, lines, shadow and view apply to the model
+// shown, size and controls to the layout; backend, offscreen and max-triangles are read when the
+// element starts (and max-triangles at each load). Taken off the page, the element frees its
+// viewer and GPU device; put back, it starts again.
 // A file dropped on the element replaces the model: a .glb, or a .gltf together with its .bin and
 // images (selected and dropped at once). Style, edges, lines and shadow stay as they are.
 //
@@ -24,15 +28,61 @@
 // For scripts and tests the element reports `state` ("starting", "loading", "ready", "error",
 // "empty"), `message` (the error shown), `notice` (the note shown under the model, e.g. an unbaked
 // file or a WebGPU device that was lost), `summary` (what was loaded), `timings` (ms since the
-// page's start: wasmReady, viewerCreated, fileFetched, modelLoaded, firstFrame) and fires "drafter-ready" /
+// page's start: contextCreated (where the WebGL2 context was made early), wasmReady, viewerCreated,
+// fileFetched, modelLoaded, firstFrame), `startup` (ms of the viewer's creation steps) and fires "drafter-ready" /
 // "drafter-error".
 
-import init, { Viewer } from './drafter_web.js';
+import init, { KeyEffect, Viewer } from './drafter_web.js';
+
+// The module is fetched and compiled by a worker, so that the main thread is free meanwhile to
+// create the canvas's WebGL2 context: a call that blocks until the browser's GPU process has the
+// context up, which in a freshly started browser is its largest step (docs/web.md). A browser
+// that refuses the worker, or a host that serves the module with another MIME type, falls back
+// to compiling here.
+const COMPILER = `onmessage = async (e) => {
+  let compiled = null;
+  try {
+    compiled = await WebAssembly.compileStreaming(fetch(e.data));
+  } catch {
+    try { compiled = await WebAssembly.compile(await (await fetch(e.data)).arrayBuffer()); } catch {}
+  }
+  postMessage(compiled);
+};`;
+
+function compileInWorker(url) {
+  return new Promise((resolve) => {
+    let worker;
+    try {
+      worker = new Worker(URL.createObjectURL(new Blob([COMPILER], { type: 'text/javascript' })));
+    } catch {
+      resolve(null);
+      return;
+    }
+    const done = (compiled) => {
+      worker.terminate();
+      resolve(compiled instanceof WebAssembly.Module ? compiled : null);
+    };
+    worker.onmessage = (e) => done(e.data);
+    worker.onerror = () => done(null);
+    worker.postMessage(url.href);
+  });
+}
 
 let module;
 function loadModule() {
-  module ??= init({ module_or_path: new URL('drafter_web_bg.wasm', import.meta.url) });
+  const url = new URL('drafter_web_bg.wasm', import.meta.url);
+  module ??= compileInWorker(url).then((compiled) => init({ module_or_path: compiled ?? url }));
   return module;
+}
+
+/** A module object's fields (its getters) as a plain object, which scripts and tests can copy; frees it. */
+function fields(object) {
+  const out = {};
+  for (const [key, d] of Object.entries(Object.getOwnPropertyDescriptors(Object.getPrototypeOf(object)))) {
+    if (d.get) out[key] = object[key];
+  }
+  object.free();
+  return out;
 }
 
 const STYLES = ['gradient', 'cel', 'gooch', 'goochel', 'phong', 'metal', 'hatch'];
@@ -203,7 +253,7 @@ async function inlineGltf(bytes, name, read, dropped) {
 }
 
 export class DrafterViewer extends HTMLElement {
-  static observedAttributes = ['src'];
+  static observedAttributes = ['src', 'shading', 'edges', 'lines', 'shadow', 'view', 'size', 'controls'];
 
   constructor() {
     super();
@@ -213,6 +263,9 @@ export class DrafterViewer extends HTMLElement {
     this.summary = null;
     this.timings = {};
     this.viewer = null;
+    /** Counts the times the element left the page: a start or load under way stops at its next step when it changes. */
+    this.generation = 0;
+    this.onDeviceLost = (e) => e.detail && this.deviceLost(e.detail);
     this.name = 'model';
     this.queued = false;
     this.drag = null;
@@ -235,11 +288,59 @@ export class DrafterViewer extends HTMLElement {
 
   connectedCallback() {
     if (!this.hasAttribute('tabindex')) this.tabIndex = 0;
+    addEventListener('drafter-device-lost', this.onDeviceLost);
     this.started ??= this.start();
   }
 
+  /** Taken off the page: the viewer and its GPU device are freed. Put back, the element starts again. */
+  disconnectedCallback() {
+    removeEventListener('drafter-device-lost', this.onDeviceLost);
+    this.generation += 1;
+    this.viewer?.free();
+    this.viewer = null;
+    this.started = null;
+    this.state = 'starting';
+  }
+
+  /**
+   * An attribute changed after the element started: a new `src` loads; the settings (shading,
+   * edges, lines, shadow, view) apply to the model shown, over what the user chose; `size` and
+   * `controls` change the layout. A value the element does not know is an error on the page, as
+   * at the start. (`backend`, `offscreen` and `max-triangles` are read when the element starts and
+   * when a file loads.)
+   */
   attributeChangedCallback(name, old, value) {
-    if (name === 'src' && value && old !== null && this.viewer) this.loadUrl(value);
+    if (old === value || !this.viewer) return;
+    if (name === 'src') {
+      if (value) this.loadUrl(value);
+      return;
+    }
+    if (name === 'controls') {
+      this.bar.hidden = value === 'none';
+      return;
+    }
+    let attributes;
+    try {
+      attributes = readAttributes(this);
+    } catch (err) {
+      this.fail(`Cannot show the model: ${err.message}`);
+      return;
+    }
+    if (this.state !== 'ready') return;
+    const v = this.viewer;
+    const key = { shading: 'style', edges: 'edges', lines: 'lines', shadow: 'shadow' }[name];
+    if (key) {
+      delete this.choices[key];
+      const carries = Boolean(this.summary?.lines);
+      const fallback = { style: STYLES[0], edges: carries, lines: carries, shadow: SHADOWS[0] }[key]; // the defaults
+      const chosen = attributes[key] ?? fallback;
+      if (key === 'style') v.set_style(chosen);
+      else if (key === 'edges') v.set_edges(chosen);
+      else if (key === 'lines') v.set_lines(chosen);
+      else v.set_shadow(chosen);
+      this.syncControls();
+    } else if (name === 'view' && attributes.view) v.set_view(attributes.view[0], attributes.view[1], 1);
+    this.redraw();
   }
 
   /** Shows `text` over the canvas (an error in red) and records it. */
@@ -272,15 +373,41 @@ export class DrafterViewer extends HTMLElement {
     else if (shown) this.focus();
   }
 
+  /**
+   * Creates the canvas's WebGL2 context now, while the module compiles, where WebGL2 is what the
+   * viewer will draw with: asked for, or the browser gives no WebGPU adapter. The viewer then takes
+   * this context (wgpu asks for the same attributes). Returns whether it did.
+   */
+  async prepareContext() {
+    const backend = this.getAttribute('backend');
+    if (backend !== null && backend !== 'webgl2') return false;
+    if (backend === null && navigator.gpu) {
+      const adapter = await navigator.gpu.requestAdapter().catch(() => null);
+      if (adapter) return false;
+    }
+    this.sizeCanvas();
+    return this.canvas.getContext('webgl2', { antialias: false }) !== null;
+  }
+
   async start() {
+    const generation = this.generation;
+    const loading = loadModule();
+    loading.catch(() => {}); // reported below
+    // Attributes a page sets right after the element is defined (index.html) are there on the next task.
+    await new Promise((resolve) => setTimeout(resolve, 0));
+    // The file downloads, and the context is created, while the module compiles.
+    let src = this.getAttribute('src');
+    let pending = src ? this.fetchModel(src) : null;
+    pending?.catch(() => {}); // reported by loadUrl
+    if (await this.prepareContext()) this.timings.contextCreated = performance.now();
     try {
-      await loadModule();
+      await loading;
     } catch (err) {
       this.fail(`This browser cannot run the viewer: ${err.message ?? err}`);
       return;
     }
     this.timings.wasmReady = performance.now();
-    // Attributes a page sets right after the element is defined are there by now.
+    if (generation !== this.generation) return;
     let attributes;
     try {
       this.bar.hidden = this.getAttribute('controls') === 'none';
@@ -290,15 +417,21 @@ export class DrafterViewer extends HTMLElement {
       return;
     }
     this.bindEvents();
-    // The file downloads while the device is requested.
-    const src = this.getAttribute('src');
-    const pending = src ? this.fetchModel(src) : null;
-    pending?.catch(() => {}); // reported by loadUrl
+    if (this.getAttribute('src') !== src) {
+      src = this.getAttribute('src');
+      pending = src ? this.fetchModel(src) : null;
+      pending?.catch(() => {});
+    }
     try {
       this.sizeCanvas();
-      this.viewer = await Viewer.create(this.canvas, attributes.backend ?? '');
+      const viewer = await Viewer.create(this.canvas, attributes.backend ?? '');
+      if (generation !== this.generation) {
+        viewer.free();
+        return;
+      }
+      this.viewer = viewer;
       this.timings.viewerCreated = performance.now();
-      this.startup = JSON.parse(this.viewer.startup());
+      this.startup = fields(this.viewer.startup());
     } catch (err) {
       this.fail(`This browser cannot run the viewer: ${err.message ?? err}`);
       return;
@@ -398,9 +531,10 @@ export class DrafterViewer extends HTMLElement {
     this.say(`reading ${name} (${(bytes.length / 1e6).toFixed(1)} MB)...`);
     // Let the message paint before the (synchronous) load.
     await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+    if (!this.viewer) return; // taken off the page meanwhile
     try {
       const attributes = readAttributes(this);
-      this.summary = JSON.parse(this.viewer.load(bytes, name, attributes.maxTriangles));
+      this.summary = fields(this.viewer.load(bytes, name, attributes.maxTriangles));
       this.model = { bytes, name };
       this.name = name.replace(/\.[^.]*$/, '');
       this.timings.modelLoaded = performance.now();
@@ -448,7 +582,7 @@ export class DrafterViewer extends HTMLElement {
     const v = this.viewer;
     const carries = Boolean(this.summary.lines);
     const pick = (key, fromAttribute, fallback) => this.choices[key] ?? fromAttribute ?? fallback;
-    v.set_style(pick('style', attributes.style, JSON.parse(v.state()).style));
+    v.set_style(pick('style', attributes.style, this.viewState().style));
     v.set_edges(pick('edges', attributes.edges, carries));
     v.set_lines(pick('lines', attributes.lines, carries));
     v.set_shadow(pick('shadow', attributes.shadow, 'none'));
@@ -468,8 +602,13 @@ export class DrafterViewer extends HTMLElement {
     this.syncControls();
   }
 
+  /** The frame's settings: style, edges, lines, shadow, orthographic, azimuth, elevation, zoom, panX, panY, width, height. */
+  viewState() {
+    return fields(this.viewer.state());
+  }
+
   syncControls() {
-    const s = JSON.parse(this.viewer.state());
+    const s = this.viewState();
     this.controls.style.value = s.style;
     this.controls.edges.checked = s.edges;
     this.controls.lines.checked = s.lines;
@@ -485,9 +624,9 @@ export class DrafterViewer extends HTMLElement {
 
   /** Runs `change` (a user's key or control) and remembers the settings it changed for the next file. */
   userChange(change) {
-    const before = JSON.parse(this.viewer.state());
+    const before = this.viewState();
     const result = change();
-    const after = JSON.parse(this.viewer.state());
+    const after = this.viewState();
     for (const key of KEPT) if (before[key] !== after[key]) this.choices[key] = after[key];
     return result;
   }
@@ -540,12 +679,12 @@ export class DrafterViewer extends HTMLElement {
     }
     if (this.state !== 'ready') return false;
     const what = this.userChange(() => this.viewer.key(key));
-    if (what === 'screenshot') this.screenshot();
-    else if (what === 'redraw') {
+    if (what === KeyEffect.Screenshot) this.screenshot();
+    else if (what === KeyEffect.Redraw) {
       this.syncControls();
       this.redraw();
     }
-    return what !== '';
+    return what !== KeyEffect.Nothing;
   }
 
   /**
@@ -556,7 +695,7 @@ export class DrafterViewer extends HTMLElement {
     if (!this.viewer || detail.id !== this.viewer.id()) return;
     const old = this.viewer;
     const wasWebGpu = /WebGpu/i.test(old.backend());
-    const settings = JSON.parse(old.state());
+    const settings = this.viewState();
     this.viewer = null;
     this.state = 'loading';
     if (!wasWebGpu) {
@@ -595,6 +734,8 @@ export class DrafterViewer extends HTMLElement {
   }
 
   bindEvents() {
+    if (this.bound) return;
+    this.bound = true;
     const c = this.controls;
     const change = (f) => () => {
       if (this.state !== 'ready') return;
@@ -618,15 +759,7 @@ export class DrafterViewer extends HTMLElement {
       const own = e.composedPath()[0] === this || ['?', 'Escape'].includes(e.key);
       if (own && this.key(e.key)) e.preventDefault();
     });
-    addEventListener('drafter-device-lost', (e) => {
-      let detail;
-      try {
-        detail = JSON.parse(e.detail);
-      } catch {
-        return;
-      }
-      this.deviceLost(detail);
-    });
+    addEventListener('drafter-device-lost', this.onDeviceLost);
     this.bindCanvas(this.canvas);
     new ResizeObserver(() => this.redraw()).observe(this.stage);
 

@@ -27,9 +27,120 @@ pub fn start() {
     }));
 }
 
-/// The event a lost device fires on the window: `detail` is the JSON `{"id", "reason", "message"}`,
-/// `id` the lost viewer's [`Viewer::id`] (the page re-creates that viewer on WebGL2).
+/// The event a lost device fires on the window: `detail` is a [`DeviceLoss`] (the page re-creates
+/// that viewer on WebGL2).
 pub const DEVICE_LOST_EVENT: &str = "drafter-device-lost";
+
+/// The `detail` of a [`DEVICE_LOST_EVENT`].
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug)]
+pub struct DeviceLoss {
+    /// The lost viewer's [`Viewer::id`].
+    #[wasm_bindgen(readonly)]
+    pub id: u32,
+    /// wgpu's reason, as its name (`Destroyed`, `Unknown`).
+    #[wasm_bindgen(readonly)]
+    pub reason: String,
+    /// The browser's message.
+    #[wasm_bindgen(readonly)]
+    pub message: String,
+}
+
+/// What [`Viewer::load`] read. Field names are the page's (camelCase).
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug)]
+pub struct Summary {
+    /// The file's name, as given.
+    #[wasm_bindgen(readonly)]
+    pub name: String,
+    #[wasm_bindgen(readonly)]
+    pub triangles: u32,
+    #[wasm_bindgen(readonly)]
+    pub parts: u32,
+    /// Baked hard edges (creases and boundaries) the lines pass draws.
+    #[wasm_bindgen(readonly, js_name = hardEdges)]
+    pub hard_edges: u32,
+    /// The file carries `DRAFTER_illustration` data.
+    #[wasm_bindgen(readonly)]
+    pub baked: bool,
+    /// The file carries baked lines for the lines pass.
+    #[wasm_bindgen(readonly)]
+    pub lines: bool,
+    /// What the load noted (textures baked or computed, parts, …), one line each.
+    #[wasm_bindgen(readonly)]
+    pub notices: Vec<String>,
+    /// Milliseconds reading the file into the CPU model.
+    #[wasm_bindgen(readonly, js_name = readMs)]
+    pub read_ms: f64,
+    /// Milliseconds uploading it.
+    #[wasm_bindgen(readonly, js_name = uploadMs)]
+    pub upload_ms: f64,
+}
+
+/// The frame's settings ([`Viewer::state`]).
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug)]
+pub struct ViewState {
+    /// The scene's style by name (`gradient`, `phong`, …).
+    #[wasm_bindgen(readonly)]
+    pub style: String,
+    #[wasm_bindgen(readonly)]
+    pub edges: bool,
+    #[wasm_bindgen(readonly)]
+    pub lines: bool,
+    /// The drop shadow by name (`none`, `hard`, `penumbra`, `soft`).
+    #[wasm_bindgen(readonly)]
+    pub shadow: String,
+    #[wasm_bindgen(readonly)]
+    pub orthographic: bool,
+    #[wasm_bindgen(readonly)]
+    pub azimuth: f32,
+    #[wasm_bindgen(readonly)]
+    pub elevation: f32,
+    #[wasm_bindgen(readonly)]
+    pub zoom: f32,
+    /// The pan, in the orbit's units, x and y.
+    #[wasm_bindgen(readonly, js_name = panX)]
+    pub pan_x: f32,
+    #[wasm_bindgen(readonly, js_name = panY)]
+    pub pan_y: f32,
+    /// The frame's size in canvas pixels.
+    #[wasm_bindgen(readonly)]
+    pub width: u32,
+    #[wasm_bindgen(readonly)]
+    pub height: u32,
+}
+
+/// Where [`Viewer::create`]'s time went, in milliseconds.
+#[wasm_bindgen]
+#[derive(Clone, Copy, Debug)]
+pub struct Startup {
+    /// The instance, with WebGPU's detection where it may be used.
+    #[wasm_bindgen(readonly)]
+    pub instance: f64,
+    /// The canvas's context.
+    #[wasm_bindgen(readonly)]
+    pub surface: f64,
+    #[wasm_bindgen(readonly)]
+    pub adapter: f64,
+    #[wasm_bindgen(readonly)]
+    pub device: f64,
+    /// The passes' shaders and layouts (pipelines compile at the first frame that uses them).
+    #[wasm_bindgen(readonly)]
+    pub renderer: f64,
+}
+
+/// What a typed key did ([`Viewer::key`]).
+#[wasm_bindgen]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeyEffect {
+    /// The key means nothing here.
+    Nothing = 0,
+    /// The frame changed: draw again.
+    Redraw = 1,
+    /// `p`: the page saves the canvas.
+    Screenshot = 2,
+}
 
 /// The next [`Viewer::id`].
 static NEXT_ID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(1);
@@ -39,9 +150,9 @@ static NEXT_ID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new
 fn announce_device_loss(id: u32, reason: wgpu::DeviceLostReason, message: &str) {
     let reason = format!("{reason:?}");
     web_sys::console::warn_1(&format!("drafter: the GPU device was lost ({reason}): {message}").into());
-    let detail = serde_json::json!({ "id": id, "reason": reason, "message": message }).to_string();
+    let detail = DeviceLoss { id, reason, message: message.to_owned() };
     let init = web_sys::CustomEventInit::new();
-    init.set_detail(&JsValue::from_str(&detail));
+    init.set_detail(&JsValue::from(detail));
     if let (Some(window), Ok(event)) =
         (web_sys::window(), web_sys::CustomEvent::new_with_event_init_dict(DEVICE_LOST_EVENT, &init))
     {
@@ -61,8 +172,8 @@ pub struct Viewer {
     orbit: Orbit,
     model: Option<Model>,
     backend: String,
-    /// Milliseconds of [`Viewer::create`]'s steps, as JSON (see [`Viewer::startup`]).
-    startup: String,
+    /// Milliseconds of [`Viewer::create`]'s steps.
+    startup: Startup,
 }
 
 /// Resolves on a later task of the page's event loop (`setTimeout(…, 0)`).
@@ -79,6 +190,16 @@ async fn next_task() -> Result<(), JsError> {
 
 fn js_error(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// Milliseconds to a tenth.
+fn ms(d: std::time::Duration) -> f64 {
+    (d.as_secs_f64() * 1e4).round() / 10.0
+}
+
+/// A count for the page (JavaScript numbers; a model this large was refused long before).
+fn saturating_u32(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
 }
 
 #[wasm_bindgen]
@@ -140,24 +261,20 @@ impl Viewer {
         };
         surface.configure(&gpu.device, &config);
         let renderer = Renderer::with_gpu(gpu, format).map_err(js_error)?;
-        let ms = |d: std::time::Duration| (d.as_secs_f64() * 1e4).round() / 10.0;
-        let startup = serde_json::json!({
-            "instance": ms(instanced),
-            "surface": ms(surfaced - instanced),
-            "adapter": ms(adapted - surfaced),
-            "device": ms(requested - adapted),
-            "renderer": ms(start.elapsed() - requested),
-        })
-        .to_string();
+        let startup = Startup {
+            instance: ms(instanced),
+            surface: ms(surfaced - instanced),
+            adapter: ms(adapted - surfaced),
+            device: ms(requested - adapted),
+            renderer: ms(start.elapsed() - requested),
+        };
         let options = RenderOptions { size: (width, height), interactive_scale, ..RenderOptions::default() };
         Ok(Viewer { id, renderer, surface, config, options, orbit: Orbit::default(), model: None, backend, startup })
     }
 
-    /// Where [`Viewer::create`]'s time went, in milliseconds, as JSON: `instance` (with WebGPU's
-    /// detection where it may be used), `surface` (the canvas's context), `adapter`, `device`, `renderer` (the passes' shaders and layouts;
-    /// pipelines compile at the first frame that uses them).
-    pub fn startup(&self) -> String {
-        self.startup.clone()
+    /// Where [`Viewer::create`]'s time went.
+    pub fn startup(&self) -> Startup {
+        self.startup
     }
 
     /// This viewer's number on the page: the `id` of its [`DEVICE_LOST_EVENT`].
@@ -183,11 +300,9 @@ impl Viewer {
     }
 
     /// Loads a model from its bytes (`name` for messages and to tell the format); refuses one that
-    /// lists more than `max_triangles` triangles. Returns a JSON summary (triangles, parts,
-    /// notices, hard edges; `baked`: the file carries `DRAFTER_illustration` data; `lines`: it
-    /// carries baked lines for the lines pass). The view is reset; the style and the other
+    /// lists more than `max_triangles` triangles. The view is reset; the style and the other
     /// settings are kept.
-    pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<String, JsError> {
+    pub fn load(&mut self, bytes: &[u8], name: &str, max_triangles: f64) -> Result<Summary, JsError> {
         let limits = drafter_io::Limits { max_triangles: max_triangles.max(0.0) as u64 };
         let start = web_time::Instant::now();
         // The silhouette hierarchies wait until the first frame is on screen (`complete_load`).
@@ -196,20 +311,19 @@ impl Viewer {
         self.renderer.set_model(&model).map_err(js_error)?;
         let uploaded = start.elapsed();
         self.orbit = Orbit::default();
-        let ms = |d: std::time::Duration| (d.as_secs_f64() * 1e4).round() / 10.0;
-        let summary = serde_json::json!({
-            // Where the load's time went: reading the file into the CPU model, then the upload.
-            "loadMs": { "read": ms(read), "upload": ms(uploaded - read) },
-            "name": name,
-            "triangles": model.triangle_count(),
-            "parts": model.parts.len(),
-            "hardEdges": self.renderer.hard_edge_count(),
-            "baked": model.baked,
-            "lines": !model.lines.is_empty(),
-            "notices": model.notices,
-        });
+        let summary = Summary {
+            name: name.to_owned(),
+            triangles: saturating_u32(model.triangle_count()),
+            parts: saturating_u32(model.parts.len()),
+            hard_edges: self.renderer.hard_edge_count(),
+            baked: model.baked,
+            lines: !model.lines.is_empty(),
+            notices: model.notices.clone(),
+            read_ms: ms(read),
+            upload_ms: ms(uploaded - read),
+        };
         self.model = Some(model);
-        Ok(summary.to_string())
+        Ok(summary)
     }
 
     /// Builds part of what [`Viewer::load`] left for after the first frame: the silhouette
@@ -286,17 +400,16 @@ impl Viewer {
     }
 
     /// What a typed key does, as in the window (`1`–`7` styles, `s` next style, `e` edges, `l`
-    /// lines, `h` next shadow, `o` orthographic, `r` reset): `"redraw"` when the frame changed,
-    /// `"screenshot"` for `p` (the page saves the canvas), `""` otherwise.
-    pub fn key(&mut self, key: &str) -> String {
+    /// lines, `h` next shadow, `o` orthographic, `r` reset, `p` screenshot).
+    pub fn key(&mut self, key: &str) -> KeyEffect {
         let mut chars = key.chars();
-        let (Some(c), None) = (chars.next(), chars.next()) else { return String::new() };
+        let (Some(c), None) = (chars.next(), chars.next()) else { return KeyEffect::Nothing };
         match action_for_char(c) {
-            Some(Action::Screenshot) => "screenshot".into(),
-            Some(Action::Quit) | None => String::new(),
+            Some(Action::Screenshot) => KeyEffect::Screenshot,
+            Some(Action::Quit) | None => KeyEffect::Nothing,
             Some(action) => {
                 action.apply(&mut self.options, &mut self.orbit);
-                "redraw".into()
+                KeyEffect::Redraw
             }
         }
     }
@@ -362,20 +475,21 @@ impl Viewer {
         Ok(readback.image().map_err(js_error)?.rgba)
     }
 
-    /// The frame's settings as JSON: style, edges, lines, shadow, orthographic, view and zoom.
-    pub fn state(&self) -> String {
-        serde_json::json!({
-            "style": self.options.style.name(),
-            "edges": self.options.enhancements.any(),
-            "lines": self.options.lines,
-            "shadow": self.options.shadow.name(),
-            "orthographic": self.options.orthographic,
-            "azimuth": self.orbit.view.azimuth_deg,
-            "elevation": self.orbit.view.elevation_deg,
-            "zoom": self.orbit.zoom,
-            "pan": self.orbit.pan,
-            "size": [self.options.size.0, self.options.size.1],
-        })
-        .to_string()
+    /// The frame's settings.
+    pub fn state(&self) -> ViewState {
+        ViewState {
+            style: self.options.style.name().to_owned(),
+            edges: self.options.enhancements.any(),
+            lines: self.options.lines,
+            shadow: self.options.shadow.name().to_owned(),
+            orthographic: self.options.orthographic,
+            azimuth: self.orbit.view.azimuth_deg,
+            elevation: self.orbit.view.elevation_deg,
+            zoom: self.orbit.zoom,
+            pan_x: self.orbit.pan[0],
+            pan_y: self.orbit.pan[1],
+            width: self.options.size.0,
+            height: self.options.size.1,
+        }
     }
 }
