@@ -1,4 +1,4 @@
-//! The heap between stages: freed arrays are reused, or handed back before the lines stage.
+//! The heap policy a process that bakes may choose: freed arrays kept and reused between stages.
 //!
 //! A bake allocates and frees arrays of tens of megabytes stage after stage. Two glibc habits cost
 //! memory or time there:
@@ -13,19 +13,15 @@
 //! [`keep_freed_memory`], for a process that bakes (the command-line tool calls it first thing), turns
 //! both off: one arena, no block mappings, no trimming. Freed blocks stay in one heap and the next
 //! stage reuses them: about half the page faults, at the same peak (docs/bench.md, "Heap reuse", has
-//! the figures and the command; mimalloc, measured there too, kept more at the peak). In a process
-//! that did not call it (a library user with its own allocator policy), [`release_free_memory`]
-//! instead returns the free pages of every arena to the kernel as the lines stage starts, where a
-//! bake's memory peaks.
+//! the figures and the command; mimalloc, measured there too, kept more at the peak).
+//!
+//! The allocator is the process's, so the policy is the program's choice: a bake itself sets none
+//! and trims nothing. A process that does not call these functions (Python, a library user with its
+//! own allocator policy, the tests) bakes under glibc's defaults.
 //!
 //! The crate's one `unsafe` place: calls into the C library with no preconditions beyond the one
 //! stated. Off glibc (musl, macOS, Windows) there is nothing to call.
 #![allow(unsafe_code)]
-
-use std::sync::atomic::{AtomicBool, Ordering};
-
-/// Set once [`keep_freed_memory`] has run: the process keeps freed blocks for reuse.
-static KEEPING: AtomicBool = AtomicBool::new(false);
 
 /// Keeps freed heap memory in one glibc arena for reuse instead of unmapping or trimming it (see the
 /// module docs). Call it first thing in `main`, while the process has one thread; the memory a bake
@@ -41,7 +37,6 @@ pub fn keep_freed_memory() {
         libc::mallopt(libc::M_MMAP_MAX, 0);
         // The top of the heap is never given back while the process runs.
         libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
-        KEEPING.store(true, Ordering::Relaxed);
     }
 }
 
@@ -55,18 +50,5 @@ pub fn keep_freed_memory_in(arenas: usize) {
     // SAFETY: as in `keep_freed_memory`: allocator parameters only, before other threads exist.
     unsafe {
         libc::mallopt(libc::M_ARENA_MAX, i32::try_from(arenas.max(1)).unwrap_or(i32::MAX));
-    }
-}
-
-/// Returns the free pages of glibc's arenas to the kernel, unless [`keep_freed_memory`] asked to keep
-/// them; a no-op off glibc. Only unused memory is touched: the bake's data and its output do not change.
-pub(crate) fn release_free_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    if !KEEPING.load(Ordering::Relaxed) {
-        // SAFETY: `malloc_trim` only gives unused heap pages back to the kernel; any thread may call it
-        // at any time.
-        unsafe {
-            libc::malloc_trim(0);
-        }
     }
 }

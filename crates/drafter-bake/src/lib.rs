@@ -281,9 +281,6 @@ pub fn bake_observed(scene: &Scene, config: &BakeConfig, on_stage: &mut dyn FnMu
     diagnostics.extend(normal_diagnostics);
     timed(Stage::Bounds, bounds_time);
     timed(Stage::Normals, normals_time);
-    // The lines stage is where a bake's memory peaks: it starts from what is live (`heap.rs`), unless
-    // the process keeps freed memory for reuse.
-    heap::release_free_memory();
     begin(Stage::Normals);
 
     let start = begin(Stage::Lines);
