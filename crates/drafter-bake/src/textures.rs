@@ -123,11 +123,34 @@ pub(crate) fn request(records: &[PartRecord], metal: &[u32], stage: &TexturesSta
 /// Requests remembered by [`bake_memoized`]: a batch's files mostly ask for the same few.
 const MEMO_ENTRIES: usize = 8;
 
+/// The lookup key of [`bake_memoized`], serialized: every option of the request by its serde form
+/// (floats in their shortest round-trip form, as the cache key has the configuration), the metal
+/// parts, and the threshold by its bits (so that no two thresholds share a key, as two non-finite
+/// floats would in JSON, where both are `null`).
+#[derive(Serialize)]
+struct MemoKey<'a> {
+    /// [`MEMO_FORM`].
+    form: &'static str,
+    request: &'a TextureRequest,
+    metal_parts: &'a [u32],
+    threshold_bits: u32,
+}
+
+/// The version of [`MemoKey`]'s form. The memo lives in one process, so a change of form can never
+/// meet an old key; the tag keeps the key self-describing like the cache's (`drafter-catalog`).
+const MEMO_FORM: &str = "drafter-textures-memo-json-1";
+
+/// [`MemoKey`] as JSON; `None` if it does not serialize.
+fn memo_key(request: &TextureRequest, metal_parts: &[u32], threshold: f32) -> Option<String> {
+    let key = MemoKey { form: MEMO_FORM, request, metal_parts, threshold_bits: threshold.to_bits() };
+    serde_json::to_string(&key).ok()
+}
+
 /// [`bake`], remembered for the process: the images are a function of the request, the metal parts
 /// and the threshold alone (the stage's own determinism), so a process that bakes many files (a
 /// batch, the Python package) computes and encodes each distinct set once. The lookup key is the
-/// arguments' `Debug` text, which lists every option. On a small part the stage is most of the bake;
-/// the bytes written do not change.
+/// arguments' canonical serialization ([`MemoKey`] as JSON), which holds every option. On a small part
+/// the stage is most of the bake; the bytes written do not change.
 pub(crate) fn bake_memoized(
     request: &TextureRequest,
     metal_parts: Vec<u32>,
@@ -135,7 +158,9 @@ pub(crate) fn bake_memoized(
 ) -> Result<BakedTextures, BakeError> {
     use std::sync::{Arc, Mutex};
     static MEMO: Mutex<Vec<(String, Arc<BakedTextures>)>> = Mutex::new(Vec::new());
-    let key = format!("{request:?}|{metal_parts:?}|{threshold:?}");
+    // The request's types serialize to JSON without fail (no map with other than string keys); were
+    // one to fail, the textures are baked without the memo.
+    let Some(key) = memo_key(request, &metal_parts, threshold) else { return bake(request, metal_parts, threshold) };
     let found = {
         let memo = MEMO.lock().unwrap_or_else(|e| e.into_inner());
         memo.iter().find(|(k, _)| *k == key).map(|(_, v)| Arc::clone(v))
@@ -289,6 +314,24 @@ mod tests {
 
     fn stage(styles: &[PartStyle]) -> TexturesStage {
         TexturesStage { styles: styles.to_vec(), ..TexturesStage::default() }
+    }
+
+    #[test]
+    fn the_memo_key_is_the_same_for_the_same_arguments_and_follows_every_option() {
+        let request = request(&[record(0, TransferCurve::Smoothstep, None)], &[0], &stage(&[PartStyle::Gradient]));
+        let key = memo_key(&request, &[0], 0.5).expect("serializes");
+        assert!(key.contains(MEMO_FORM), "{key}");
+        assert_eq!(memo_key(&request.clone(), &[0], 0.5).as_ref(), Some(&key), "deterministic");
+        let mut other = request.clone();
+        other.metal.as_mut().expect("a metal part asks for the metal textures").seed += 1;
+        assert_ne!(memo_key(&other, &[0], 0.5).as_ref(), Some(&key), "an option");
+        assert_ne!(memo_key(&request, &[1], 0.5).as_ref(), Some(&key), "the metal parts");
+        assert_ne!(memo_key(&request, &[0], 0.25).as_ref(), Some(&key), "the threshold");
+        assert_ne!(
+            memo_key(&request, &[0], f32::NAN),
+            memo_key(&request, &[0], f32::INFINITY),
+            "non-finite thresholds"
+        );
     }
 
     #[test]

@@ -49,6 +49,10 @@ const MAGIC: &[u8; 8] = b"DRFTCACH";
 const LAYOUT: u32 = 1;
 /// The version of the configuration's canonical form in the key: changed whenever the form does.
 pub const CONFIG_FORM: &str = "drafter-config-json-1";
+/// The version of the import limits' encoding in a refusal's key ([`failure_key`]), changed whenever
+/// the encoding does. Version 2: the fields' bytes, where version 1 (untagged) hashed their `Debug`
+/// text; a refusal stored under version 1 is no longer found, is baked again, and ages out.
+pub const LIMITS_FORM: &str = "drafter-limits-le-2";
 /// Payloads per entry: main file, .bin, report.
 const MAX_PAYLOADS: u32 = 4;
 /// Temporary files older than this are a killed writer's and are removed by [`Cache::evict`].
@@ -141,12 +145,18 @@ pub fn key_of_file(path: &Path, config: &drafter_bake::BakeConfig) -> std::io::R
 
 /// The key under which the refusal of an input is stored: a file the importer or the bake refuses
 /// for its content is refused again by the same build with the same configuration and the same
-/// import limits, so a rerun replays the one-line reason instead of parsing the file again.
+/// import limits, so a rerun replays the one-line reason instead of parsing the file again. The
+/// limits enter as an explicit encoding, tagged with [`LIMITS_FORM`]: each field, in declaration
+/// order, little-endian.
 pub fn failure_key(key: &Key, limits: &drafter_io::Limits) -> Key {
+    // Every field named, so that a field added to the limits cannot be left out of the key.
+    let drafter_io::Limits { max_triangles } = *limits;
     let mut h = blake3::Hasher::new();
     h.update(b"drafter-cache-failure\0");
+    h.update(&(LIMITS_FORM.len() as u64).to_le_bytes());
+    h.update(LIMITS_FORM.as_bytes());
     h.update(&key.0);
-    h.update(format!("{limits:?}").as_bytes());
+    h.update(&max_triangles.to_le_bytes());
     Key(*h.finalize().as_bytes())
 }
 
@@ -517,6 +527,7 @@ impl Cache {
 
 /// A file's identity for receipts: size, modification and change times in nanoseconds, inode and
 /// device. Writing or replacing the file changes at least one of them.
+#[cfg(unix)]
 fn identity(path: &Path) -> Option<String> {
     use std::os::unix::fs::MetadataExt;
     let m = std::fs::metadata(path).ok()?;
@@ -532,10 +543,27 @@ fn identity(path: &Path) -> Option<String> {
     ))
 }
 
+/// A file's identity for receipts where there is no inode or change time: size, and modification
+/// and creation times in nanoseconds since the epoch (a platform without a creation time gives 0).
+/// Writing the file changes its size or modification time; a file replaced by another keeps them
+/// only if the writer set them, which is what a receipt trusts on such platforms.
+#[cfg(not(unix))]
+fn identity(path: &Path) -> Option<String> {
+    let m = std::fs::metadata(path).ok()?;
+    let nanos = |t: std::io::Result<SystemTime>| {
+        t.ok().and_then(|t| t.duration_since(SystemTime::UNIX_EPOCH).ok()).map_or(0, |d| d.as_nanos())
+    };
+    Some(format!("\n{} {} {}", m.len(), nanos(m.modified()), nanos(m.created())))
+}
+
+/// The host's name for receipts, so that machines sharing a cache folder keep receipts apart: the
+/// kernel's on Linux, `COMPUTERNAME` or `HOSTNAME` elsewhere, empty where neither is known.
 fn hostname() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .map(|h| h.trim().chars().filter(char::is_ascii_alphanumeric).collect())
-        .unwrap_or_default()
+    #[cfg(target_os = "linux")]
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname").ok();
+    #[cfg(not(target_os = "linux"))]
+    let name = std::env::var("COMPUTERNAME").or_else(|_| std::env::var("HOSTNAME")).ok();
+    name.map(|h| h.trim().chars().filter(char::is_ascii_alphanumeric).collect()).unwrap_or_default()
 }
 
 fn encode_header(payloads: &[&[u8]]) -> Vec<u8> {
@@ -689,6 +717,18 @@ mod tests {
         std::fs::remove_file(dir.join("a.bin")).unwrap();
         assert_eq!(key_of(&path, gltf, &config), None, "a missing external file is not cached");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_refusals_key_follows_the_bake_key_and_the_limits() {
+        let key = Key(digest(b"input"));
+        let limits = drafter_io::Limits::default();
+        let base = failure_key(&key, &limits);
+        assert_eq!(failure_key(&key, &limits), base, "deterministic");
+        assert_ne!(base, key, "apart from the bake's key");
+        assert_ne!(failure_key(&Key(digest(b"other")), &limits), base, "the bake's key is part of it");
+        let lower = drafter_io::Limits { max_triangles: limits.max_triangles - 1 };
+        assert_ne!(failure_key(&key, &lower), base, "the limits are part of it");
     }
 
     #[test]
