@@ -590,6 +590,61 @@ mod tests {
     }
 
     #[test]
+    fn compaction_drops_what_nothing_reads_and_renumbers_every_reference() {
+        // Views 0-5 of 4 bytes each; accessor 0 (on view 1) is read by nothing, so both go. Every
+        // other accessor is read from one of the places the compaction knows.
+        let document = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["EXT_mesh_gpu_instancing", "DRAFTER_illustration"],
+            "bufferViews": (0..6).map(|v| json!({"buffer": 0, "byteOffset": 4 * v, "byteLength": 4})).collect::<Vec<_>>(),
+            "accessors": [
+                {"bufferView": 1, "componentType": 5126, "count": 1, "type": "SCALAR"},
+                {"bufferView": 2, "componentType": 5126, "count": 1, "type": "SCALAR", "min": [0, -0.0]},
+                {"bufferView": 3, "componentType": 5126, "count": 1, "type": "SCALAR"},
+                {"componentType": 5126, "count": 1, "type": "SCALAR",
+                 "sparse": {"count": 1, "indices": {"bufferView": 4, "componentType": 5121}, "values": {"bufferView": 5}}},
+                {"bufferView": 2, "componentType": 5126, "count": 1, "type": "SCALAR"}
+            ],
+            "images": [{"bufferView": 0, "mimeType": "image/png"}],
+            "meshes": [{"primitives": [{
+                "attributes": {"POSITION": 1},
+                "targets": [{"POSITION": 2, "_X": "not an index"}],
+                "extensions": {"DRAFTER_illustration": {"partLabels": 4}}
+            }]}],
+            "skins": [{"inverseBindMatrices": 3, "joints": [0]}],
+            "animations": [{"samplers": [{"input": 4, "output": 4}], "channels": []}],
+            "nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 4}}}}]
+        });
+        let mut doc = Doc::new(Root::deserialize(&document).expect("a document"));
+        doc.bin = (0..24).collect();
+        doc.compact("DRAFTER_illustration").expect("compacts");
+        let views: Vec<_> = doc.root.buffer_views().iter().map(|v| (v.byte_offset, v.byte_length)).collect();
+        assert_eq!(views, (0..5).map(|v| (Some(4 * v), Some(4))).collect::<Vec<_>>());
+        assert_eq!(doc.bin, [0, 1, 2, 3].into_iter().chain(8..24).collect::<Vec<u8>>(), "view 1's bytes gone");
+        let out = Value::from(doc.root);
+        let accessors = &out["accessors"];
+        assert_eq!(accessors.as_array().map(Vec::len), Some(4));
+        assert_eq!((&accessors[0]["bufferView"], &accessors[0]["min"]), (&json!(1), &json!([0, -0.0])));
+        assert_eq!(accessors[1]["bufferView"], 2);
+        assert_eq!(
+            accessors[2]["sparse"],
+            json!({"count": 1, "indices": {"bufferView": 3, "componentType": 5121}, "values": {"bufferView": 4}})
+        );
+        assert_eq!(accessors[3]["bufferView"], 1);
+        assert_eq!(out["images"][0]["bufferView"], 0);
+        let primitive = &out["meshes"][0]["primitives"][0];
+        assert_eq!(primitive["attributes"]["POSITION"], 0);
+        assert_eq!(primitive["targets"], json!([{"POSITION": 1, "_X": "not an index"}]));
+        assert_eq!(primitive["extensions"]["DRAFTER_illustration"]["partLabels"], 3);
+        assert_eq!(out["skins"][0], json!({"inverseBindMatrices": 2, "joints": [0]}));
+        assert_eq!(out["animations"][0]["samplers"][0], json!({"input": 3, "output": 3}));
+        assert_eq!(out["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["TRANSLATION"], 3);
+        // A reference to an accessor the document lacks leaves it as it is.
+        let mut dangling = Doc::new(Root::deserialize(&json!({"meshes": [{"primitives": [{"indices": 9}]}]})).unwrap());
+        assert!(dangling.compact("DRAFTER_illustration").is_err());
+    }
+
+    #[test]
     fn node_extensions_serialise_as_the_document_that_holds_them() {
         // Every node but the last gets an extension; the cases put `extensions` and our key first,
         // between and after the existing keys, and in place of an old one.

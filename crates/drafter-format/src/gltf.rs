@@ -19,9 +19,9 @@
 //!
 //! **The owner of the document's JSON.** The writer (`doc.rs`, `writer.rs`), the codecs
 //! (`meshopt.rs`, `draco.rs`) and the importer edit these objects, never a `Value` tree; the one
-//! walk of JSON left is inside extensions whose accessor references this layer does not type
+//! walk of JSON left is over the accessor references this layer keeps as JSON
 //! ([`Extensible::visit_extension_indices`]: `DRAFTER_illustration`'s records, the edges'
-//! `lineStrings`, `EXT_mesh_gpu_instancing`'s attributes), here.
+//! `lineStrings`, `EXT_mesh_gpu_instancing`'s attributes; morph targets), here.
 //!
 //! **Why not gltf-json's `Root`.** The importer reads its input through the gltf crate, whose
 //! validation it wants; this layer is for the writer's pass-through of that input, the readers
@@ -260,8 +260,9 @@ object! {
         material: u64,
         /// The mode's code ([`Mode::from_code`]); absent means triangles.
         mode: u64,
-        /// Morph targets: attribute name → accessor index, each.
-        targets: Vec<BTreeMap<String, u64>>,
+        /// Morph targets: attribute name → accessor index, each; JSON, as the importer's gltf-json
+        /// takes a target's names other than `POSITION`, `NORMAL` and `TANGENT` with any value.
+        targets: Vec<Members>,
     }
 }
 
@@ -515,7 +516,7 @@ impl Root {
                 primitive.attributes.iter_mut().flat_map(BTreeMap::values_mut).for_each(&mut *f);
                 primitive.indices.iter_mut().for_each(&mut *f);
                 for target in primitive.targets.iter_mut().flatten() {
-                    target.values_mut().for_each(&mut *f);
+                    target.values_mut().for_each(|a| visit_index(a, f));
                 }
                 for (name, keys) in primitive_extensions {
                     primitive.visit_extension_indices(name, keys, f);
