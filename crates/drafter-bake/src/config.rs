@@ -135,8 +135,13 @@ impl BakeConfig {
     }
 
     /// The same tables as JSON (what Python's `config=` mapping becomes); as [`BakeConfig::from_toml`].
+    /// The JSON is read as TOML values first, so that an error names its key, as a file's does
+    /// (``… expected u32 in `gradient.q` ``), where the JSON reader would give a column of text the
+    /// user never wrote.
     pub fn from_json(text: &str) -> Result<Self, BakeError> {
-        serde_json::from_str(text).map_err(|e| BakeError::Config(one_line(&e.to_string())))
+        let config = |e: &dyn std::fmt::Display| BakeError::Config(one_line(&e.to_string()));
+        let value: toml::Value = serde_json::from_str(text).map_err(|e| config(&e))?;
+        Self::deserialize(value).map_err(|e| config(&e))
     }
 
     /// Checks every option against its documented range: the one check of a config, whether it
@@ -232,9 +237,9 @@ pub enum Compression {
 }
 
 /// Upper bound of [`NormalsStage::strength`].
-pub const MAX_STRENGTH: f32 = 5.0;
+const MAX_STRENGTH: f32 = 5.0;
 /// Upper bound of [`NormalsStage::iterations`].
-pub const MAX_ITERATIONS: u32 = 200;
+const MAX_ITERATIONS: u32 = 200;
 
 /// `[normals]`, the normal stage (Cignoni et al. 2005 enhancement + crease-aware vertex normals).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -243,10 +248,10 @@ pub struct NormalsStage {
     /// Compute and write normals. Default true.
     pub enabled: bool,
     /// `k` of `n_E = normalize(n + k(n - n_L))`. Default [`drafter_normals::DEFAULT_STRENGTH`]
-    /// (0.5); range [0, [`MAX_STRENGTH`]].
+    /// (0.5); range [0, 5].
     pub strength: f32,
     /// Low-pass iterations. Default [`drafter_normals::DEFAULT_ITERATIONS`] (20); range
-    /// 0..=[`MAX_ITERATIONS`].
+    /// 0..=200.
     pub iterations: u32,
     /// Vertex normals are not averaged across edges sharper than this. Default
     /// [`drafter_normals::DEFAULT_CREASE_ANGLE_DEG`] (30°); range [0, 180].
@@ -620,8 +625,15 @@ mod tests {
             assert!(err.starts_with("config: "), "{text:?}: {err}");
             assert!(!err.contains('\n'), "multi-line: {err}");
         }
-        let err = BakeConfig::from_json(r#"{"normals": {"smooth": true}}"#).unwrap_err().to_string();
-        assert!(err.contains("smooth"), "{err}");
+        // JSON's errors name the key too, not a column of text the user never wrote.
+        for (json, needle) in [
+            (r#"{"normals": {"smooth": true}}"#, "unknown field `smooth`, expected one of `enabled`"),
+            (r#"{"gradient": {"q": "ten"}}"#, "expected u32 in `gradient.q`"),
+            (r#"{"part": [{"id": 1, "style": "neon"}]}"#, "in `part.style`"),
+        ] {
+            let err = BakeConfig::from_json(json).unwrap_err().to_string();
+            assert!(err.contains(needle) && !err.contains("column"), "{json}: {err}");
+        }
     }
 
     #[test]
