@@ -48,7 +48,7 @@ pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("DRAFTER
 const MAGIC: &[u8; 8] = b"DRFTCACH";
 const LAYOUT: u32 = 1;
 /// The version of the configuration's canonical form in the key: changed whenever the form does.
-pub const CONFIG_FORM: &str = "drafter-config-json-1";
+pub const CONFIG_FORM: &str = "drafter-config-json-2";
 /// The version of the import limits' encoding in a refusal's key ([`failure_key`]), changed whenever
 /// the encoding does. Version 2: the fields' bytes, where version 1 (untagged) hashed their `Debug`
 /// text; a refusal stored under version 1 is no longer found, is baked again, and ages out.
