@@ -14,6 +14,7 @@
 
 mod diagnostic;
 pub mod gradient;
+pub mod hierarchy;
 mod ids;
 mod obb_method;
 mod param;

@@ -84,6 +84,7 @@ mod normal_split;
 mod query;
 mod spatial;
 
+pub use drafter_core::hierarchy::ConeBvhArrays;
 use glam::{Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
@@ -151,34 +152,6 @@ impl Default for ConeBvhOptions {
             sample_eyes: DEFAULT_SAMPLE_EYES,
         }
     }
-}
-
-/// The flat arrays of a [`ConeBvh`], ready for glTF buffer views.
-///
-/// The storage order of the candidates is not stored: [`ConeBvh::from_arrays`] builds the binary
-/// tree again, replaying the recorded split of every inner node (`splits`) with the builder's
-/// arithmetic instead of searching for it, which gives the builder's candidate order; `nodes`
-/// then refer to ranges of that order.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ConeBvhArrays {
-    /// 6 `f32` per node: box min x, y, z, max x, y, z of the candidate points below.
-    pub node_boxes: Vec<f32>,
-    /// 4 `f32` per node: cone axis x, y, z and `sin α + margin` (≥ 1: never culled).
-    pub node_cones: Vec<f32>,
-    /// 4 `u32` per node, nodes breadth-first from the root: first child, child count, and the
-    /// range of the node's candidates (its whole subtree) in the binary tree's preorder candidate
-    /// order; the children's ranges tile their parent's in order.
-    pub nodes: Vec<u32>,
-    /// The Gauss-map level of the normal split (see [`NormalSplit::Level`]).
-    pub normal_level: u32,
-    /// The leaf size the binary tree was cut at ([`ConeBvhOptions::leaf_size`]).
-    pub leaf_size: u32,
-    /// One byte per inner node of each dual-space tree, in preorder: `axis · 32 + bin`, the split
-    /// between bins `bin − 1` and `bin` of `DUAL_BINS` (32) on that axis, or `MEDIAN_SPLIT`.
-    pub splits: Vec<u8>,
-    /// Where each dual-space tree's bytes start in `splits`, one per tree in the order the normal
-    /// split emits them.
-    pub split_starts: Vec<u32>,
 }
 
 /// The split byte of an inner node split at the median of its widest axis of centres.

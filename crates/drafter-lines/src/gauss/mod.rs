@@ -64,6 +64,7 @@ mod cells;
 mod quad;
 mod query;
 
+pub use drafter_core::hierarchy::GaussMapArrays;
 use glam::{Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
@@ -186,27 +187,6 @@ impl LevelHistogram {
         }
         h
     }
-}
-
-/// The flat arrays of a [`GaussMapHierarchy`], ready for glTF buffer views.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct GaussMapArrays {
-    /// 0 octahedron, 1 icosahedron.
-    pub base: u32,
-    /// Deepest level that was built.
-    pub max_depth: u32,
-    /// 4 `f32` per node: cap centre x, y, z and the cull threshold `sin r + ε` (≥ 1: never culled).
-    pub node_caps: Vec<f32>,
-    /// The overlapping-bin factor ([`Bins::Overlapping`]); 0 for [`Bins::Strict`].
-    pub overlap: f32,
-    /// 4 `u32` per node, nodes breadth-first from the root (the whole sphere; depth 1 = level 0):
-    /// first child, child count, first own arc and end of own arcs, positions in the storage
-    /// order; own arcs of the nodes follow one another in node order.
-    ///
-    /// The storage order itself is not stored: which cell holds an arc is a function of its two
-    /// normals (the bin rule), so [`GaussMapHierarchy::from_arrays`] assigns the arcs again with
-    /// the builder's arithmetic and checks the result against these nodes.
-    pub nodes: Vec<u32>,
 }
 
 /// See the module docs.
