@@ -12,10 +12,14 @@
 //! refusing the whole document; a member of the wrong JSON type is refused when the document is
 //! read.
 //!
-//! **Written as sorted JSON.** An object becomes a `serde_json::Value` by moving its members into
-//! its `other` map ([`IntoJson`]; `Value::from(root)`), whose keys are sorted, and that is written
-//! as text: the member order every document drafter writes has (serde would write a struct's
-//! fields in declaration order). The `Serialize` impls go the same way.
+//! **Read and written as JSON maps.** serde reads the document's text as one `serde_json::Value`;
+//! each object is then taken out of its JSON map member by member ([`FromJson`]), and written by
+//! moving its members back into that map ([`IntoJson`]; `Value::from(root)`), whose keys are
+//! sorted, before the map is written as text: the member order every document drafter writes has
+//! (serde would write a struct's fields in declaration order). The `Deserialize` and `Serialize`
+//! impls go the same way. Plain functions rather than serde's visitors and serializers, which
+//! would put a copy of their machinery for every member type into the browser's module, whose
+//! size has a limit (the page's folder, `docs/web.md`).
 //!
 //! **The owner of the document's JSON.** The writer (`doc.rs`, `writer.rs`), the codecs
 //! (`meshopt.rs`, `draco.rs`) and the importer edit these objects, never a `Value` tree; the one
@@ -55,8 +59,11 @@ pub type Members = serde_json::Map<String, Value>;
 ///
 /// Written out rather than derived with `#[serde(flatten)]`: flatten buffers every member and
 /// deserializes each type through its own copy of that machinery, which made the browser's module
-/// tens of kilobytes larger; here an object is read as a JSON map once and each named member taken
-/// out of it, and written as that map again (sorted, as the writer's documents are).
+/// tens of kilobytes larger. Here serde only reads the document's JSON, as one `Value`; each
+/// object is then taken out of its JSON map member by member ([`FromJson`]) and moved back into
+/// it to be written ([`IntoJson`], sorted, as the writer's documents are), by plain functions
+/// rather than serde's visitors and serializers, which the browser's module would hold a copy of
+/// for every member type.
 macro_rules! object {
     ($(#[$meta:meta])* $name:ident { $($(#[$member:meta])* $field:ident $(as $key:literal)?: $ty:ty,)* }) => {
         $(#[$meta])*
@@ -71,9 +78,7 @@ macro_rules! object {
             /// The object as a JSON map: its other members, and each named member that is set.
             fn from(object: $name) -> Value {
                 let mut map = object.other;
-                $(if let Some(value) = object.$field {
-                    map.insert(member_key!($field $(, $key)?), IntoJson::into_json(value));
-                })*
+                $(put(&mut map, member_name!($field $(, $key)?), object.$field.map(IntoJson::into_json));)*
                 Value::Object(map)
             }
         }
@@ -81,6 +86,23 @@ macro_rules! object {
         impl IntoJson for $name {
             fn into_json(self) -> Value {
                 Value::from(self)
+            }
+        }
+
+        impl FromJson for $name {
+            fn from_json(value: Value) -> Result<Self, String> {
+                let mut other = Members::from_json(value)?;
+                // Every member read before the first error is returned: one drop of the whole
+                // object then, rather than one of the members read so far after each.
+                let mut error = None;
+                let object = $name {
+                    $($field: take(&mut other, member_name!($field $(, $key)?), &mut error),)*
+                    other,
+                };
+                match error {
+                    None => Ok(object),
+                    Some(error) => Err(error),
+                }
             }
         }
 
@@ -92,23 +114,20 @@ macro_rules! object {
 
         impl<'de> Deserialize<'de> for $name {
             fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-                let mut other = Members::deserialize(deserializer)?;
-                Ok($name {
-                    $($field: take(&mut other, &member_key!($field $(, $key)?)).map_err(serde::de::Error::custom)?,)*
-                    other,
-                })
+                Self::from_json(Value::deserialize(deserializer)?).map_err(serde::de::Error::custom)
             }
         }
     };
 }
 
-/// A member's key: its own, or the field's name in camelCase.
-macro_rules! member_key {
+/// A member's name: its own key, or the field's name, which [`camel_case`] makes the key (a key
+/// given is one word, which it leaves as it is).
+macro_rules! member_name {
     ($field:ident) => {
-        camel_case(stringify!($field))
+        stringify!($field)
     };
     ($field:ident, $key:literal) => {
-        String::from($key)
+        $key
     };
 }
 
@@ -129,11 +148,114 @@ fn camel_case(name: &str) -> String {
     out
 }
 
-/// Member `key` taken out of `members` and read as a `T`; absent or `null` is `None`.
-fn take<T: DeserializeOwned>(members: &mut Members, key: &str) -> Result<Option<T>, String> {
-    match members.remove(key) {
-        None | Some(Value::Null) => Ok(None),
-        Some(value) => serde_json::from_value(value).map(Some).map_err(|e| format!("`{key}`: {e}")),
+/// Member `name` (see [`member_name`]) taken out of `members` and read as a `T`; absent or `null`
+/// is `None`, and so is a member that does not read, whose error goes to `error` (the first
+/// one). The work that does not depend on `T` is in functions of their own, not copied into
+/// every object's reading of every member.
+#[inline(never)]
+fn take<T: FromJson>(members: &mut Members, name: &str, error: &mut Option<String>) -> Option<T> {
+    match T::from_json(member(members, name)?) {
+        Ok(value) => Some(value),
+        Err(e) => {
+            error.get_or_insert_with(|| in_member(name, e));
+            None
+        }
+    }
+}
+
+/// Member `name` taken out of `members`; `None` when absent or `null`.
+#[inline(never)]
+fn member(members: &mut Members, name: &str) -> Option<Value> {
+    members.remove(&camel_case(name)).filter(|value| !value.is_null())
+}
+
+/// `error` of member `name`, named.
+#[inline(never)]
+fn in_member(name: &str, error: String) -> String {
+    format!("`{}`: {error}", camel_case(name))
+}
+
+/// Sets member `name` (see [`member_name`]) of `map` to `value`, if any.
+#[inline(never)]
+fn put(map: &mut Members, name: &str, value: Option<Value>) {
+    if let Some(value) = value {
+        map.insert(camel_case(name), value);
+    }
+}
+
+/// A typed member read from its JSON, the inverse of [`IntoJson`]; `Err` names what was expected.
+pub trait FromJson: Sized {
+    fn from_json(value: Value) -> Result<Self, String>;
+}
+
+/// "invalid type: …, expected `what`", as serde words it.
+fn unexpected(value: &Value, what: &str) -> String {
+    let found = match value {
+        Value::Null => "null".to_owned(),
+        Value::Bool(b) => format!("boolean `{b}`"),
+        Value::Number(n) => format!("number `{n}`"),
+        Value::String(s) => format!("string {s:?}"),
+        Value::Array(_) => "sequence".to_owned(),
+        Value::Object(_) => "map".to_owned(),
+    };
+    format!("invalid type: {found}, expected {what}")
+}
+
+impl FromJson for u64 {
+    fn from_json(value: Value) -> Result<Self, String> {
+        value.as_u64().ok_or_else(|| unexpected(&value, "an unsigned integer"))
+    }
+}
+
+impl FromJson for bool {
+    fn from_json(value: Value) -> Result<Self, String> {
+        value.as_bool().ok_or_else(|| unexpected(&value, "a boolean"))
+    }
+}
+
+impl FromJson for String {
+    fn from_json(value: Value) -> Result<Self, String> {
+        match value {
+            Value::String(s) => Ok(s),
+            other => Err(unexpected(&other, "a string")),
+        }
+    }
+}
+
+impl FromJson for Value {
+    fn from_json(value: Value) -> Result<Self, String> {
+        Ok(value)
+    }
+}
+
+impl FromJson for Members {
+    fn from_json(value: Value) -> Result<Self, String> {
+        match value {
+            Value::Object(map) => Ok(map),
+            other => Err(unexpected(&other, "a map")),
+        }
+    }
+}
+
+impl<T: FromJson> FromJson for Vec<T> {
+    fn from_json(value: Value) -> Result<Self, String> {
+        let Value::Array(items) = value else { return Err(unexpected(&value, "a sequence")) };
+        let mut out = Vec::with_capacity(items.len());
+        for item in items {
+            out.push(T::from_json(item)?);
+        }
+        Ok(out)
+    }
+}
+
+impl<T: FromJson> FromJson for BTreeMap<String, T> {
+    fn from_json(value: Value) -> Result<Self, String> {
+        // Inserted one by one: the members come sorted, and `collect` would bring a sort along.
+        let mut out = BTreeMap::new();
+        for (key, value) in Members::from_json(value)? {
+            out.insert(key, T::from_json(value)?);
+        }
+        Ok(out)
     }
 }
 
@@ -176,13 +298,21 @@ impl IntoJson for Members {
 
 impl<T: IntoJson> IntoJson for Vec<T> {
     fn into_json(self) -> Value {
-        Value::Array(self.into_iter().map(IntoJson::into_json).collect())
+        let mut items = Vec::with_capacity(self.len());
+        for item in self {
+            items.push(item.into_json());
+        }
+        Value::Array(items)
     }
 }
 
 impl<T: IntoJson> IntoJson for BTreeMap<String, T> {
     fn into_json(self) -> Value {
-        Value::Object(self.into_iter().map(|(k, v)| (k, v.into_json())).collect())
+        let mut map = Members::new();
+        for (key, value) in self {
+            map.insert(key, value.into_json());
+        }
+        Value::Object(map)
     }
 }
 
@@ -460,7 +590,8 @@ fn extension<T: DeserializeOwned>(extensions: &Option<Members>, name: &str) -> O
 impl Root {
     /// Reads a document from its JSON text.
     pub fn from_slice(json: &[u8]) -> serde_json::Result<Self> {
-        serde_json::from_slice(json)
+        let value: Value = serde_json::from_slice(json)?;
+        Self::from_json(value).map_err(serde::de::Error::custom)
     }
 
     pub fn accessors(&self) -> &[Accessor] {
