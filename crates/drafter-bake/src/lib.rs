@@ -31,9 +31,9 @@ use std::time::{Duration, Instant};
 use drafter_bounds::{Obb, ObbOptions, Projector, box_with_axes, oriented_box};
 use drafter_core::{Diagnostic, DiagnosticKind, PartId, Scene, Topology, TriangleGroup, Weld};
 use drafter_format::{
-    BakeOutput, BoxRecord, ConeBvhData, Container, FORMAT_VERSION, GENERATOR, GaussMapData, GradientRecord,
-    HardEdgeClass, InputInfo, MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges,
-    ProjectorRecord, RootExtension, StoredNormals, TextureImage, VertexData, Written,
+    BakeOutput, BoxRecord, Container, FORMAT_VERSION, GENERATOR, GradientRecord, HardEdgeClass, InputInfo,
+    MeshSilhouettes, NormalsInfo, ObbMethod, PartRecord, PartStyle, PrimitiveEdges, ProjectorRecord, RootExtension,
+    StoredNormals, TextureImage, VertexData, Written,
 };
 use drafter_lines::{EdgeClass, HierarchyChoice, SilhouetteIndex, SilhouetteOptions};
 use drafter_segment::{MeshLabels, Parts};
@@ -830,22 +830,8 @@ fn silhouettes_of(
         candidate_corners: corners,
         orthographic,
         perspective,
-        gauss_map: arrays.gauss_map.map(|g| GaussMapData {
-            base: g.base,
-            max_depth: g.max_depth,
-            overlap: g.overlap,
-            node_caps: g.node_caps,
-            nodes: g.nodes,
-        }),
-        cone_bvh: arrays.cone_bvh.map(|b| ConeBvhData {
-            normal_level: b.normal_level,
-            leaf_size: b.leaf_size,
-            node_boxes: b.node_boxes,
-            node_cones: b.node_cones,
-            nodes: b.nodes,
-            splits: b.splits,
-            split_starts: b.split_starts,
-        }),
+        gauss_map: arrays.gauss_map,
+        cone_bvh: arrays.cone_bvh,
     })
 }
 

@@ -11,9 +11,7 @@ use drafter_core::rng::Rng;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use drafter_lines::{
-    BruteForce, ConeBvhArrays, EdgeSet, GaussMapArrays, HierarchyChoice, SilhouetteArrays, SilhouetteIndex, View,
-};
+use drafter_lines::{BruteForce, EdgeSet, HierarchyChoice, SilhouetteArrays, SilhouetteIndex, View};
 use glam::Vec3;
 
 const VIEWS: usize = 10_000;
@@ -47,22 +45,8 @@ fn check(path: &Path, compress: drafter_bake::Compression) -> usize {
             candidate_edges: s.candidate_corners.clone(),
             candidate_normals: s.candidate_normals.clone(),
             candidate_points: points.clone(),
-            gauss_map: s.gauss_map.as_ref().map(|g| GaussMapArrays {
-                base: g.base,
-                max_depth: g.max_depth,
-                overlap: g.overlap,
-                node_caps: g.node_caps.clone(),
-                nodes: g.nodes.clone(),
-            }),
-            cone_bvh: s.cone_bvh.as_ref().map(|b| ConeBvhArrays {
-                node_boxes: b.node_boxes.clone(),
-                node_cones: b.node_cones.clone(),
-                nodes: b.nodes.clone(),
-                normal_level: b.normal_level,
-                leaf_size: b.leaf_size,
-                splits: b.splits.clone(),
-                split_starts: b.split_starts.clone(),
-            }),
+            gauss_map: s.gauss_map.clone(),
+            cone_bvh: s.cone_bvh.clone(),
             orthographic: choice,
             perspective: HierarchyChoice::ConeBvh { leaf_size: 0, nodes: 0, predicted_speedup: 0.0 },
         };

@@ -47,9 +47,8 @@ pub use reader::{
     read_normal_sets, read_scalars, read_textures, split_container,
 };
 pub use writer::{
-    BakeOutput, ConeBvhData, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, GaussMapData,
-    MAX_PRIMITIVE_VERTICES, MeshSilhouettes, PrimitiveEdges, SamplerDesc, StoredNormals, TextureImage, VertexData,
-    Written, first_use, write,
+    BakeOutput, Container, DEFAULT_MATERIAL, DEFAULT_MATERIAL_NAME, EmbeddedTextures, MAX_PRIMITIVE_VERTICES,
+    MeshSilhouettes, PrimitiveEdges, SamplerDesc, StoredNormals, TextureImage, VertexData, Written, first_use, write,
 };
 
 /// `drafter <version>`, written as the generator.

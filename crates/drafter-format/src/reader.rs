@@ -23,7 +23,8 @@ use crate::ext::{
     EDGE_VISIBILITY_EXTENSION, EXTENSION, FORMAT_VERSION, MeshExtension, NodeExtension, PartRecord, PrimitiveExtension,
     RootExtension, TexturesRecord,
 };
-use crate::writer::{ConeBvhData, GaussMapData, MeshSilhouettes, PrimitiveEdges, StoredNormals};
+use crate::writer::{MeshSilhouettes, PrimitiveEdges, StoredNormals};
+use drafter_core::hierarchy::{ConeBvhArrays, GaussMapArrays};
 
 /// What a baked file carries in `DRAFTER_illustration`.
 #[derive(Clone, Debug, PartialEq)]
@@ -247,7 +248,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                 orthographic: s.orthographic,
                 perspective: s.perspective,
                 gauss_map: match s.gauss_map {
-                    Some(g) => Some(GaussMapData {
+                    Some(g) => Some(GaussMapArrays {
                         base: g.base,
                         max_depth: g.max_depth,
                         overlap: g.overlap,
@@ -257,7 +258,7 @@ pub fn read(bytes: &[u8], external: &dyn Fn(&str) -> Option<Vec<u8>>) -> Result<
                     None => None,
                 },
                 cone_bvh: match s.cone_bvh {
-                    Some(b) => Some(ConeBvhData {
+                    Some(b) => Some(ConeBvhArrays {
                         normal_level: b.normal_level,
                         leaf_size: b.leaf_size,
                         node_boxes: f32s(b.node_boxes)?,

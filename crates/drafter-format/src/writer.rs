@@ -6,6 +6,7 @@
 //! document with one node per part instance. Either way the extension is listed in
 //! `extensionsUsed` only, so every viewer still opens the file as a plain model.
 
+use drafter_core::hierarchy::{ConeBvhArrays, GaussMapArrays};
 use drafter_core::{Mesh, Scene, TriangleGroup};
 use rayon::prelude::*;
 use serde_json::Value;
@@ -214,32 +215,11 @@ pub struct MeshSilhouettes {
     pub orthographic: crate::OrthographicHierarchy,
     /// What answers perspective views.
     pub perspective: crate::PerspectiveHierarchy,
-    pub gauss_map: Option<GaussMapData>,
-    pub cone_bvh: Option<ConeBvhData>,
-}
-
-/// The Gauss-map hierarchy as stored (drafter-lines' `GaussMapArrays`): no candidate order, a
-/// reader assigns the arcs to their cells again.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct GaussMapData {
-    pub base: u32,
-    pub max_depth: u32,
-    pub overlap: f32,
-    pub node_caps: Vec<f32>,
-    pub nodes: Vec<u32>,
-}
-
-/// The cone BVH as stored (drafter-lines' `ConeBvhArrays`): no candidate order, a reader replays
-/// the recorded splits.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ConeBvhData {
-    pub normal_level: u32,
-    pub leaf_size: u32,
-    pub node_boxes: Vec<f32>,
-    pub node_cones: Vec<f32>,
-    pub nodes: Vec<u32>,
-    pub splits: Vec<u8>,
-    pub split_starts: Vec<u32>,
+    /// The Gauss-map hierarchy as stored: no candidate order, a reader assigns the arcs to their
+    /// cells again.
+    pub gauss_map: Option<GaussMapArrays>,
+    /// The cone BVH as stored: no candidate order, a reader replays the recorded splits.
+    pub cone_bvh: Option<ConeBvhArrays>,
 }
 
 /// A mesh's vertices re-laid out by the normal stage: every output vertex copies the attributes of

@@ -33,10 +33,7 @@ use web_time::Instant;
 
 use drafter_core::Scene;
 use drafter_format::{BakedFile, HardEdgeClass, MeshSilhouettes};
-use drafter_lines::{
-    BruteForceReason, ConeBvhArrays, EdgeSet, GaussMapArrays, HierarchyChoice, SilhouetteArrays, SilhouetteIndex,
-    View as LinesView,
-};
+use drafter_lines::{BruteForceReason, EdgeSet, HierarchyChoice, SilhouetteArrays, SilhouetteIndex, View as LinesView};
 use glam::{DMat4, DVec3, Vec3};
 
 use crate::layout::LineSegmentGpu;
@@ -426,22 +423,8 @@ pub fn load_silhouettes(
         candidate_edges: s.candidate_corners.clone(),
         candidate_normals: s.candidate_normals.clone(),
         candidate_points: points.clone(),
-        gauss_map: s.gauss_map.as_ref().filter(|_| gauss).map(|g| GaussMapArrays {
-            base: g.base,
-            max_depth: g.max_depth,
-            overlap: g.overlap,
-            node_caps: g.node_caps.clone(),
-            nodes: g.nodes.clone(),
-        }),
-        cone_bvh: s.cone_bvh.as_ref().filter(|_| bvh).map(|b| ConeBvhArrays {
-            node_boxes: b.node_boxes.clone(),
-            node_cones: b.node_cones.clone(),
-            nodes: b.nodes.clone(),
-            normal_level: b.normal_level,
-            leaf_size: b.leaf_size,
-            splits: b.splits.clone(),
-            split_starts: b.split_starts.clone(),
-        }),
+        gauss_map: s.gauss_map.clone().filter(|_| gauss),
+        cone_bvh: s.cone_bvh.clone().filter(|_| bvh),
         orthographic: if gauss { orthographic } else { none },
         perspective: if bvh { perspective } else { none },
     };
