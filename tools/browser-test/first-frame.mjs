@@ -8,6 +8,8 @@
 // Usage: node tools/browser-test/first-frame.mjs PAGE_DIR FILE [FILE ...] [--runs N]
 
 import { execFileSync } from 'node:child_process';
+import { mkdtempSync, rmSync } from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import process from 'node:process';
 import { fileURLToPath } from 'node:url';
@@ -36,7 +38,9 @@ const median = (xs) => {
 };
 const ms = (x) => (x === undefined ? '-' : `${Math.round(x)}`);
 
-console.log(`# ${runs} runs each, ms from navigation start; load average at start ${(await import('node:os')).loadavg()[0].toFixed(2)}`);
+console.log(`# ${runs} runs each, ms from navigation start; load average at start ${os.loadavg()[0].toFixed(2)}`);
+const shots = mkdtempSync(path.join(os.tmpdir(), 'drafter-first-frame-'));
+process.on('exit', () => rmSync(shots, { recursive: true, force: true }));
 console.log('file\tview\trun\tfirstFrame\twasmReady\tsurface\trenderer\tread\tfirstDraw');
 const rows = [];
 for (const file of files) {
@@ -46,7 +50,7 @@ for (const file of files) {
       // is a new browser on a new profile.
       let out;
       try {
-        out = execFileSync('node', [path.join(here, 'web.mjs'), 'shots', pageDir, file, ...flags], { encoding: 'utf8' });
+        out = execFileSync('node', [path.join(here, 'web.mjs'), 'shots', pageDir, file, '--out', shots, ...flags], { encoding: 'utf8' });
       } catch (err) {
         out = err.stdout ?? '';
       }

@@ -28,50 +28,14 @@
 // For scripts and tests the element reports `state` ("starting", "loading", "ready", "error",
 // "empty"), `message` (the error shown), `notice` (the note shown under the model, e.g. an unbaked
 // file or a WebGPU device that was lost), `summary` (what was loaded), `timings` (ms since the
-// page's start: contextCreated (where the WebGL2 context was made early), wasmReady, viewerCreated,
-// fileFetched, modelLoaded, firstFrame), `startup` (ms of the viewer's creation steps) and fires "drafter-ready" /
+// page's start: wasmReady, viewerCreated, fileFetched, modelLoaded, firstFrame), `startup` (ms of the viewer's creation steps) and fires "drafter-ready" /
 // "drafter-error".
 
 import init, { KeyEffect, Viewer } from './drafter_web.js';
 
-// The module is fetched and compiled by a worker, so that the main thread is free meanwhile to
-// create the canvas's WebGL2 context: a call that blocks until the browser's GPU process has the
-// context up, which in a freshly started browser is its largest step (docs/web.md). A browser
-// that refuses the worker, or a host that serves the module with another MIME type, falls back
-// to compiling here.
-const COMPILER = `onmessage = async (e) => {
-  let compiled = null;
-  try {
-    compiled = await WebAssembly.compileStreaming(fetch(e.data));
-  } catch {
-    try { compiled = await WebAssembly.compile(await (await fetch(e.data)).arrayBuffer()); } catch {}
-  }
-  postMessage(compiled);
-};`;
-
-function compileInWorker(url) {
-  return new Promise((resolve) => {
-    let worker;
-    try {
-      worker = new Worker(URL.createObjectURL(new Blob([COMPILER], { type: 'text/javascript' })));
-    } catch {
-      resolve(null);
-      return;
-    }
-    const done = (compiled) => {
-      worker.terminate();
-      resolve(compiled instanceof WebAssembly.Module ? compiled : null);
-    };
-    worker.onmessage = (e) => done(e.data);
-    worker.onerror = () => done(null);
-    worker.postMessage(url.href);
-  });
-}
-
 let module;
 function loadModule() {
-  const url = new URL('drafter_web_bg.wasm', import.meta.url);
-  module ??= compileInWorker(url).then((compiled) => init({ module_or_path: compiled ?? url }));
+  module ??= init({ module_or_path: new URL('drafter_web_bg.wasm', import.meta.url) });
   return module;
 }
 
@@ -373,33 +337,16 @@ export class DrafterViewer extends HTMLElement {
     else if (shown) this.focus();
   }
 
-  /**
-   * Creates the canvas's WebGL2 context now, while the module compiles, where WebGL2 is what the
-   * viewer will draw with: asked for, or the browser gives no WebGPU adapter. The viewer then takes
-   * this context (wgpu asks for the same attributes). Returns whether it did.
-   */
-  async prepareContext() {
-    const backend = this.getAttribute('backend');
-    if (backend !== null && backend !== 'webgl2') return false;
-    if (backend === null && navigator.gpu) {
-      const adapter = await navigator.gpu.requestAdapter().catch(() => null);
-      if (adapter) return false;
-    }
-    this.sizeCanvas();
-    return this.canvas.getContext('webgl2', { antialias: false }) !== null;
-  }
-
   async start() {
     const generation = this.generation;
     const loading = loadModule();
     loading.catch(() => {}); // reported below
     // Attributes a page sets right after the element is defined (index.html) are there on the next task.
     await new Promise((resolve) => setTimeout(resolve, 0));
-    // The file downloads, and the context is created, while the module compiles.
+    // The file downloads while the module compiles and the device is requested.
     let src = this.getAttribute('src');
     let pending = src ? this.fetchModel(src) : null;
     pending?.catch(() => {}); // reported by loadUrl
-    if (await this.prepareContext()) this.timings.contextCreated = performance.now();
     try {
       await loading;
     } catch (err) {
