@@ -9,15 +9,15 @@
 //! with spaces, the BIN chunk with zeros, both to 4 bytes. The GL enums (component types, buffer view targets) are
 //! `drafter_format::accessor`'s.
 //!
-//! Determinism: JSON objects are built with keys inserted in sorted order (see [`object`]), so the bytes are the
-//! same whether or not some other crate of the build turns on serde_json's `preserve_order`; floats are written
-//! by serde_json's shortest round-trip formatting; nothing depends on time or hashing.
+//! The document is drafter-format's typed glTF ([`gltf::Root`]), written as the format's writer writes its own:
+//! members sorted, floats in serde_json's shortest round-trip formatting; nothing depends on time or hashing.
 //!
 //! Each primitive's `extras.brepFaces` lists its B-rep faces as `[surface, firstTriangle, triangleCount]` (the
 //! triangles of a face are contiguous), for tests that want the CAD face of a triangle as ground truth.
 
 use drafter_format::accessor::{ARRAY_BUFFER, ComponentType, ELEMENT_ARRAY_BUFFER};
-use serde_json::{Map, Value};
+use drafter_format::gltf::{self, Members};
+use serde_json::Value;
 
 use crate::solid::{Surface, TriMesh};
 
@@ -149,43 +149,37 @@ impl Document {
     /// The document as GLB bytes.
     pub fn to_glb(&self) -> Vec<u8> {
         let mut bin = BinBuilder::default();
-        let meshes: Vec<Value> = self.meshes.iter().map(|mesh| mesh_json(mesh, &mut bin)).collect();
-        let mut top = vec![
-            ("asset", object(vec![("generator", GENERATOR.into()), ("version", "2.0".into())])),
-            ("scene", 0.into()),
-            (
-                "scenes",
-                Value::Array(vec![object(vec![
-                    ("name", self.scene_name.as_str().into()),
-                    ("nodes", self.roots.iter().map(|n| Value::from(n.0)).collect()),
-                ])]),
-            ),
-            ("nodes", self.nodes.iter().map(node_json).collect()),
-            ("meshes", Value::Array(meshes)),
-            ("materials", self.materials.iter().map(material_json).collect()),
-        ];
-        if !bin.data.is_empty() {
-            top.push(("accessors", Value::Array(std::mem::take(&mut bin.accessors))));
-            top.push(("bufferViews", Value::Array(std::mem::take(&mut bin.views))));
-            top.push(("buffers", Value::Array(vec![object(vec![("byteLength", bin.data.len().into())])])));
-        }
-        // glTF arrays must not be empty: leave out what the document does not have.
-        top.retain(|(_, value)| value.as_array().is_none_or(|a| !a.is_empty()));
-        let json = object(top).to_string().into_bytes();
+        let meshes: Vec<gltf::Mesh> = self.meshes.iter().map(|mesh| mesh_json(mesh, &mut bin)).collect();
+        let root = gltf::Root {
+            asset: Some(gltf::Asset {
+                generator: Some(GENERATOR.to_owned()),
+                version: Some("2.0".to_owned()),
+                ..Default::default()
+            }),
+            scene: Some(0),
+            scenes: Some(vec![gltf::Scene {
+                name: Some(self.scene_name.clone()),
+                nodes: Some(self.roots.iter().map(|n| n.0 as u64).collect()),
+                ..Default::default()
+            }]),
+            // glTF arrays must not be empty: leave out what the document does not have.
+            nodes: non_empty(self.nodes.iter().map(node_json).collect()),
+            meshes: non_empty(meshes),
+            materials: non_empty(self.materials.iter().map(material_json).collect()),
+            accessors: non_empty(std::mem::take(&mut bin.accessors)),
+            buffer_views: non_empty(std::mem::take(&mut bin.views)),
+            buffers: (!bin.data.is_empty())
+                .then(|| vec![gltf::Buffer { byte_length: Some(bin.data.len() as u64), ..Default::default() }]),
+            ..Default::default()
+        };
+        let json = Value::from(root).to_string().into_bytes();
         // The samples are a few kilobytes, far below the container's 4 GiB limit.
         drafter_format::glb::write(&json, &bin.data).expect("a sample fits in a GLB")
     }
 }
 
-/// A JSON object with its keys inserted in sorted order, so the output does not depend on whether serde_json's
-/// map keeps insertion order (`preserve_order`) or sorts (the default).
-pub fn object(mut entries: Vec<(&str, Value)>) -> Value {
-    entries.sort_by(|a, b| a.0.cmp(b.0));
-    let mut map = Map::new();
-    for (key, value) in entries {
-        map.insert(key.to_owned(), value);
-    }
-    Value::Object(map)
+fn non_empty<T>(items: Vec<T>) -> Option<Vec<T>> {
+    (!items.is_empty()).then_some(items)
 }
 
 fn pad(bytes: &mut Vec<u8>, with: u8) {
@@ -198,25 +192,24 @@ fn pad(bytes: &mut Vec<u8>, with: u8) {
 #[derive(Debug, Default)]
 struct BinBuilder {
     data: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+    views: Vec<gltf::BufferView>,
+    accessors: Vec<gltf::Accessor>,
 }
 
 impl BinBuilder {
-    /// Appends a 4-byte-aligned buffer view and an accessor over all of it; returns the accessor index.
-    fn push(&mut self, bytes: &[u8], target: u32, accessor: Vec<(&str, Value)>) -> usize {
+    /// Appends a 4-byte-aligned buffer view and `accessor` over all of it; returns the accessor index.
+    fn push(&mut self, bytes: &[u8], target: u32, accessor: gltf::Accessor) -> u64 {
         pad(&mut self.data, 0);
-        self.views.push(object(vec![
-            ("buffer", 0.into()),
-            ("byteOffset", self.data.len().into()),
-            ("byteLength", bytes.len().into()),
-            ("target", target.into()),
-        ]));
+        self.views.push(gltf::BufferView {
+            buffer: Some(0),
+            byte_offset: Some(self.data.len() as u64),
+            byte_length: Some(bytes.len() as u64),
+            target: Some(u64::from(target)),
+            ..Default::default()
+        });
         self.data.extend_from_slice(bytes);
-        let mut accessor = accessor;
-        accessor.push(("bufferView", (self.views.len() - 1).into()));
-        self.accessors.push(object(accessor));
-        self.accessors.len() - 1
+        self.accessors.push(gltf::Accessor { buffer_view: Some(self.views.len() as u64 - 1), ..accessor });
+        self.accessors.len() as u64 - 1
     }
 }
 
@@ -229,7 +222,7 @@ fn float_array(values: [f32; 3]) -> Value {
     values.iter().map(|&v| Value::from(f64::from(v))).collect()
 }
 
-fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
+fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> gltf::Mesh {
     let geometry = &mesh.geometry;
     let count = geometry.positions.len();
     let mut min = [f32::INFINITY; 3];
@@ -240,18 +233,18 @@ fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
             max[axis] = max[axis].max(p[axis]);
         }
     }
-    let vec3 = |extra: Vec<(&'static str, Value)>| {
-        let mut fields =
-            vec![("componentType", ComponentType::F32.code().into()), ("count", count.into()), ("type", "VEC3".into())];
-        fields.extend(extra);
-        fields
+    let vec3 = gltf::Accessor {
+        component_type: Some(u64::from(ComponentType::F32.code())),
+        count: Some(count as u64),
+        kind: Some("VEC3".to_owned()),
+        ..Default::default()
     };
     let position = bin.push(
         &floats(&geometry.positions),
         ARRAY_BUFFER,
-        vec3(vec![("min", float_array(min)), ("max", float_array(max))]),
+        gltf::Accessor { min: Some(float_array(min)), max: Some(float_array(max)), ..vec3.clone() },
     );
-    let normal = bin.push(&floats(&geometry.normals), ARRAY_BUFFER, vec3(Vec::new()));
+    let normal = bin.push(&floats(&geometry.normals), ARRAY_BUFFER, vec3);
     let flat = geometry.triangles.iter().flatten();
     let (index_bytes, component): (Vec<u8>, ComponentType) = if count <= usize::from(u16::MAX) {
         (flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(), ComponentType::U16)
@@ -261,11 +254,12 @@ fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
     let indices = bin.push(
         &index_bytes,
         ELEMENT_ARRAY_BUFFER,
-        vec![
-            ("componentType", component.code().into()),
-            ("count", (3 * geometry.triangles.len()).into()),
-            ("type", "SCALAR".into()),
-        ],
+        gltf::Accessor {
+            component_type: Some(u64::from(component.code())),
+            count: Some(3 * geometry.triangles.len() as u64),
+            kind: Some("SCALAR".to_owned()),
+            ..Default::default()
+        },
     );
     let faces: Value = geometry
         .faces
@@ -274,13 +268,14 @@ fn mesh_json(mesh: &Mesh, bin: &mut BinBuilder) -> Value {
             Value::from(vec![Value::from(surface_name(f.surface)), f.first_triangle.into(), f.triangle_count.into()])
         })
         .collect();
-    let primitive = object(vec![
-        ("attributes", object(vec![("NORMAL", normal.into()), ("POSITION", position.into())])),
-        ("extras", object(vec![("brepFaces", faces)])),
-        ("indices", indices.into()),
-        ("material", mesh.material.0.into()),
-    ]);
-    object(vec![("name", mesh.name.as_str().into()), ("primitives", Value::Array(vec![primitive]))])
+    let primitive = gltf::Primitive {
+        attributes: Some([("NORMAL".to_owned(), normal), ("POSITION".to_owned(), position)].into()),
+        extras: Some(serde_json::json!({ "brepFaces": faces })),
+        indices: Some(indices),
+        material: Some(mesh.material.0 as u64),
+        ..Default::default()
+    };
+    gltf::Mesh { name: Some(mesh.name.clone()), primitives: Some(vec![primitive]), ..Default::default() }
 }
 
 /// Name of a surface kind in `extras.brepFaces`.
@@ -293,55 +288,55 @@ pub fn surface_name(surface: Surface) -> &'static str {
     }
 }
 
-fn node_json(node: &Node) -> Value {
-    let mut fields: Vec<(&str, Value)> = vec![("name", node.name.as_str().into())];
-    if let Some(mesh) = node.mesh {
-        fields.push(("mesh", mesh.0.into()));
-    }
-    if !node.children.is_empty() {
-        fields.push(("children", node.children.iter().map(|c| Value::from(c.0)).collect()));
-    }
+fn numbers(values: &[f64]) -> Value {
+    values.iter().map(|&v| Value::from(v)).collect()
+}
+
+fn node_json(node: &Node) -> gltf::Node {
+    // Translation, rotation and scale are members the typed node keeps among its others.
+    let mut other = Members::new();
+    let mut matrix = None;
     match node.transform {
         Transform::Identity => {}
         Transform::Trs { translation, rotation, scale } => {
             if translation != [0.0; 3] {
-                fields.push(("translation", translation.iter().map(|&v| Value::from(v)).collect()));
+                other.insert("translation".to_owned(), numbers(&translation));
             }
             if rotation != [0.0, 0.0, 0.0, 1.0] {
-                fields.push(("rotation", rotation.iter().map(|&v| Value::from(v)).collect()));
+                other.insert("rotation".to_owned(), numbers(&rotation));
             }
             if scale != [1.0; 3] {
-                fields.push(("scale", scale.iter().map(|&v| Value::from(v)).collect()));
+                other.insert("scale".to_owned(), numbers(&scale));
             }
         }
-        Transform::Matrix(m) => fields.push(("matrix", m.iter().map(|&v| Value::from(v)).collect())),
+        Transform::Matrix(m) => matrix = Some(numbers(&m)),
     }
-    object(fields)
+    gltf::Node {
+        name: Some(node.name.clone()),
+        mesh: node.mesh.map(|m| m.0 as u64),
+        children: (!node.children.is_empty()).then(|| node.children.iter().map(|c| c.0 as u64).collect()),
+        matrix,
+        other,
+        ..Default::default()
+    }
 }
 
-fn material_json(material: &Material) -> Value {
-    object(vec![
-        ("name", material.name.as_str().into()),
-        (
-            "pbrMetallicRoughness",
-            object(vec![
-                ("baseColorFactor", material.base_color.iter().map(|&v| Value::from(v)).collect()),
-                ("metallicFactor", material.metallic.into()),
-                ("roughnessFactor", material.roughness.into()),
-            ]),
-        ),
-    ])
+fn material_json(material: &Material) -> gltf::Material {
+    gltf::Material {
+        name: Some(material.name.clone()),
+        pbr_metallic_roughness: Some(gltf::PbrMetallicRoughness {
+            base_color_factor: Some(numbers(&material.base_color)),
+            metallic_factor: Some(material.metallic.into()),
+            roughness_factor: Some(material.roughness.into()),
+            ..Default::default()
+        }),
+        ..Default::default()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn object_keys_come_out_sorted_whatever_the_insertion_order() {
-        let v = object(vec![("b", 1.into()), ("a", 2.into()), ("c", 3.into())]);
-        assert_eq!(v.to_string(), r#"{"a":2,"b":1,"c":3}"#);
-    }
 
     #[test]
     fn empty_document_is_a_valid_glb_header_and_padded_json() {
