@@ -7,46 +7,12 @@
 
 mod common;
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
 /// A small closed mesh as OFF text, its first vertex moved by `k` so each file differs.
 fn tetrahedron(k: usize) -> String {
     format!("OFF\n4 4 0\n{} 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n", -(k as f64) * 1e-3)
-}
-
-#[derive(Debug, PartialEq, Eq)]
-enum Node {
-    Folder,
-    File(Vec<u8>),
-    Link(PathBuf),
-}
-
-/// Everything below `root`, links not followed, leaving out the paths in `allowed` (and what lies
-/// below them).
-fn snapshot(root: &Path, allowed: &[PathBuf]) -> BTreeMap<PathBuf, Node> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![root.to_path_buf()];
-    while let Some(folder) = stack.pop() {
-        for entry in std::fs::read_dir(&folder).expect("listed").flatten() {
-            let path = entry.path();
-            if allowed.iter().any(|a| path.starts_with(a)) {
-                continue;
-            }
-            let kind = entry.file_type().expect("type");
-            let node = if kind.is_symlink() {
-                Node::Link(std::fs::read_link(&path).expect("link"))
-            } else if kind.is_dir() {
-                stack.push(path.clone());
-                Node::Folder
-            } else {
-                Node::File(std::fs::read(&path).expect("read"))
-            };
-            out.insert(path, node);
-        }
-    }
-    out
 }
 
 fn bake_in(cwd: &Path, args: &[&str]) -> Output {
@@ -57,9 +23,9 @@ fn bake_in(cwd: &Path, args: &[&str]) -> Output {
 /// to `t`) but the folders leading to them.
 fn confined_run(t: &Path, args: &[&str], allowed: &[&str]) -> Output {
     let allowed: Vec<PathBuf> = allowed.iter().map(|a| t.join(a)).collect();
-    let before = snapshot(t, &allowed);
+    let before = common::snapshot(t, &allowed);
     let out = bake_in(t, args);
-    let after = snapshot(t, &allowed);
+    let after = common::snapshot(t, &allowed);
     let changed: Vec<_> = before
         .keys()
         .chain(after.keys())
@@ -67,7 +33,7 @@ fn confined_run(t: &Path, args: &[&str], allowed: &[&str]) -> Output {
         // The folders on the way to `-o` are created as the user asked.
         .filter(|p| {
             !(!before.contains_key(*p)
-                && after.get(*p) == Some(&Node::Folder)
+                && after.get(*p) == Some(&common::TreeNode::Folder)
                 && allowed.iter().any(|a| a.starts_with(p)))
         })
         .map(|p| p.strip_prefix(t).unwrap_or(p).to_path_buf())

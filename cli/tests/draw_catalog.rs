@@ -14,27 +14,6 @@ fn samples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples")
 }
 
-/// Every file below `root` with its bytes, leaving out `allowed` and what lies below it.
-fn snapshot(root: &Path, allowed: &[PathBuf]) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![root.to_path_buf()];
-    while let Some(folder) = stack.pop() {
-        for entry in std::fs::read_dir(&folder).expect("listed").flatten() {
-            let path = entry.path();
-            if allowed.iter().any(|a| path.starts_with(a)) {
-                continue;
-            }
-            if entry.file_type().expect("type").is_dir() {
-                stack.push(path.clone());
-                out.insert(path, Vec::new());
-            } else {
-                out.insert(path.clone(), std::fs::read(&path).expect("read"));
-            }
-        }
-    }
-    out
-}
-
 fn report(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).expect("report written")).expect("report is JSON")
 }
@@ -75,7 +54,7 @@ fn a_catalog_of_sheets_draws_the_good_files_confined_and_a_rerun_is_all_cache_hi
         draw(args)
     };
     let allowed = [out.clone(), cache.clone(), root.join("out2"), root.join("r1.json"), root.join("r2.json")];
-    let before = snapshot(&root, &allowed);
+    let before = common::snapshot(&root, &allowed);
 
     let (code, stderr) = catalog(&out, &root.join("r1.json"));
     assert_eq!(code, Some(4), "{stderr}");
@@ -95,7 +74,7 @@ fn a_catalog_of_sheets_draws_the_good_files_confined_and_a_rerun_is_all_cache_hi
         }
     }
     assert!(!out.join("broken.svg").exists() && !out.join("broken.dxf").exists());
-    assert_eq!(snapshot(&root, &allowed), before, "written outside -o and the cache");
+    assert_eq!(common::snapshot(&root, &allowed), before, "written outside -o and the cache");
 
     // The bytes of single drawings, the same options.
     for (input, name) in [(models.join("gear.glb"), "gear"), (elsewhere.join("shaft.glb"), "elsewhere/shaft")] {
@@ -138,7 +117,7 @@ fn a_catalog_of_sheets_draws_the_good_files_confined_and_a_rerun_is_all_cache_hi
     let third = report(&root.join("r1.json"));
     let up_to_date = third["files"].as_array().unwrap().iter().filter(|r| r["up_to_date"] == true).count();
     assert_eq!(up_to_date, 3, "{third}");
-    assert_eq!(snapshot(&root, &allowed), before, "written outside -o and the cache");
+    assert_eq!(common::snapshot(&root, &allowed), before, "written outside -o and the cache");
 
     // An option changed: drawn again.
     let gear = models.join("gear.glb");

@@ -71,3 +71,37 @@ pub fn gltf_triangle(edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
     edit(&mut json);
     serde_json::to_vec_pretty(&json).expect("json")
 }
+
+/// What [`snapshot`] records of a path.
+#[derive(Debug, PartialEq, Eq)]
+pub enum TreeNode {
+    Folder,
+    File(Vec<u8>),
+    Link(PathBuf),
+}
+
+/// Everything below `root`, links not followed, leaving out the paths in `allowed` (and what lies
+/// below them).
+pub fn snapshot(root: &Path, allowed: &[PathBuf]) -> std::collections::BTreeMap<PathBuf, TreeNode> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(folder) = stack.pop() {
+        for entry in std::fs::read_dir(&folder).expect("listed").flatten() {
+            let path = entry.path();
+            if allowed.iter().any(|a| path.starts_with(a)) {
+                continue;
+            }
+            let kind = entry.file_type().expect("type");
+            let node = if kind.is_symlink() {
+                TreeNode::Link(std::fs::read_link(&path).expect("link"))
+            } else if kind.is_dir() {
+                stack.push(path.clone());
+                TreeNode::Folder
+            } else {
+                TreeNode::File(std::fs::read(&path).expect("read"))
+            };
+            out.insert(path, node);
+        }
+    }
+    out
+}
