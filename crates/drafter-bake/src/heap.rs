@@ -51,4 +51,7 @@ pub fn keep_freed_memory_in(arenas: usize) {
     unsafe {
         libc::mallopt(libc::M_ARENA_MAX, i32::try_from(arenas.max(1)).unwrap_or(i32::MAX));
     }
+    // Other allocators have no such setting.
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    let _ = arenas;
 }

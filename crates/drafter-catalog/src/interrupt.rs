@@ -13,12 +13,15 @@
 //!
 //! The crate's one `unsafe` place: a POSIX signal handler may only call async-signal-safe
 //! functions, so it reads the registered paths from atomic pointers and calls `unlink` and `_exit`
-//! (both async-signal-safe), nothing else.
+//! (both async-signal-safe), nothing else. Off Unix there is no handler: [`install`] does nothing
+//! and a guard registers nothing (the graceful stop's flag stays unset), so an interrupted write
+//! may leave its temporary file there; the previous output stays intact all the same.
 #![allow(unsafe_code)]
 
-use std::ffi::CString;
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicI32, AtomicPtr, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+#[cfg(unix)]
+use std::{ffi::CString, sync::atomic::AtomicPtr};
 
 /// Set by [`set_graceful`]: the first signal asks for a stop instead of exiting.
 static GRACEFUL: AtomicBool = AtomicBool::new(false);
@@ -41,8 +44,10 @@ pub fn stop_requested() -> Option<i32> {
 /// Slots for the temporary files to remove if a signal arrives (null: free). A bake stages its
 /// main file, a .gltf's .bin, the report and one PNG per texture at once; a file past the last
 /// slot is still removed on every other path out, only not by a signal.
+#[cfg(unix)]
 static TEMP_FILES: [AtomicPtr<libc::c_char>; 64] = [const { AtomicPtr::new(std::ptr::null_mut()) }; 64];
 
+#[cfg(unix)]
 extern "C" fn on_signal(signal: libc::c_int) {
     if GRACEFUL.load(Ordering::SeqCst)
         && STOP_SIGNAL.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst).is_ok()
@@ -64,6 +69,7 @@ extern "C" fn on_signal(signal: libc::c_int) {
 
 /// Installs the handler for SIGINT, SIGTERM and SIGHUP (once, before the first write).
 pub fn install() {
+    #[cfg(unix)]
     for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
         // SAFETY: a zeroed sigaction is a valid value; the handler only calls async-signal-safe
         // functions (see the module docs).
@@ -81,6 +87,12 @@ pub fn install() {
 pub struct TempFileGuard(Option<usize>);
 
 impl TempFileGuard {
+    #[cfg(not(unix))]
+    pub fn new(_path: &Path) -> Self {
+        Self(None)
+    }
+
+    #[cfg(unix)]
     pub fn new(path: &Path) -> Self {
         use std::os::unix::ffi::OsStrExt;
         let Ok(c) = CString::new(path.as_os_str().as_bytes()) else { return Self(None) };
@@ -96,6 +108,9 @@ impl TempFileGuard {
 
 impl Drop for TempFileGuard {
     fn drop(&mut self) {
+        #[cfg(not(unix))]
+        let _ = self.0;
+        #[cfg(unix)]
         if let Some(slot) = self.0 {
             TEMP_FILES[slot].store(std::ptr::null_mut(), Ordering::SeqCst);
         }

@@ -64,9 +64,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
 /// this user cannot open for writing is refused and left as it was; otherwise the new bytes are
 /// staged beside it, given the file's owner and group where the user may (root; a group the user
 /// is in) and then its mode, and renamed over it. A path that does not exist yet is written as
-/// [`write_atomically`] writes (the umask's mode).
+/// [`write_atomically`] writes (the umask's mode). Off Unix the file's owner and mode are the
+/// platform's business: the read-only flag is checked, the new file takes the folder's defaults.
 pub fn replace_in_place(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    use std::os::unix::fs::{MetadataExt, PermissionsExt};
     let io = |what: &str, e: std::io::Error| Error::Io(format!("{}: {what}: {e}", path.display()));
     let target = match std::fs::canonicalize(path) {
         Ok(target) => target,
@@ -77,20 +77,28 @@ pub fn replace_in_place(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     if !metadata.is_file() {
         return Err(Error::Input(format!("{}: not a regular file; not replaced", path.display())));
     }
-    let mode = metadata.permissions().mode() & 0o7777;
     if metadata.permissions().readonly() {
-        return Err(Error::Io(format!("{}: read-only (mode {mode:04o}); not replaced", path.display())));
+        #[cfg(unix)]
+        let mode = format!(" (mode {:04o})", std::os::unix::fs::PermissionsExt::mode(&metadata.permissions()) & 0o7777);
+        #[cfg(not(unix))]
+        let mode = String::new();
+        return Err(Error::Io(format!("{}: read-only{mode}; not replaced", path.display())));
     }
     // Opening for writing (no truncation, nothing written) asks the kernel what it would allow:
     // the mode bits, ACLs, a read-only mount.
     std::fs::OpenOptions::new().write(true).open(&target).map_err(|e| io("cannot write", e))?;
     let staged = Staged::new(&target, bytes)?;
-    // Owner first: a change of owner clears the set-id bits, which the mode then restores.
-    if std::os::unix::fs::chown(&staged.temp, Some(metadata.uid()), Some(metadata.gid())).is_err() {
-        let _ = std::os::unix::fs::chown(&staged.temp, None, Some(metadata.gid()));
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{MetadataExt, PermissionsExt};
+        // Owner first: a change of owner clears the set-id bits, which the mode then restores.
+        if std::os::unix::fs::chown(&staged.temp, Some(metadata.uid()), Some(metadata.gid())).is_err() {
+            let _ = std::os::unix::fs::chown(&staged.temp, None, Some(metadata.gid()));
+        }
+        let mode = metadata.permissions().mode() & 0o7777;
+        std::fs::set_permissions(&staged.temp, std::fs::Permissions::from_mode(mode))
+            .map_err(|e| io("cannot keep its mode", e))?;
     }
-    std::fs::set_permissions(&staged.temp, std::fs::Permissions::from_mode(mode))
-        .map_err(|e| io("cannot keep its mode", e))?;
     commit(vec![staged])
 }
 
