@@ -8,9 +8,9 @@ drafter-catalog). Every call releases the GIL while it works, so Python threads 
     glb = drafter.bake(stl_bytes, name="part.stl", config={"gradient": {"q": 12}})
     info = drafter.inspect(glb)                              # what ``drafter inspect --json`` prints
     record = drafter.bake_file("a.obj", "out/a.glb", cache="~/.cache/drafter")
-    report = drafter.bake_many("models/", "baked/", cache="/shared/drafter-cache")
+    report = drafter.bake_many("models/", "baked/", cache="drafter-cache/")
     drafter.draw("gearbox.gltf", "gearbox.pdf", sheet="A3", projection="third", hidden="dashed")
-    report = drafter.draw_many("models/", "sheets/", format=["svg", "pdf"], sheet="A3", cache="/shared/drafter-cache")
+    report = drafter.draw_many("models/", "sheets/", format=["svg", "pdf"], sheet="A3", cache="drafter-cache/")
 
 Errors raise :class:`InputError` (bad input or options: the CLI's exit code 2), :class:`IoError`
 (a file could not be read or written: 3; also an :class:`OSError`) or :class:`InternalError` (a
