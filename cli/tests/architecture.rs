@@ -320,6 +320,17 @@ fn stage_crates_depend_on_drafter_core_only() {
     }
 }
 
+/// The glTF owner knows the file and nothing of how it is made: it names no bake stage (the texture
+/// mappings it writes are drafter-core's enums), no importer, no view.
+#[test]
+fn the_format_depends_on_drafter_core_only() {
+    let manifests = manifests();
+    let format = &manifests["drafter-format"];
+    let workspace: Vec<&String> =
+        format.normal.iter().filter(|d| manifests.contains_key(d.as_str()) && *d != "drafter-core").collect();
+    assert!(workspace.is_empty(), "{} depends on workspace crates {workspace:?}", format.path);
+}
+
 /// Fails when `root` reaches a crate `forbidden` says yes to, naming the crate that brings it in.
 fn assert_reaches_none(root: &str, forbidden: fn(&str) -> bool, why: &str) {
     let manifests = manifests();

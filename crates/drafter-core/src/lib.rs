@@ -13,6 +13,7 @@
 //! Invariant: nothing in this crate reads or writes files.
 
 mod diagnostic;
+pub mod env_map;
 pub mod gradient;
 pub mod hierarchy;
 mod ids;

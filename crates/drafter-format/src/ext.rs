@@ -5,8 +5,8 @@
 //! value outside them is refused when the file is read and no user parses a name again later.
 
 pub use drafter_core::ObbMethod;
+pub use drafter_core::env_map::{CoolToWarmEncoding, EnvMapping};
 pub use drafter_core::gradient::TransferCurve;
-pub use drafter_textures::{CoolToWarmEncoding, EnvMapping};
 use serde::{Deserialize, Serialize};
 
 /// The extension's name, as listed in `extensionsUsed` (never in `extensionsRequired`).

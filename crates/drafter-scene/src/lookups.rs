@@ -104,9 +104,9 @@ impl LookupImage {
     }
 }
 
-/// How an environment map is indexed by the eye-space normal: drafter-textures' rule, which the
+/// How an environment map is indexed by the eye-space normal: the shared rule, which the
 /// bake writes (the spec's `mapping` / `highlightMapping`).
-pub use drafter_textures::EnvMapping;
+pub use drafter_core::env_map::EnvMapping;
 
 /// The γ atlas: row `r` holds `curves[r]`.
 #[derive(Clone, Debug, PartialEq)]

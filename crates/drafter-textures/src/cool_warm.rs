@@ -34,6 +34,8 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+pub use drafter_core::env_map::CoolToWarmEncoding;
+
 use crate::envmap::{EnvMapping, bake_env_map};
 use crate::error::OptionError;
 use crate::texture::{SamplerHint, Texture, TextureFormat, TextureKind};
@@ -56,16 +58,6 @@ pub const DEFAULT_SPLASH_BETA: f32 = 0.78;
 pub const DEFAULT_LIGHT_IN_EYE: [f32; 3] = [1.0, 1.0, 0.5];
 /// Default of [`CoolToWarmOptions::size`].
 pub const DEFAULT_COOL_TO_WARM_SIZE: u32 = 128;
-
-/// What the channels of a cool-to-warm map hold (module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CoolToWarmEncoding {
-    /// RGB = the shaded colour for one object colour; A = 1.
-    Colour,
-    /// RGB = colour-independent base, A = object-colour weight: `I = clamp(rgb + a·k_d)`.
-    Factored,
-}
 
 /// Parameters of one cool-to-warm map.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
