@@ -118,8 +118,8 @@ const MAX_THREADS: usize = 1024;
 
 pub fn run(args: Args) -> Result<()> {
     if let Some(n) = args.threads {
-        // A thread per core is all the bake can use; thousands only cost their start-up (2,000
-        // took 34 s on a 2-core machine) and past that their stacks exhaust memory.
+        // A thread per core is all the bake can use; thousands only cost their start-up (seconds
+        // to minutes on a small machine) and past that their stacks exhaust memory.
         if !(1..=MAX_THREADS).contains(&n) {
             return Err(BadInput(format!("--threads must be between 1 and {MAX_THREADS}, not {n}")).into());
         }

@@ -752,8 +752,8 @@ fn silhouettes_of(
     hierarchies: bool,
 ) -> Option<MeshSilhouettes> {
     // Candidates per primitive, counted first so that each primitive fills its own slice of the
-    // arrays on the thread pool (pushing 1.3M candidates one by one into growing vectors took
-    // 0.11 s of one core on the dragon).
+    // arrays on the thread pool, rather than pushing a million candidates one by one into growing
+    // vectors on one core.
     let counts: Vec<usize> = edges.par_iter().map(|e| e.as_ref().map_or(0, |e| e.silhouette_slots().count())).collect();
     let total: usize = counts.iter().sum();
     if total == 0 {

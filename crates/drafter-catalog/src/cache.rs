@@ -202,10 +202,8 @@ fn key_from(path: &Path, input_digest: &[u8; 32], uris: &[String], config: &draf
 
 /// Feeds the file at `path` to `hasher`: memory-mapped and hashed on the thread pool from 16 KB on
 /// (blake3's `update_mmap_rayon`, which reads smaller files), so that the bytes are neither copied
-/// nor given fresh pages. Measured on the shared models with their pages cached (best of 30): the
-/// dragon's 15.7 MB in 1.7 ms against 3.0 ms read in 4 MB blocks through one buffer, Buggy.bin's
-/// 7.6 MB in 1.1 against 1.7–1.9 ms; in a cached rerun of the whole folder the copies and the page
-/// faults of reading were two fifths of the time.
+/// nor given fresh pages: in a cached rerun of a catalog, hashing is most of the work, and reading
+/// through a buffer would add a copy and a page fault per block to it.
 fn hash_file(hasher: &mut blake3::Hasher, path: &Path) -> std::io::Result<()> {
     hasher.update_mmap_rayon(path).map(|_| ())
 }

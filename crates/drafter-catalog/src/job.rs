@@ -88,7 +88,7 @@ pub fn bake_bytes(
     limits: &drafter_io::Limits,
     on_stage: &mut dyn FnMut(drafter_bake::Stage),
 ) -> Result<Baked, Error> {
-    // The input's digest (for the provenance) beside the import: 9 ms of one core on the dragon.
+    // The input's digest (for the provenance) beside the import, on the thread pool.
     let (imported, digest) =
         rayon::join(|| drafter_io::import_bytes_within(path, &bytes, limits), || sha2::Sha256::digest(&bytes));
     let imported = imported?;

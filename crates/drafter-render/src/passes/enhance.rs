@@ -15,11 +15,11 @@
 //!   planes, 1/z or z, above [`DEPTH_EDGE_THRESHOLD`]); a **crease** where the normal turns by more
 //!   than [`CREASE_ANGLE_DEG`] to the next pixel of the same part.
 //!
-//! Why edges are not a pass of their own, as in Lux et al.: measured on lavapipe (the CPU Vulkan
-//! device of CI and headless use) at 1600×1200, a full-screen pass costs about half a Phong frame
-//! whatever its shader does. With a separate edge pass (and a half-resolution blur) gradient +
-//! edges took 2.7× the Phong frame (`drafter bench render`); with the edges computed in the
-//! display pass, which reads the same texels anyway, and the blur at quarter resolution, 1.4–1.5×.
+//! Why edges are not a pass of their own, as in Lux et al.: on lavapipe (the CPU Vulkan device of
+//! CI and headless use) a full-screen pass costs a large part of a Phong frame whatever its shader
+//! does, so a separate edge pass (and a half-resolution blur) nearly doubled the gradient + edges
+//! frame; the edges are computed in the display pass, which reads the same texels anyway, and the
+//! blur runs at quarter resolution (`drafter bench render` measures the frames; docs/bench.md).
 //! On a GPU either layout costs well under a millisecond.
 //!
 //! # Limits
