@@ -353,10 +353,14 @@ impl Renderer {
         }
         self.shadow.prepare(queue, &plan);
         let radius = (max - min).length() * 0.5;
+        if options.drawn_enhancements().unsharp_mask {
+            self.enhance.ensure_pipeline(&self.gpu.device);
+        }
         self.enhance
             .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
         self.display.prepare(&self.gpu.device, queue, &display::uniforms(options, radius, options.orthographic));
         if options.lines {
+            self.lines.ensure_pipeline(&self.gpu.device);
             let view = world_view(&camera, scene.origin);
             let silhouettes = scene.lines.lines.silhouettes(view);
             let uniforms = lines::uniforms(options, &camera, size.1);

@@ -54,7 +54,10 @@ pub struct EnhanceSetup {
 #[derive(Debug)]
 pub struct EnhancePass {
     layout: wgpu::BindGroupLayout,
-    blur: wgpu::RenderPipeline,
+    pipeline_layout: wgpu::PipelineLayout,
+    /// Compiled, with its shader module, by [`Self::ensure_pipeline`] at the first frame with the
+    /// unsharp mask (a frame without image-space edges never needs it).
+    blur: Option<wgpu::RenderPipeline>,
     uniforms: [wgpu::Buffer; 2],
 }
 
@@ -67,7 +70,6 @@ pub struct EnhanceBindings {
 
 impl EnhancePass {
     pub fn new(device: &wgpu::Device) -> EnhancePass {
-        let module = device.create_shader_module(super::shader_source!("enhance.wgsl", "fullscreen.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("enhance bind group layout"),
             entries: &[
@@ -81,16 +83,6 @@ impl EnhancePass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let blur = fullscreen_pipeline(
-            device,
-            "enhance blur pipeline",
-            &pipeline_layout,
-            &module,
-            "fs_blur",
-            BLUR_FORMAT,
-            None,
-            &[],
-        );
         let uniform = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -100,7 +92,24 @@ impl EnhancePass {
             })
         };
         let uniforms = [uniform("enhance blur h uniforms"), uniform("enhance blur v uniforms")];
-        EnhancePass { layout, blur, uniforms }
+        EnhancePass { layout, pipeline_layout, blur: None, uniforms }
+    }
+
+    /// Compiles the blur the first time a frame draws the unsharp mask.
+    pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
+        if self.blur.is_none() {
+            let module = device.create_shader_module(super::shader_source!("enhance.wgsl", "fullscreen.wgsl"));
+            self.blur = Some(fullscreen_pipeline(
+                device,
+                "enhance blur pipeline",
+                &self.pipeline_layout,
+                &module,
+                "fs_blur",
+                BLUR_FORMAT,
+                None,
+                &[],
+            ));
+        }
     }
 
     pub fn bindings(&self, device: &wgpu::Device, targets: &Targets) -> EnhanceBindings {
@@ -141,7 +150,12 @@ impl EnhancePass {
     }
 
     /// Blurs the linear depth into `targets.blur_b` (via `blur_a`).
+    /// Records the blur; [`Self::ensure_pipeline`] must have run (the renderer's `prepare` does).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets, bindings: &EnhanceBindings) {
+        let Some(blur) = self.blur.as_ref() else {
+            debug_assert!(false, "the blur is encoded before its pipeline was compiled");
+            return;
+        };
         encoder.push_debug_group(LABEL);
         let draws = [
             ("enhance blur h pass", &bindings.blur_h, &targets.blur_a.view),
@@ -156,7 +170,7 @@ impl EnhancePass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.blur);
+            pass.set_pipeline(blur);
             pass.set_bind_group(0, group, &[]);
             pass.draw(0..3, 0..1);
         }

@@ -137,14 +137,17 @@ pub struct LinesPass {
     frame_layout: wgpu::BindGroupLayout,
     targets_layout: wgpu::BindGroupLayout,
     segments_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+    /// Compiled, with its shader module, by [`Self::ensure_pipeline`] at the first frame with
+    /// lines (a view without them never needs it).
+    pipeline: Option<wgpu::RenderPipeline>,
     uniforms: wgpu::Buffer,
 }
 
 impl LinesPass {
     /// A lines pass blending over a `format` target (the display pass's output).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> LinesPass {
-        let module = device.create_shader_module(super::shader_source!("lines.wgsl", "shared.wgsl"));
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lines frame bind group layout"),
@@ -163,9 +166,24 @@ impl LinesPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&targets_layout), Some(&segments_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lines uniforms"),
+            size: size_of::<LinesUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        LinesPass { frame_layout, targets_layout, segments_layout, layout, format, pipeline: None, uniforms }
+    }
+
+    /// Compiles the pipeline the first time a frame draws lines.
+    pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
+        if self.pipeline.is_some() {
+            return;
+        }
+        let module = device.create_shader_module(super::shader_source!("lines.wgsl", "shared.wgsl"));
+        self.pipeline = Some(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("lines pipeline"),
-            layout: Some(&layout),
+            layout: Some(&self.layout),
             vertex: wgpu::VertexState {
                 module: &module,
                 entry_point: Some("vs_main"),
@@ -180,21 +198,14 @@ impl LinesPass {
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
-                    format,
+                    format: self.format,
                     blend: Some(wgpu::BlendState::ALPHA_BLENDING),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),
             multiview_mask: None,
             cache: None,
-        });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("lines uniforms"),
-            size: size_of::<LinesUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        LinesPass { frame_layout, targets_layout, segments_layout, pipeline, uniforms }
+        }));
     }
 
     fn segment_buffer(&self, device: &wgpu::Device, label: &'static str, capacity: u64) -> SegmentBuffer {
@@ -273,7 +284,8 @@ impl LinesPass {
         scene.last = Some(silhouettes);
     }
 
-    /// Draws the lines over `output` (the display pass's result, same size as the targets).
+    /// Draws the lines over `output` (the display pass's result, same size as the targets);
+    /// [`Self::ensure_pipeline`] must have run (the renderer's `prepare` does).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -281,6 +293,10 @@ impl LinesPass {
         targets_bind_group: &wgpu::BindGroup,
         output: &wgpu::TextureView,
     ) {
+        let Some(pipeline) = self.pipeline.as_ref() else {
+            debug_assert!(false, "lines are encoded before their pipeline was compiled");
+            return;
+        };
         encoder.push_debug_group(LABEL);
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -291,7 +307,7 @@ impl LinesPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &scene.frame_bind_group, &[]);
             pass.set_bind_group(1, targets_bind_group, &[]);
             for segments in [&scene.hard, &scene.silhouettes] {

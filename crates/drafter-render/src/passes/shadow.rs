@@ -194,7 +194,6 @@ fn steep(light_dir: Vec3) -> Vec3 {
 #[derive(Debug)]
 pub struct ShadowPass {
     scene_layout: wgpu::BindGroupLayout,
-    module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     resolve_pipeline_layout: wgpu::PipelineLayout,
     /// Compiled by [`Self::ensure_pipelines`] when a frame first draws a shadow (the page's default
@@ -265,8 +264,6 @@ fn layer_uniforms(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgp
 impl ShadowPass {
     pub fn new(device: &wgpu::Device) -> ShadowPass {
         use wgpu::ShaderStages as S;
-        let module =
-            device.create_shader_module(super::shader_source!("shadow.wgsl", "shared.wgsl", "fullscreen.wgsl"));
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow scene bind group layout"),
             entries: &[crate::table::layout_entry(0, S::VERTEX)],
@@ -329,7 +326,6 @@ impl ShadowPass {
         });
         ShadowPass {
             scene_layout,
-            module,
             layout,
             resolve_pipeline_layout,
             pipelines: None,
@@ -369,12 +365,14 @@ impl ShadowPass {
         if self.pipelines.is_some() {
             return;
         }
+        let module =
+            device.create_shader_module(super::shader_source!("shadow.wgsl", "shared.wgsl", "fullscreen.wgsl"));
         let layer_pipeline = |label: &str, format, blend, depth_stencil| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&self.layout),
                 vertex: wgpu::VertexState {
-                    module: &self.module,
+                    module: &module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &[Some(crate::passes::gbuffer::vertex_layout())],
@@ -383,7 +381,7 @@ impl ShadowPass {
                 depth_stencil,
                 multisample: wgpu::MultisampleState::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &self.module,
+                    module: &module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })],
@@ -409,7 +407,7 @@ impl ShadowPass {
             device,
             "shadow resolve pipeline",
             &self.resolve_pipeline_layout,
-            &self.module,
+            &module,
             "fs_resolve",
             SHADOW_MASK_FORMAT,
             None,

@@ -20,11 +20,10 @@ pub const LABEL: &str = "upscale";
 #[derive(Debug)]
 pub struct UpscalePass {
     layout: wgpu::BindGroupLayout,
-    module: wgpu::ShaderModule,
     pipeline_layout: wgpu::PipelineLayout,
     format: wgpu::TextureFormat,
     /// Compiled by [`Self::ensure_pipeline`] at the first interactive frame (a still view never
-    /// needs it).
+    /// needs it), its shader module with it.
     pipeline: Option<wgpu::RenderPipeline>,
     sampler: wgpu::Sampler,
 }
@@ -32,7 +31,6 @@ pub struct UpscalePass {
 impl UpscalePass {
     /// An upscale pass writing `format` (the display pass's).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> UpscalePass {
-        let module = device.create_shader_module(super::shader_source!("upscale.wgsl", "fullscreen.wgsl"));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("upscale bind group layout"),
             entries: &[texture_entry(0, FILTERABLE), sampler_entry(1)],
@@ -50,17 +48,18 @@ impl UpscalePass {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             ..Default::default()
         });
-        UpscalePass { layout, module, pipeline_layout, format, pipeline: None, sampler }
+        UpscalePass { layout, pipeline_layout, format, pipeline: None, sampler }
     }
 
     /// Compiles the pipeline the first time an interactive frame is drawn.
     pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
         if self.pipeline.is_none() {
+            let module = device.create_shader_module(super::shader_source!("upscale.wgsl", "fullscreen.wgsl"));
             self.pipeline = Some(fullscreen_pipeline(
                 device,
                 "upscale pipeline",
                 &self.pipeline_layout,
-                &self.module,
+                &module,
                 "fs_main",
                 self.format,
                 None,
