@@ -5,7 +5,8 @@ report as ``drafter bake DIR -o OUT --report``.
 
     import ray, drafter.ray
     ray.init(address="auto")                     # a cluster started with `ray start --head` / `--address`
-    report = drafter.ray.bake_catalog(["/data/catalog"], "/data/baked", cache="/data/drafter-cache")
+    # run from the shared folder: relative paths are resolved on the driver
+    report = drafter.ray.bake_catalog(["catalog"], "baked", cache="drafter-cache")
 
 Every path (inputs, manifests, ``out_dir``, ``cache``, ``report``, a config file) is resolved on
 the driver, against its working folder, before any task is sent: the workers' working folder is

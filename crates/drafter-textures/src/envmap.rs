@@ -4,11 +4,10 @@
 //! Sample both with linear filtering and clamp-to-edge. A texel's value is the shading function
 //! evaluated at the normal of its centre.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 pub use drafter_core::env_map::EnvMapping;
-use glam::Vec3;
 
 /// Bakes a `size × size` map: `channels` bytes per texel, from `shade(normal) → values in [0, 1]`
 /// (only the first `channels` values are used). Rows are computed in parallel; each texel depends
