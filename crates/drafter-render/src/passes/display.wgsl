@@ -45,16 +45,17 @@ fn has(flag: u32) -> bool {
 @group(0) @binding(6) var shadow_tex: texture_2d<f32>;
 @group(0) @binding(7) var linear_sampler: sampler;
 
-fn clamp_xy(p: vec2<i32>) -> vec2<i32> {
-    return clamp(p, vec2<i32>(0), vec2<i32>(textureDimensions(id_tex)) - 1);
+// The G-buffer at p, clamped to the last texel `hi` (the targets' size less one).
+fn part_at(p: vec2<i32>, hi: vec2<i32>) -> u32 {
+    return textureLoad(id_tex, clamp(p, vec2<i32>(0), hi), 0).r;
 }
 
-fn part_at(p: vec2<i32>) -> u32 {
-    return textureLoad(id_tex, clamp_xy(p), 0).r;
+fn depth_at(p: vec2<i32>, hi: vec2<i32>) -> f32 {
+    return textureLoad(depth_tex, clamp(p, vec2<i32>(0), hi), 0).r;
 }
 
-fn depth_at(p: vec2<i32>) -> f32 {
-    return textureLoad(depth_tex, clamp_xy(p), 0).r;
+fn normal_at(p: vec2<i32>, hi: vec2<i32>) -> vec3<f32> {
+    return textureLoad(normal_tex, clamp(p, vec2<i32>(0), hi), 0).xyz;
 }
 
 // Depth as a quantity that is affine along a plane in screen space: 1/z for a perspective camera,
@@ -63,60 +64,95 @@ fn affine_depth(d: f32) -> f32 {
     return select(1.0 / max(d, 1e-30), d, u.ortho > 0.5);
 }
 
-// Outline test towards `dir`: a different part within `r` pixels (drawn on the nearer side), or the
-// background within `outer` pixels of the model / the model within `r` pixels of the background
-// (both sides: the heavier outer line).
-fn outline_towards(p: vec2<i32>, id: u32, d: f32, dir: vec2<i32>, r: i32, outer: i32) -> bool {
-    for (var k = 1; k <= max(r, outer); k = k + 1) {
-        let q = p + dir * k;
-        let id_q = part_at(q);
-        if id_q == id {
-            continue;
-        }
-        if id == 0u {
-            if k <= r {
-                return true;
-            }
-        } else if id_q == 0u {
-            if k <= outer {
-                return true;
-            }
-        } else if k <= r && d <= depth_at(q) {
-            return true;
-        }
+// The outline test of a model pixel (part `id`, depth `d`) against the neighbour `k` pixels away
+// (part `id_q`, depth `d_q`, read only for k <= r): the background within `outer` pixels (the
+// heavier outer line), or another part within `r` pixels and farther (drawn on the nearer side).
+fn outline_against(id: u32, d: f32, id_q: u32, d_q: f32, k: i32, r: i32, outer: i32) -> bool {
+    if id_q == id {
+        return false;
     }
-    return false;
+    if id_q == 0u {
+        return k <= outer;
+    }
+    return k <= r && d <= d_q;
 }
 
-// A depth jump inside the part along `dir` (second difference of the affine depth), towards a
-// farther neighbour: silhouettes and occluding contours of a part over itself.
-fn depth_jump_along(p: vec2<i32>, id: u32, d: f32, dir: vec2<i32>, r: i32) -> bool {
+// A depth jump inside the part across p, between the neighbours `a` and `b` at the same distance
+// on either side (second difference of the affine depth `g` of p), towards a farther neighbour:
+// silhouettes and occluding contours of a part over itself.
+fn depth_jump(id: u32, d: f32, g: f32, id_a: u32, id_b: u32, da: f32, db: f32) -> bool {
+    if id_a != id || id_b != id {
+        return false;
+    }
+    let second = abs(affine_depth(da) + affine_depth(db) - 2.0 * g) / max(abs(g), 1e-30);
+    return second > u.depth_threshold && max(da, db) - d > 0.002 * u.scene_radius;
+}
+
+// The image-space edges at pixel p, read in one walk outwards along the four axis directions, each
+// neighbour once (a CPU rasteriser pays for every texel read of every pixel):
+// - outline: on the background, the model within `r` pixels; on the model, the background within
+//   `outer` pixels, a nearer pixel of another part within `r`, or a depth jump (above) within `r`;
+// - crease: the normal turns by more than the crease angle within `r` pixels right or down, within
+//   the part (right and down only, so the line is one pixel wide per unit of radius).
+struct Edges {
+    outline: bool,
+    crease: bool,
+}
+
+fn edges_at(p: vec2<i32>, id: u32, d: f32, hi: vec2<i32>, r: i32, outer: i32) -> Edges {
+    var e = Edges(false, false);
+    let x = vec2<i32>(1, 0);
+    let y = vec2<i32>(0, 1);
+    if id == 0u {
+        // Only the model within r pixels counts for the background.
+        if has(DISPLAY_OUTLINES) {
+            for (var k = 1; k <= r && !e.outline; k = k + 1) {
+                e.outline = part_at(p + x * k, hi) != 0u || part_at(p - x * k, hi) != 0u
+                    || part_at(p + y * k, hi) != 0u || part_at(p - y * k, hi) != 0u;
+            }
+        }
+        return e;
+    }
     let g = affine_depth(d);
-    for (var k = 1; k <= r; k = k + 1) {
-        let pa = p + dir * k;
-        let pb = p - dir * k;
-        if part_at(pa) != id || part_at(pb) != id {
-            continue;
+    var n = vec3<f32>(0.0);
+    if has(DISPLAY_CREASES) {
+        n = normal_at(p, hi);
+    }
+    let reach = select(r, max(r, outer), has(DISPLAY_OUTLINES));
+    for (var k = 1; k <= reach; k = k + 1) {
+        let right = p + x * k;
+        let left = p - x * k;
+        let down = p + y * k;
+        let up = p - y * k;
+        let id_r = part_at(right, hi);
+        let id_l = part_at(left, hi);
+        let id_d = part_at(down, hi);
+        let id_u = part_at(up, hi);
+        var d_r = 0.0;
+        var d_l = 0.0;
+        var d_d = 0.0;
+        var d_u = 0.0;
+        if k <= r && has(DISPLAY_OUTLINES) {
+            d_r = depth_at(right, hi);
+            d_l = depth_at(left, hi);
+            d_d = depth_at(down, hi);
+            d_u = depth_at(up, hi);
         }
-        let da = depth_at(pa);
-        let db = depth_at(pb);
-        let second = abs(affine_depth(da) + affine_depth(db) - 2.0 * g) / max(abs(g), 1e-30);
-        if second > u.depth_threshold && max(da, db) - d > 0.002 * u.scene_radius {
-            return true;
+        if has(DISPLAY_OUTLINES) {
+            e.outline = e.outline || outline_against(id, d, id_r, d_r, k, r, outer)
+                || outline_against(id, d, id_l, d_l, k, r, outer) || outline_against(id, d, id_d, d_d, k, r, outer)
+                || outline_against(id, d, id_u, d_u, k, r, outer);
+            if k <= r {
+                e.outline = e.outline || depth_jump(id, d, g, id_r, id_l, d_r, d_l)
+                    || depth_jump(id, d, g, id_d, id_u, d_d, d_u);
+            }
+        }
+        if k <= r && has(DISPLAY_CREASES) {
+            e.crease = e.crease || (id_r == id && dot(n, normal_at(right, hi)) < u.crease_cos)
+                || (id_d == id && dot(n, normal_at(down, hi)) < u.crease_cos);
         }
     }
-    return false;
-}
-
-// The normal turns by more than the crease angle towards `dir` within the part.
-fn crease_towards(p: vec2<i32>, id: u32, n: vec3<f32>, dir: vec2<i32>, r: i32) -> bool {
-    for (var k = 1; k <= r; k = k + 1) {
-        let q = p + dir * k;
-        if part_at(q) == id && dot(n, textureLoad(normal_tex, clamp_xy(q), 0).xyz) < u.crease_cos {
-            return true;
-        }
-    }
-    return false;
+    return e;
 }
 
 // The blurred depth at full-resolution pixel p: bilinear over the quarter-resolution texels
@@ -138,12 +174,18 @@ fn blurred_at(p: vec2<i32>) -> f32 {
 @fragment
 fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(frag.xy);
-    let id = part_at(p);
-    let d = depth_at(p);
+    let hi = vec2<i32>(textureDimensions(id_tex)) - 1;
+    let id = part_at(p, hi);
+    var d = 0.0;
+    if id != 0u {
+        d = depth_at(p, hi);
+    }
     let r = max(i32(round(u.line_radius)), 1);
     let outer = i32(round(u.line_radius * 1.5));
-    let x = vec2<i32>(1, 0);
-    let y = vec2<i32>(0, 1);
+    var e = Edges(false, false);
+    if has(DISPLAY_OUTLINES) || has(DISPLAY_CREASES) {
+        e = edges_at(p, id, d, hi, r, outer);
+    }
 
     var c: vec3<f32>;
     if id == 0u {
@@ -170,23 +212,12 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         if id == u.selected {
             c = mix(c, u.highlight_color.rgb, u.highlight_color.a);
         }
-        if has(DISPLAY_CREASES) {
-            // Right and down only, so the line is one pixel wide per unit of radius.
-            let n = textureLoad(normal_tex, p, 0).xyz;
-            if crease_towards(p, id, n, x, r) || crease_towards(p, id, n, y, r) {
-                c = mix(c, u.crease_color.rgb, u.crease_color.a);
-            }
+        if e.crease {
+            c = mix(c, u.crease_color.rgb, u.crease_color.a);
         }
     }
-    if has(DISPLAY_OUTLINES) {
-        var outline = outline_towards(p, id, d, x, r, outer) || outline_towards(p, id, d, -x, r, outer)
-            || outline_towards(p, id, d, y, r, outer) || outline_towards(p, id, d, -y, r, outer);
-        if id != 0u && !outline {
-            outline = depth_jump_along(p, id, d, x, r) || depth_jump_along(p, id, d, y, r);
-        }
-        if outline {
-            c = u.line_color.rgb;
-        }
+    if e.outline {
+        c = u.line_color.rgb;
     }
     return vec4<f32>(c, 1.0);
 }
