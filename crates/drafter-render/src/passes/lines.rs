@@ -43,6 +43,8 @@ use crate::table::{self, Table};
 use crate::targets::Targets;
 
 pub const LABEL: &str = "lines";
+/// Vertices per segment: its quad's two triangles (`vs_main` in lines.wgsl).
+const VERTICES_PER_SEGMENT: u32 = 6;
 /// Table texels per segment (`segment_at` in lines.wgsl).
 const SEGMENT_TEXELS: u64 = (size_of::<LineSegmentGpu>() / crate::table::TEXEL_BYTES) as u64;
 
@@ -313,7 +315,11 @@ impl LinesPass {
             for segments in [&scene.hard, &scene.silhouettes] {
                 if segments.count > 0 {
                     pass.set_bind_group(2, &segments.bind_group, &[]);
-                    pass.draw(0..6, 0..segments.count);
+                    // Six vertices a segment in one plain draw, not one instance a segment: a CPU
+                    // rasteriser (SwiftShader, the browsers' WebGL without a GPU) sets up every
+                    // instance as a draw of its own, which for an assembly's 10⁵ segments is most
+                    // of the frame.
+                    pass.draw(0..segments.count.saturating_mul(VERTICES_PER_SEGMENT), 0..1);
                 }
             }
         }

@@ -1,5 +1,6 @@
 // Lines pass: every baked edge (and every silhouette of this frame) as a screen-space quad of a width
-// in pixels, instanced (one instance per segment, 6 vertices), blended over the display output.
+// in pixels (6 vertices per segment, vertex 6i + k being corner k of segment i, in one draw),
+// blended over the display output.
 // The quad is the segment's capsule: extended by the half-width at both ends and cut round in the
 // fragment shader, so consecutive segments join without gaps. Hidden parts are discarded by
 // comparing the line's view depth with the G-buffer's linear depth at the nearest point of the
@@ -65,8 +66,9 @@ fn is_outline(kind: u32) -> bool {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
-    let s = segment_at(i);
+fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
+    let v = vertex % 6u;
+    let s = segment_at(vertex / 6u);
     let inst = instance_at(s.instance);
     var a = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.a, 1.0))).xyz;
     var b = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.b, 1.0))).xyz;
