@@ -39,6 +39,30 @@ function loadModule() {
   return module;
 }
 
+/**
+ * Resolves once the GPU has run every command the page gave it so far: a WebGL2 fence, polled
+ * every few milliseconds (its status changes only between tasks); on WebGPU at once. Only the
+ * first frame's timing waits for it: requestAnimationFrame alone fires before a CPU rasteriser
+ * has finished a large frame.
+ */
+function gpuFinished(viewer, canvas) {
+  // Asked only of a viewer on WebGL2, so that the call finds wgpu's context, never makes one.
+  const gl = /Gl\b/.test(viewer.backend()) ? canvas.getContext('webgl2') : null;
+  if (!gl || gl.isContextLost()) return Promise.resolve();
+  const sync = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+  if (!sync) return Promise.resolve();
+  gl.flush();
+  return new Promise((resolve) => {
+    const poll = () => {
+      if (gl.isContextLost() || gl.getSyncParameter(sync, gl.SYNC_STATUS) === gl.SIGNALED) {
+        gl.deleteSync(sync);
+        resolve();
+      } else setTimeout(poll, 4);
+    };
+    setTimeout(poll, 0);
+  });
+}
+
 /** A module object's fields (its getters) as a plain object, which scripts and tests can copy; frees it. */
 function fields(object) {
   const out = {};
@@ -498,7 +522,8 @@ export class DrafterViewer extends HTMLElement {
       this.fail(`Cannot draw ${name}: ${err.message ?? err}`);
       return;
     }
-    // The frame is on screen once the browser has composited it.
+    // The frame is on screen once the GPU has drawn it and the browser has composited it.
+    await gpuFinished(this.viewer, this.canvas);
     await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
     this.timings.firstFrame = performance.now();
     this.state = 'ready';
