@@ -6,10 +6,11 @@
 //   PAGE_DIR: the built page (index.html, drafter-viewer.js, drafter_web.js, drafter_web_bg.wasm).
 //   FILE: the model, served from its folder.
 //   shots --out DIR --styles a,b,... [--size WxH] [--view AZ,EL] [--edges] [--lines] [--shadow S]
-//         [--frames N] [--no-src] [--capture]
+//         [--frames N] [--no-src] [--capture] [--idle-browser]
 //       Loads the page with FILE, then draws each style and saves the canvas as DIR/STYLE.png
 //       (with --capture, and always on WebGPU: the pixels of viewer.capture(), the same frame
-//       drawn offscreen).
+//       drawn offscreen). --idle-browser: opens the page only once the freshly started browser's
+//       own start-up work is done (lib/browser.mjs, waitUntilBrowserIdle; idleWaitMs says how long).
 //       Prints {ok, backend, summary, timings, startup, shots, frameMs, consoleErrors}: timings in ms from
 //       the navigation's start (wasmReady, fileFetched, modelLoaded, firstFrame); with --frames,
 //       frameMs holds N full frames of the first style, each timed from recording until the GPU
@@ -44,7 +45,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import process from 'node:process';
 
-import { launchBrowser, killBrowser } from './lib/browser.mjs';
+import { launchBrowser, killBrowser, waitUntilBrowserIdle } from './lib/browser.mjs';
 
 // WebGPU without a GPU: Dawn on Chromium's bundled SwiftShader Vulkan.
 const WEBGPU_ARGS = (process.env.DRAFTER_WEBGPU_ARGS ?? '--enable-unsafe-webgpu --enable-features=Vulkan --use-webgpu-adapter=swiftshader').split(' ');
@@ -53,7 +54,7 @@ import { startServer } from './lib/server.mjs';
 function parse(argv) {
   const [command, pageDir, file, ...rest] = argv;
   const options = { backend: 'webgl2', timeout: process.env.DRAFTER_WEB_TIMEOUT ?? '120', size: '800x600', view: '35,25', shadow: 'none', param: [], set: [] };
-  const flags = ['edges', 'lines', 'no-src', 'capture', 'no-size', 'controls', 'reload', 'lose-device', 'help-key', 'reattach'];
+  const flags = ['edges', 'lines', 'no-src', 'capture', 'idle-browser', 'no-size', 'controls', 'reload', 'lose-device', 'help-key', 'reattach'];
   for (let i = 0; i < rest.length; i++) {
     const name = rest[i].replace(/^--/, '');
     if (flags.includes(name)) options[name] = true;
@@ -222,6 +223,7 @@ async function main() {
   const consoleErrors = [];
   let result;
   try {
+    const idleWaitMs = options['idle-browser'] ? await waitUntilBrowserIdle(browser) : undefined;
     const dpr = Number(options.dpr ?? 1);
     // The page's size in CSS pixels: with --no-size and --dpr N, the canvas is N times larger.
     const [w, h] = options.size.split('x').map((n) => Math.round(Number(n) / (options['no-size'] ? dpr : 1)));
@@ -336,7 +338,7 @@ async function main() {
           Number(options.frames),
         );
       }
-      result = { ok: true, backend: status.backend, summary: status.summary, timings: status.timings, startup: status.startup, shots, frameMs };
+      result = { ok: true, backend: status.backend, summary: status.summary, timings: status.timings, startup: status.startup, shots, frameMs, idleWaitMs };
     } else if (command === 'interact') {
       const pixels = () =>
         page.evaluate(() => {

@@ -55,6 +55,47 @@ export async function launchBrowser(timeoutMs, extraArgs = []) {
 }
 
 /**
+ * Waits until the browser's own start-up work is done: its processes (the launched one's process
+ * group) together use under a tenth of a core for `quietMs`, or `maxMs` passed. Returns the ms waited.
+ * A freshly started Chromium spends about a second of CPU after launch on work of its own (the
+ * omnibox popup's WebUI page, among others), which on two cores a page opened at once competes
+ * with; the first-frame benchmark waits for it (docs/web.md, "First frame"). Linux only: reads /proc.
+ */
+export async function waitUntilBrowserIdle(browser, { quietMs = 500, maxMs = 15_000 } = {}) {
+  const group = browser.process()?.pid;
+  if (!group) return 0;
+  const { readdirSync, readFileSync } = await import('node:fs');
+  // CPU seconds of every process in the group (utime + stime, in clock ticks of 1/100 s).
+  const cpuTicks = () => {
+    let ticks = 0;
+    for (const pid of readdirSync('/proc')) {
+      if (!/^\d+$/.test(pid)) continue;
+      let stat;
+      try {
+        stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
+      } catch {
+        continue; // gone meanwhile
+      }
+      const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+      if (Number(fields[2]) === group) ticks += Number(fields[11]) + Number(fields[12]);
+    }
+    return ticks;
+  };
+  const start = Date.now();
+  const step = 100;
+  let quiet = 0;
+  let before = cpuTicks();
+  while (quiet < quietMs && Date.now() - start < maxMs) {
+    await new Promise((resolve) => setTimeout(resolve, step));
+    const now = cpuTicks();
+    // A tenth of a core over the step: at most one tick (1/100 s) per 100 ms.
+    quiet = now - before <= step / 100 ? quiet + step : 0;
+    before = now;
+  }
+  return Date.now() - start;
+}
+
+/**
  * Opens `url`, waits (at most `timeoutMs`) until the page sets window.__result, and returns
  * { result, consoleErrors }. With `screenshot` (a path) and a successful result, saves the view as PNG.
  */
