@@ -407,8 +407,10 @@ export class DrafterViewer extends HTMLElement {
       this.fail(`This browser cannot run the viewer: ${err.message ?? err}`);
       return;
     }
-    if (src) await this.loadUrl(src, pending);
-    else {
+    if (src) {
+      this.warmPipelines(attributes);
+      await this.loadUrl(src, pending);
+    } else {
       this.state = 'empty';
       this.say('Drop a baked .glb file here');
     }
@@ -553,7 +555,7 @@ export class DrafterViewer extends HTMLElement {
   applySettings(attributes) {
     const v = this.viewer;
     const carries = Boolean(this.summary.lines);
-    const pick = (key, fromAttribute, fallback) => this.choices[key] ?? fromAttribute ?? fallback;
+    const pick = (key, fromAttribute, fallback) => this.pick(key, fromAttribute, fallback);
     v.set_style(pick('style', attributes.style, this.viewState().style));
     v.set_edges(pick('edges', attributes.edges, carries));
     v.set_lines(pick('lines', attributes.lines, carries));
@@ -572,6 +574,29 @@ export class DrafterViewer extends HTMLElement {
     }
     this.note(notes.join(' '));
     this.syncControls();
+  }
+
+  /** A setting: what the user chose before, else the attribute's value, else `fallback`. */
+  pick(key, fromAttribute, fallback) {
+    return this.choices[key] ?? fromAttribute ?? fallback;
+  }
+
+  /**
+   * Compiles the pipelines the first frame will most likely draw with (a baked file's defaults:
+   * edges and lines on) before the file is read: the browser's GPU process then compiles them
+   * during the read instead of at the first draw. A file that asks for others compiles those then.
+   */
+  warmPipelines(attributes) {
+    try {
+      this.viewer.warm_pipelines(
+        this.pick('style', attributes.style, this.viewState().style),
+        this.pick('edges', attributes.edges, true),
+        this.pick('lines', attributes.lines, true),
+        this.pick('shadow', attributes.shadow, 'none'),
+      );
+    } catch (err) {
+      console.warn(`drafter: pipelines not compiled ahead: ${err.message ?? err}`);
+    }
   }
 
   /** The frame's settings: style, edges, lines, shadow, orthographic, azimuth, elevation, zoom, panX, panY, width, height. */

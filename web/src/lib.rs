@@ -414,6 +414,21 @@ impl Viewer {
         }
     }
 
+    /// Compiles the pipelines of a first frame in `style` with edges, lines and `shadow` as given,
+    /// before a model is loaded (`Renderer::warm_pipelines`): the page calls it before reading its
+    /// file, so the browser's GPU process compiles them during the read. The settings stay as they
+    /// were.
+    pub fn warm_pipelines(&mut self, style: &str, edges: bool, lines: bool, shadow: &str) -> Result<(), JsError> {
+        let saved = self.options.clone();
+        let set = self.set_style(style).and_then(|()| self.set_shadow(shadow));
+        self.set_edges(edges);
+        self.set_lines(lines);
+        let options = std::mem::replace(&mut self.options, saved);
+        set?;
+        self.renderer.warm_pipelines(&options);
+        Ok(())
+    }
+
     /// Sets the scene's style by name (`gradient`, `phong`, `cel`, `gooch`, `goochel`, `metal`,
     /// `hatch`).
     pub fn set_style(&mut self, name: &str) -> Result<(), JsError> {

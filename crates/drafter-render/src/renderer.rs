@@ -269,6 +269,38 @@ impl Renderer {
         self.targets.as_ref().map(|t| &t.targets.part_id.texture)
     }
 
+    /// Compiles, with no model loaded yet, the pipelines a first frame drawn with `options` will
+    /// use (a model whose parts carry style hints may still ask for another G-buffer pipeline).
+    /// A browser's GL finishes a program in the background after linking it, so the page calls
+    /// this before reading its file and that work is done during the read, not at the first draw.
+    pub fn warm_pipelines(&mut self, options: &RenderOptions) {
+        let device = &self.gpu.device;
+        self.gbuffer.compile(device, crate::passes::gbuffer::frame_styles(options, 0, true));
+        self.display.compile(device, display::uniforms(options, 1.0, options.orthographic).flags);
+        if options.shadow != ShadowMode::None {
+            self.shadow.ensure_pipelines(device);
+        }
+        if options.drawn_enhancements().unsharp_mask {
+            self.enhance.ensure_pipeline(device);
+        }
+        if options.lines {
+            self.lines.ensure_pipeline(device);
+        }
+        if options.interactive {
+            self.upscale.ensure_pipeline(device);
+        }
+    }
+
+    /// How many pipelines the passes have compiled so far (the shadow pass's set counting as one).
+    pub fn compiled_pipelines(&self) -> usize {
+        self.gbuffer.compiled()
+            + self.display.compiled()
+            + self.shadow.compiled()
+            + self.enhance.compiled()
+            + self.lines.compiled()
+            + self.upscale.compiled()
+    }
+
     /// Fits the camera for `options` and writes every pass's uniforms.
     fn prepare(&mut self, options: &RenderOptions) -> Result<FrameInfo, RenderError> {
         options.validate().map_err(RenderError::Options)?;

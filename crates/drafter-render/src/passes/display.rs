@@ -135,6 +135,16 @@ impl DisplayPass {
     /// Compiles (once) and selects the pipeline for `flags`.
     fn specialise(&mut self, device: &wgpu::Device, flags: u32) {
         self.flags = flags;
+        self.compile(device, flags);
+    }
+
+    /// How many pipelines this pass has compiled.
+    pub fn compiled(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    /// Compiles the pipeline for `flags` if it is not yet, without selecting it.
+    pub fn compile(&mut self, device: &wgpu::Device, flags: u32) {
         self.pipelines.entry(flags).or_insert_with(|| {
             fullscreen_pipeline(
                 device,

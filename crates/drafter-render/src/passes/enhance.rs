@@ -96,6 +96,11 @@ impl EnhancePass {
     }
 
     /// Compiles the blur the first time a frame draws the unsharp mask.
+    /// How many pipelines this pass has compiled (0 or 1).
+    pub fn compiled(&self) -> usize {
+        usize::from(self.blur.is_some())
+    }
+
     pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
         if self.blur.is_none() {
             let module = device.create_shader_module(super::shader_source!("enhance.wgsl", "fullscreen.wgsl"));

@@ -337,10 +337,20 @@ impl GBufferPass {
     /// Makes the frames that follow use the pipeline specialised for `styles` (bit
     /// [`Style::index`] per style that may be drawn), compiling it the first time it is asked for.
     pub fn specialise(&mut self, device: &wgpu::Device, styles: u32) {
+        self.styles = self.compile(device, styles);
+    }
+
+    /// How many pipelines this pass has compiled.
+    pub fn compiled(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    /// Compiles the pipeline for `styles` if it is not yet, without selecting it; returns the
+    /// styles it draws.
+    pub fn compile(&mut self, device: &wgpu::Device, styles: u32) -> u32 {
         let styles = if styles & ALL_STYLES == 0 { ALL_STYLES } else { styles & ALL_STYLES };
-        self.styles = styles;
         if self.pipelines.contains_key(&styles) {
-            return;
+            return styles;
         }
         let target = |format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let constants = [("STYLES", f64::from(styles))];
@@ -382,6 +392,7 @@ impl GBufferPass {
             cache: None,
         });
         self.pipelines.insert(styles, pipeline);
+        styles
     }
 
     /// The bind group of a scene: frame uniforms, instances, label → part, parts, materials and the

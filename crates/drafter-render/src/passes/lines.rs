@@ -178,6 +178,11 @@ impl LinesPass {
     }
 
     /// Compiles the pipeline the first time a frame draws lines.
+    /// How many pipelines this pass has compiled (0 or 1).
+    pub fn compiled(&self) -> usize {
+        usize::from(self.pipeline.is_some())
+    }
+
     pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
         if self.pipeline.is_some() {
             return;

@@ -361,6 +361,11 @@ impl ShadowPass {
     }
 
     /// Compiles the pipelines the first time a frame draws a shadow.
+    /// Whether this pass has compiled its pipelines (0 or 1).
+    pub fn compiled(&self) -> usize {
+        usize::from(self.pipelines.is_some())
+    }
+
     pub fn ensure_pipelines(&mut self, device: &wgpu::Device) {
         if self.pipelines.is_some() {
             return;

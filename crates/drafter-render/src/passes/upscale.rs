@@ -52,6 +52,11 @@ impl UpscalePass {
     }
 
     /// Compiles the pipeline the first time an interactive frame is drawn.
+    /// How many pipelines this pass has compiled (0 or 1).
+    pub fn compiled(&self) -> usize {
+        usize::from(self.pipeline.is_some())
+    }
+
     pub fn ensure_pipeline(&mut self, device: &wgpu::Device) {
         if self.pipeline.is_none() {
             let module = device.create_shader_module(super::shader_source!("upscale.wgsl", "fullscreen.wgsl"));
