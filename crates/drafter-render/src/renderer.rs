@@ -277,6 +277,15 @@ impl Renderer {
         let device = &self.gpu.device;
         self.gbuffer.compile(device, crate::passes::gbuffer::frame_styles(options, 0, true));
         self.display.compile(device, display::uniforms(options, 1.0, options.orthographic).flags);
+        self.ensure_pass_pipelines(options);
+    }
+
+    /// Makes the pipelines of the passes a frame drawn with `options` uses beside the G-buffer
+    /// and the display (which are specialised per frame): one place for the conditions, shared by
+    /// [`Self::prepare`] and [`Self::warm_pipelines`].
+    fn ensure_pass_pipelines(&mut self, options: &RenderOptions) {
+        let device = &self.gpu.device;
+        // A penumbra or soft shadow drawn as the hard one while dragging uses the same pipelines.
         if options.shadow != ShadowMode::None {
             self.shadow.ensure_pipelines(device);
         }
@@ -304,6 +313,7 @@ impl Renderer {
     /// Fits the camera for `options` and writes every pass's uniforms.
     fn prepare(&mut self, options: &RenderOptions) -> Result<FrameInfo, RenderError> {
         options.validate().map_err(RenderError::Options)?;
+        self.ensure_pass_pipelines(options);
         let size = options.drawn_size();
         if self.targets.as_ref().is_some_and(|t| t.targets.size != size)
             && self.spare_targets.as_ref().is_some_and(|t| t.targets.size == size)
@@ -380,19 +390,12 @@ impl Renderer {
             &drawn_layers
         };
         let plan = shadow::plan(drawn_shadow, layers, camera.clip_from_render(), &scene.fit_points, mask_size);
-        if drawn_shadow != ShadowMode::None {
-            self.shadow.ensure_pipelines(&self.gpu.device);
-        }
         self.shadow.prepare(queue, &plan);
         let radius = (max - min).length() * 0.5;
-        if options.drawn_enhancements().unsharp_mask {
-            self.enhance.ensure_pipeline(&self.gpu.device);
-        }
         self.enhance
             .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
         self.display.prepare(&self.gpu.device, queue, &display::uniforms(options, radius, options.orthographic));
         if options.lines {
-            self.lines.ensure_pipeline(&self.gpu.device);
             let view = world_view(&camera, scene.origin);
             let silhouettes = scene.lines.lines.silhouettes(view);
             let uniforms = lines::uniforms(options, &camera, size.1);
@@ -415,9 +418,6 @@ impl Renderer {
         output: Option<&wgpu::TextureView>,
     ) -> Result<FrameInfo, RenderError> {
         let info = self.prepare(options)?;
-        if options.interactive {
-            self.upscale.ensure_pipeline(&self.gpu.device);
-        }
         if options.interactive && output.is_none() {
             self.ensure_upscaled(info.target_size)?;
         }

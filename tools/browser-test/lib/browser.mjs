@@ -1,6 +1,7 @@
 // Runs one test page in headless Chromium (Debian's build, software WebGL 2 through SwiftShader) and
 // collects what the page reports, its console errors and, if asked, an 800x600 screenshot.
 
+import { readdirSync, readFileSync } from 'node:fs';
 import puppeteer from 'puppeteer-core';
 
 export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
@@ -64,7 +65,6 @@ export async function launchBrowser(timeoutMs, extraArgs = []) {
 export async function waitUntilBrowserIdle(browser, { quietMs = 500, maxMs = 15_000 } = {}) {
   const group = browser.process()?.pid;
   if (!group) return 0;
-  const { readdirSync, readFileSync } = await import('node:fs');
   // CPU seconds of every process in the group (utime + stime, in clock ticks of 1/100 s).
   const cpuTicks = () => {
     let ticks = 0;
