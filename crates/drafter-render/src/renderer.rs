@@ -170,7 +170,7 @@ impl Renderer {
         let device = &self.gpu.device;
         let queue = &self.gpu.queue;
         let (gpu, lines) = scoped(device, || {
-            let gpu = SceneGpu::upload(device, queue, model, &self.gbuffer, &self.shadow, &self.frame_uniforms);
+            let gpu = SceneGpu::upload(device, queue, model, &self.gbuffer, &self.frame_uniforms);
             let lines =
                 self.lines.scene(device, queue, model.lines.clone(), &self.frame_uniforms, &gpu.buffers.instances);
             (gpu, lines)

@@ -35,10 +35,12 @@ pub struct SceneBuffers {
 pub struct SceneGpu {
     pub batches: Vec<BatchGpu>,
     pub buffers: SceneBuffers,
+    /// The instances again, as the G-buffer and shadow passes' second vertex buffer
+    /// ([`crate::passes::gbuffer::instance_layout`]): at least one record, so that it can be bound.
+    pub instance_vertices: wgpu::Buffer,
     /// The model's lookup textures (baked, or the procedural fallbacks).
     pub lookups: LookupsGpu,
     pub gbuffer_bind_group: wgpu::BindGroup,
-    pub shadow_bind_group: wgpu::BindGroup,
 }
 
 impl BatchGpu {
@@ -57,7 +59,6 @@ impl SceneGpu {
         queue: &wgpu::Queue,
         model: &Model,
         gbuffer: &crate::passes::gbuffer::GBufferPass,
-        shadow: &crate::passes::shadow::ShadowPass,
         frame: &wgpu::Buffer,
     ) -> SceneGpu {
         let storage = |label: &str, contents: &[u8]| Table::with_contents(device, queue, label, contents);
@@ -100,9 +101,15 @@ impl SceneGpu {
                 instances: b.instances.clone(),
             })
             .collect();
+        let instance_records: &[crate::gpu_types::InstanceGpu] =
+            if model.instances.is_empty() { &[bytemuck::Zeroable::zeroed()] } else { &model.instances };
+        let instance_vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene instance records"),
+            contents: bytemuck::cast_slice(instance_records),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
         let lookups = LookupsGpu::upload(device, queue, model.lookups());
         let gbuffer_bind_group = gbuffer.bind_group(device, frame, &buffers, &lookups);
-        let shadow_bind_group = shadow.scene_bind_group(device, &buffers);
-        SceneGpu { batches, buffers, lookups, gbuffer_bind_group, shadow_bind_group }
+        SceneGpu { batches, buffers, instance_vertices, lookups, gbuffer_bind_group }
     }
 }

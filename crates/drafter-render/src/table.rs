@@ -1,6 +1,6 @@
 //! The arrays the scene's shaders index by instance, label, part, material or segment, held in 2D
 //! textures of 16-byte texels (`Rgba32Uint`, a float stored by its bits) and read with
-//! `textureLoad`; the accessors (`instance_at`, `part_at`, ...) are WGSL functions beside the
+//! `textureLoad`; the accessors (`instance_transform_at`, `part_at`, ...) are WGSL functions beside the
 //! structs they return (`passes/shared.wgsl` and the passes' own files).
 //!
 //! # Why textures and not storage buffers
@@ -128,12 +128,13 @@ mod tests {
     use super::TEXEL_BYTES;
     use crate::gpu_types::{InstanceGpu, LineSegmentGpu, MaterialGpu, PartGpu};
 
-    /// The WGSL accessors read whole texels: `instance_at` 8 (shared.wgsl), `part_at` 6 and
-    /// `material_at` 2 (gbuffer.wgsl), `segment_at` 2 (lines.wgsl).
+    /// The WGSL accessors step whole records: `instance_transform_at` 8 texels (of which it
+    /// reads the transform's 4), `segment_at` 2 (lines.wgsl), `part_at` 6 and `material_at` 2
+    /// (gbuffer.wgsl).
     #[test]
     fn the_accessors_read_the_rust_structs_whole() {
         for (name, size, texels, source) in [
-            ("instance_at", size_of::<InstanceGpu>(), 8, include_str!("passes/shared.wgsl")),
+            ("instance_transform_at", size_of::<InstanceGpu>(), 8, include_str!("passes/lines.wgsl")),
             ("part_at", size_of::<PartGpu>(), 6, include_str!("passes/gbuffer.wgsl")),
             ("material_at", size_of::<MaterialGpu>(), 2, include_str!("passes/gbuffer.wgsl")),
             ("segment_at", size_of::<LineSegmentGpu>(), 2, include_str!("passes/lines.wgsl")),

@@ -82,8 +82,9 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use crate::gpu_types::{
-    LOOKUP_CEL, LOOKUP_CEL_SPECULAR, LOOKUP_COOL_TO_WARM, LOOKUP_COOL_TO_WARM_FACTORED, LOOKUP_COOL_TO_WARM_SPHERE,
-    LOOKUP_COOL_TO_WARM_SPLASH, LOOKUP_HATCH, LOOKUP_METAL, LOOKUP_METAL_SPHERE, LookupUniforms, Vertex,
+    InstanceGpu, LOOKUP_CEL, LOOKUP_CEL_SPECULAR, LOOKUP_COOL_TO_WARM, LOOKUP_COOL_TO_WARM_FACTORED,
+    LOOKUP_COOL_TO_WARM_SPHERE, LOOKUP_COOL_TO_WARM_SPLASH, LOOKUP_HATCH, LOOKUP_METAL, LOOKUP_METAL_SPHERE,
+    LookupUniforms, Vertex,
 };
 use crate::lookups::{self, BakedLookups, EnvMapping, LookupFormat, LookupImage};
 use crate::passes::{FILTERABLE, FLOAT, color_attachment, sampler_entry, texture_entry, uniform_entry};
@@ -106,6 +107,23 @@ pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     }
 }
 
+/// [`InstanceGpu`] as vertex attributes (`InstanceIn` in shared.wgsl): its transform's four
+/// columns, the normal matrix's three and the ids, in the order of the struct's fields.
+const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
+    4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
+    8 => Float32x4, 9 => Float32x4, 10 => Float32x4, 11 => Uint32x4,
+];
+
+/// The second vertex buffer of the G-buffer and shadow passes: the scene's instances
+/// ([`crate::scene::SceneGpu::instance_vertices`]), one record per instance drawn.
+pub fn instance_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: size_of::<InstanceGpu>() as wgpu::BufferAddress,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &INSTANCE_ATTRIBUTES,
+    }
+}
+
 /// Every style's bit (`STYLES` in `gbuffer.wgsl`): the pipeline that draws any mix of part styles.
 pub const ALL_STYLES: u32 = (1 << Style::ALL.len()) - 1;
 
@@ -120,7 +138,7 @@ pub fn frame_styles(options: &RenderOptions, part_hints: u32, unhinted_parts: bo
 }
 
 /// Bindings of the lookup textures (keep in sync with `gbuffer.wgsl`).
-const LOOKUP_BINDINGS: std::ops::Range<u32> = 6..12;
+const LOOKUP_BINDINGS: std::ops::Range<u32> = 5..11;
 
 #[derive(Debug)]
 pub struct GBufferPass {
@@ -283,10 +301,9 @@ impl GBufferPass {
         let mut entries = vec![
             uniform_entry(0, S::VERTEX_FRAGMENT, false),
             table::layout_entry(1, S::VERTEX),
-            table::layout_entry(2, S::VERTEX),
+            table::layout_entry(2, S::FRAGMENT),
             table::layout_entry(3, S::FRAGMENT),
-            table::layout_entry(4, S::FRAGMENT),
-            uniform_entry(5, S::FRAGMENT, false),
+            uniform_entry(4, S::FRAGMENT, false),
         ];
         // The γ atlas is read with `textureLoad` (its procedural form is 32-bit float, which
         // core WebGPU cannot filter); the others with the samplers.
@@ -361,7 +378,7 @@ impl GBufferPass {
                 module: &self.module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
+                buffers: &[Some(vertex_layout()), Some(instance_layout())],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -406,14 +423,13 @@ impl GBufferPass {
     ) -> wgpu::BindGroup {
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&scene.instances.view) },
             wgpu::BindGroupEntry {
-                binding: 2,
+                binding: 1,
                 resource: wgpu::BindingResource::TextureView(&scene.label_to_part.view),
             },
-            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&scene.parts.view) },
-            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&scene.materials.view) },
-            wgpu::BindGroupEntry { binding: 5, resource: lookups.uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&scene.parts.view) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&scene.materials.view) },
+            wgpu::BindGroupEntry { binding: 4, resource: lookups.uniforms.as_entire_binding() },
         ];
         entries.extend(LOOKUP_BINDINGS.zip(&lookups.views).map(|(binding, view)| wgpu::BindGroupEntry {
             binding,
@@ -475,6 +491,7 @@ impl GBufferPass {
             let Some(pipeline) = pipeline else { return };
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &scene.gbuffer_bind_group, &[]);
+            pass.set_vertex_buffer(1, scene.instance_vertices.slice(..));
             for batch in &scene.batches {
                 pass.set_vertex_buffer(0, batch.vertices_for(enhanced_normals).slice(..));
                 pass.set_index_buffer(batch.indices.slice(..), wgpu::IndexFormat::Uint32);
@@ -488,6 +505,43 @@ impl GBufferPass {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The instance attributes lie where [`InstanceGpu`]'s fields do, fill the record, and match
+    /// `InstanceIn`'s locations and types in shared.wgsl.
+    #[test]
+    fn the_instance_attributes_are_the_instance_record() {
+        let fields = [
+            std::mem::offset_of!(InstanceGpu, render_from_object),
+            std::mem::offset_of!(InstanceGpu, render_from_object) + 16,
+            std::mem::offset_of!(InstanceGpu, render_from_object) + 32,
+            std::mem::offset_of!(InstanceGpu, render_from_object) + 48,
+            std::mem::offset_of!(InstanceGpu, normal_from_object),
+            std::mem::offset_of!(InstanceGpu, normal_from_object) + 16,
+            std::mem::offset_of!(InstanceGpu, normal_from_object) + 32,
+            std::mem::offset_of!(InstanceGpu, label_base),
+        ];
+        let offsets: Vec<usize> = INSTANCE_ATTRIBUTES.iter().map(|a| a.offset as usize).collect();
+        assert_eq!(offsets, fields);
+        let last = INSTANCE_ATTRIBUTES[7];
+        assert_eq!(last.offset + last.format.size(), size_of::<InstanceGpu>() as u64);
+        let shared = include_str!("shared.wgsl");
+        let body = &shared[shared.find("struct InstanceIn {").expect("InstanceIn in shared.wgsl")..];
+        let body = &body[..body.find('}').unwrap_or(body.len())];
+        for attribute in INSTANCE_ATTRIBUTES {
+            let ty = match attribute.format {
+                wgpu::VertexFormat::Float32x4 => "vec4<f32>",
+                wgpu::VertexFormat::Uint32x4 => "vec4<u32>",
+                other => panic!("{other:?} not expected"),
+            };
+            let line = body
+                .lines()
+                .find(|l| l.contains(&format!("@location({})", attribute.shader_location)))
+                .unwrap_or_else(|| panic!("no @location({}) in InstanceIn", attribute.shader_location));
+            assert!(line.contains(ty), "{line}: expected {ty}");
+        }
+        // The vertex attributes stop below the first instance location.
+        assert!(VERTEX_ATTRIBUTES.iter().all(|a| a.shader_location < INSTANCE_ATTRIBUTES[0].shader_location));
+    }
 
     fn table(steps: u32, specular: bool) -> CelTableRecord {
         CelTableRecord { steps, specular, min_level: 0.3, specular_threshold: 0.95, diffuse_max: 0.8 }

@@ -76,11 +76,10 @@ fn may_draw(style: u32) -> bool {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// The scene's tables (table.rs; instance_at is in shared.wgsl).
-@group(0) @binding(1) var instance_table: texture_2d<u32>;
-@group(0) @binding(2) var label_table: texture_2d<u32>;
-@group(0) @binding(3) var part_table: texture_2d<u32>;
-@group(0) @binding(4) var material_table: texture_2d<u32>;
+// The scene's tables (table.rs); the instances come as vertex attributes (InstanceIn, shared.wgsl).
+@group(0) @binding(1) var label_table: texture_2d<u32>;
+@group(0) @binding(2) var part_table: texture_2d<u32>;
+@group(0) @binding(3) var material_table: texture_2d<u32>;
 
 // The part of label k of the scene (4 labels a texel).
 fn part_of_label(k: u32) -> u32 {
@@ -115,15 +114,15 @@ fn material_at(i: u32) -> Material {
     material.pad1 = rest.w;
     return material;
 }
-@group(0) @binding(5) var<uniform> lookups: Lookups;
-@group(0) @binding(6) var gamma_atlas: texture_2d<f32>;
-@group(0) @binding(7) var cel_atlas: texture_2d<f32>;
-@group(0) @binding(8) var cool_to_warm: texture_2d<f32>;
-@group(0) @binding(9) var hatching: texture_2d<f32>;
-@group(0) @binding(10) var metal_bands: texture_2d<f32>;
-@group(0) @binding(11) var metal_highlights: texture_2d<f32>;
-@group(0) @binding(12) var clamp_sampler: sampler;
-@group(0) @binding(13) var repeat_sampler: sampler;
+@group(0) @binding(4) var<uniform> lookups: Lookups;
+@group(0) @binding(5) var gamma_atlas: texture_2d<f32>;
+@group(0) @binding(6) var cel_atlas: texture_2d<f32>;
+@group(0) @binding(7) var cool_to_warm: texture_2d<f32>;
+@group(0) @binding(8) var hatching: texture_2d<f32>;
+@group(0) @binding(9) var metal_bands: texture_2d<f32>;
+@group(0) @binding(10) var metal_highlights: texture_2d<f32>;
+@group(0) @binding(11) var clamp_sampler: sampler;
+@group(0) @binding(12) var repeat_sampler: sampler;
 
 struct VertexIn {
     @location(0) position_in_object: vec3<f32>,
@@ -142,8 +141,8 @@ struct VertexOut {
 }
 
 @vertex
-fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
-    let inst = instance_at(instance_index);
+fn vs_main(v: VertexIn, instance: InstanceIn) -> VertexOut {
+    let inst = instance_from(instance);
     let position = inst.render_from_object * vec4<f32>(v.position_in_object, 1.0);
     let normal_from_object = mat3x3<f32>(inst.normal_col0.xyz, inst.normal_col1.xyz, inst.normal_col2.xyz);
     let label = min(v.label, max(inst.label_count, 1u) - 1u);

@@ -5,7 +5,7 @@
 // fragment shader, so consecutive segments join without gaps. Hidden parts are discarded by
 // comparing the line's view depth with the G-buffer's linear depth at the nearest point of the
 // segment (and one texel to either side), within a tolerance.
-// Frame and Instance are in shared.wgsl. Keep the structs in sync with gpu_types.rs (FrameUniforms, InstanceGpu, LineSegmentGpu,
+// Frame is in shared.wgsl. Keep the structs in sync with gpu_types.rs (FrameUniforms, InstanceGpu, LineSegmentGpu,
 // LinesUniforms) and the class codes (`kind`) with edges::LineClass.
 
 struct Segment {
@@ -33,6 +33,19 @@ const CONTOUR_DEPTH_JUMP: f32 = 0.1;
 @group(1) @binding(0) var linear_depth_tex: texture_2d<f32>;
 @group(1) @binding(1) var part_id_tex: texture_2d<u32>;
 @group(2) @binding(0) var segment_table: texture_2d<u32>;
+
+// The render-from-object transform of instance i: the first 4 of its 8 texels (table.rs; the
+// record is gpu_types::InstanceGpu, `Instance` in shared.wgsl). Every vertex of a segment reads
+// it, and only it.
+fn instance_transform_at(i: u32) -> mat4x4<f32> {
+    let t = i * 8u;
+    return mat4x4<f32>(
+        bitcast<vec4<f32>>(textureLoad(instance_table, table_coord(t), 0)),
+        bitcast<vec4<f32>>(textureLoad(instance_table, table_coord(t + 1u), 0)),
+        bitcast<vec4<f32>>(textureLoad(instance_table, table_coord(t + 2u), 0)),
+        bitcast<vec4<f32>>(textureLoad(instance_table, table_coord(t + 3u), 0)),
+    );
+}
 
 // Segment i of the bound table (table.rs): 2 texels.
 fn segment_at(i: u32) -> Segment {
@@ -69,9 +82,9 @@ fn is_outline(kind: u32) -> bool {
 fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
     let v = vertex % 6u;
     let s = segment_at(vertex / 6u);
-    let inst = instance_at(s.instance);
-    var a = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.a, 1.0))).xyz;
-    var b = (frame.view_from_render * (inst.render_from_object * vec4<f32>(s.b, 1.0))).xyz;
+    let render_from_object = instance_transform_at(s.instance);
+    var a = (frame.view_from_render * (render_from_object * vec4<f32>(s.a, 1.0))).xyz;
+    var b = (frame.view_from_render * (render_from_object * vec4<f32>(s.b, 1.0))).xyz;
     var out: VertexOut;
     out.kind = s.kind;
     // Clip against the near plane (view space looks down -z).

@@ -193,7 +193,6 @@ fn steep(light_dir: Vec3) -> Vec3 {
 
 #[derive(Debug)]
 pub struct ShadowPass {
-    scene_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     resolve_pipeline_layout: wgpu::PipelineLayout,
     /// Compiled by [`Self::ensure_pipelines`] when a frame first draws a shadow (the page's default
@@ -264,10 +263,6 @@ fn layer_uniforms(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgp
 impl ShadowPass {
     pub fn new(device: &wgpu::Device) -> ShadowPass {
         use wgpu::ShaderStages as S;
-        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow scene bind group layout"),
-            entries: &[crate::table::layout_entry(0, S::VERTEX)],
-        });
         let layer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow layer bind group layout"),
             entries: &[uniform_entry(0, S::VERTEX_FRAGMENT, true)],
@@ -287,12 +282,12 @@ impl ShadowPass {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow pipeline layout"),
-            bind_group_layouts: &[Some(&scene_layout), Some(&layer_layout)],
+            bind_group_layouts: &[Some(&layer_layout)],
             immediate_size: 0,
         });
         let resolve_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow resolve pipeline layout"),
-            bind_group_layouts: &[None, None, Some(&resolve_layout)],
+            bind_group_layouts: &[None, Some(&resolve_layout)],
             immediate_size: 0,
         });
         let (layers, layers_bind_group, stride) = layer_uniforms(device, &layer_layout);
@@ -325,7 +320,6 @@ impl ShadowPass {
             ],
         });
         ShadowPass {
-            scene_layout,
             layout,
             resolve_pipeline_layout,
             pipelines: None,
@@ -336,18 +330,6 @@ impl ShadowPass {
             resolve_uniforms,
             resolve_bind_group,
         }
-    }
-
-    /// The bind group of a scene: its instances.
-    pub fn scene_bind_group(&self, device: &wgpu::Device, scene: &crate::scene::SceneBuffers) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow scene bind group"),
-            layout: &self.scene_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&scene.instances.view),
-            }],
-        })
     }
 
     /// Uploads `plan` for the next [`Self::encode`].
@@ -380,7 +362,10 @@ impl ShadowPass {
                     module: &module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(crate::passes::gbuffer::vertex_layout())],
+                    buffers: &[
+                        Some(crate::passes::gbuffer::vertex_layout()),
+                        Some(crate::passes::gbuffer::instance_layout()),
+                    ],
                 },
                 primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
                 depth_stencil,
@@ -423,8 +408,8 @@ impl ShadowPass {
     }
 
     fn draw_batches(&self, pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, layer: usize) {
-        pass.set_bind_group(0, &scene.shadow_bind_group, &[]);
-        pass.set_bind_group(1, &self.layers_bind_group, &[(layer as u64 * self.stride) as u32]);
+        pass.set_bind_group(0, &self.layers_bind_group, &[(layer as u64 * self.stride) as u32]);
+        pass.set_vertex_buffer(1, scene.instance_vertices.slice(..));
         for batch in &scene.batches {
             pass.set_vertex_buffer(0, batch.vertices.slice(..));
             pass.set_index_buffer(batch.indices.slice(..), wgpu::IndexFormat::Uint32);
@@ -459,7 +444,7 @@ impl ShadowPass {
                 multiview_mask: None,
             });
             pass.set_pipeline(&pipelines.resolve_pipeline);
-            pass.set_bind_group(2, &self.resolve_bind_group, &[]);
+            pass.set_bind_group(1, &self.resolve_bind_group, &[]);
             pass.draw(0..3, 0..1);
         } else {
             for k in 0..plan.layers.len().min(MAX_LAYERS) {

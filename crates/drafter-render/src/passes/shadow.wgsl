@@ -17,8 +17,7 @@ struct Resolve {
     inverse_scales: array<vec4<f32>, 4>,
 }
 
-@group(0) @binding(0) var instance_table: texture_2d<u32>;
-@group(1) @binding(0) var<uniform> layer: ShadowLayer;
+@group(0) @binding(0) var<uniform> layer: ShadowLayer;
 
 struct VertexIn {
     @location(0) position_in_object: vec3<f32>,
@@ -28,8 +27,8 @@ struct VertexIn {
 }
 
 @vertex
-fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> @builtin(position) vec4<f32> {
-    let p = (instance_at(instance_index).render_from_object * vec4<f32>(v.position_in_object, 1.0)).xyz;
+fn vs_main(v: VertexIn, instance: InstanceIn) -> @builtin(position) vec4<f32> {
+    let p = (instance_from(instance).render_from_object * vec4<f32>(v.position_in_object, 1.0)).xyz;
     let light = layer.light_position.xyz;
     // The ray from the light through p meets the plane y = h at t; points at or above the light's
     // height cast no shadow and are pushed far along their ray instead.
@@ -46,10 +45,10 @@ fn fs_main() -> @location(0) vec4<f32> {
     return vec4<f32>(layer.plane.z, 0.0, 0.0, 0.0);
 }
 
-// The resolve's own group (2), apart from the layer draws' groups 0 and 1.
-@group(2) @binding(0) var<uniform> resolve: Resolve;
-@group(2) @binding(1) var ground_map: texture_2d<f32>;
-@group(2) @binding(2) var map_sampler: sampler;
+// The resolve's own group (1), apart from the layer draws' group 0.
+@group(1) @binding(0) var<uniform> resolve: Resolve;
+@group(1) @binding(1) var ground_map: texture_2d<f32>;
+@group(1) @binding(2) var map_sampler: sampler;
 
 // The soft shadow at a mask pixel: the camera ray meets the ground at x; the shadow of plane k,
 // moved to the ground, is the ground shadow scaled by s_k about the light's foot point f, so its
