@@ -197,12 +197,14 @@ pub fn sphere_directions(n: usize) -> Vec<Vec3> {
 ///
 /// Equal to scanning every point for every direction (the farthest, the first of equals), which
 /// on a large scan would cost a noticeable part of the load: the points are bucketed into a grid
-/// of cells, each bounded by a sphere around its points, and a cell is scanned for a direction
-/// only when its sphere reaches the best lower bound that any cell guarantees along it (with a
-/// margin far above `f32` rounding). Hand-written: no crate does support queries with ties
-/// resolved this way.
+/// of cells, each bounded by a sphere around its points, the cells into blocks of 4³ bounded by
+/// spheres around theirs; for each direction the blocks are visited farthest reach first, and a
+/// block or cell is scanned only while its sphere reaches the farthest point found so far (with a
+/// margin far above `f32` rounding), so a direction costs a sort of the blocks and a few cells.
+/// Hand-written: no crate does support queries with ties resolved this way.
 pub fn support_points(points: &[Vec3], directions: &[Vec3]) -> Vec<usize> {
     const GRID: usize = 16;
+    const BLOCK: usize = 4;
     if points.is_empty() {
         return Vec::new();
     }
@@ -236,38 +238,74 @@ pub fn support_points(points: &[Vec3], directions: &[Vec3]) -> Vec<usize> {
         sorted[next[c]] = i as u32;
         next[c] += 1;
     }
-    // Per occupied cell: its points, centre, radius and rounding margin (infinite for the
-    // non-finite cell, which is then never skipped).
-    let spheres: Vec<(&[u32], Vec3, f32, f32)> = starts
-        .windows(2)
-        .filter(|w| w[1] > w[0])
-        .map(|w| {
-            let ids = &sorted[w[0]..w[1]];
-            let (a, b) = ids
+    // Per occupied cell: its points, centre and reach along any direction (radius plus a
+    // rounding margin far above f32 rounding), grouped by the block of BLOCK³ cells it lies in.
+    // The non-finite points' cell is scanned for every direction.
+    // A cell: its points, its centre and its reach.
+    type Cell<'a> = (&'a [u32], Vec3, f32);
+    const BLOCKS: usize = GRID / BLOCK;
+    let mut unbounded: &[u32] = &[];
+    let mut blocks: Vec<Vec<Cell>> = vec![Vec::new(); BLOCKS * BLOCKS * BLOCKS];
+    for (cell, w) in starts.windows(2).enumerate().filter(|(_, w)| w[1] > w[0]) {
+        let ids = &sorted[w[0]..w[1]];
+        if cell == GRID * GRID * GRID {
+            unbounded = ids;
+            continue;
+        }
+        let (a, b) = ids
+            .iter()
+            .map(|&i| points[i as usize])
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
+        let centre = (a + b) * 0.5;
+        let radius = ids.iter().map(|&i| (points[i as usize] - centre).length()).fold(0.0f32, f32::max);
+        let margin = 1e-5 * (centre.length() + radius) + f32::MIN_POSITIVE;
+        let (x, y, z) = (cell % GRID / BLOCK, cell / GRID % GRID / BLOCK, cell / (GRID * GRID) / BLOCK);
+        blocks[(z * BLOCKS + y) * BLOCKS + x].push((ids, centre, radius + margin));
+    }
+    // Per occupied block: its cells and a sphere around their spheres, the reach again with a
+    // margin of its own.
+    let blocks: Vec<(Vec<Cell>, Vec3, f32)> = blocks
+        .into_iter()
+        .filter(|cells| !cells.is_empty())
+        .map(|cells| {
+            let (a, b) = cells
                 .iter()
-                .map(|&i| points[i as usize])
-                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &(_, c, r)| (a.min(c - r), b.max(c + r)));
             let centre = (a + b) * 0.5;
-            let radius = ids.iter().map(|&i| (points[i as usize] - centre).length()).fold(0.0f32, f32::max);
-            let finite = ids.iter().all(|&i| points[i as usize].is_finite()) && radius.is_finite();
-            let margin = if finite { 1e-5 * (centre.length() + radius) + f32::MIN_POSITIVE } else { f32::INFINITY };
-            (ids, centre, radius, margin)
+            let radius = cells.iter().map(|&(_, c, r)| (c - centre).length() + r).fold(0.0f32, f32::max);
+            let reach = radius + 1e-5 * (centre.length() + radius) + f32::MIN_POSITIVE;
+            (cells, centre, reach)
         })
         .collect();
+    let mut reach: Vec<f32> = Vec::with_capacity(blocks.len());
     let mut indices: Vec<usize> = directions
         .iter()
         .map(|&d| {
-            // Every point of a cell is at least `c·d − r` along `d`, so the farthest point is too.
-            let lower = spheres.iter().map(|&(_, c, r, m)| along(&c, d) - r - m).fold(f32::NEG_INFINITY, f32::max);
             let (mut best, mut arg) = (f32::NEG_INFINITY, usize::MAX);
-            for &(ids, c, r, m) in &spheres {
-                if along(&c, d) + r + m < lower {
-                    continue;
-                }
+            let scan = |ids: &[u32], best: &mut f32, arg: &mut usize| {
                 for &i in ids {
                     let x = along(&points[i as usize], d);
-                    if x > best || (x == best && best > f32::NEG_INFINITY && (i as usize) < arg) {
-                        (best, arg) = (x, i as usize);
+                    if x > *best || (x == *best && *best > f32::NEG_INFINITY && (i as usize) < *arg) {
+                        (*best, *arg) = (x, i as usize);
+                    }
+                }
+            };
+            scan(unbounded, &mut best, &mut arg);
+            // The block that reaches farthest along `d` first, then every other that can still
+            // reach the farthest point found; inside them, only cells that can. Every point of a
+            // skipped block or cell lies short of a point already found, so the answer is the
+            // full scan's, ties included. (A reach that overflowed to NaN is scanned.)
+            reach.clear();
+            reach.extend(blocks.iter().map(|&(_, c, r)| along(&c, d) + r));
+            let first = (0..blocks.len()).fold(0, |k, j| if reach[j] > reach[k] || reach[j].is_nan() { j } else { k });
+            let others = (0..blocks.len()).filter(|&k| k != first);
+            for k in (!blocks.is_empty()).then_some(first).into_iter().chain(others) {
+                if reach[k] < best {
+                    continue;
+                }
+                for &(ids, c, r) in &blocks[k].0 {
+                    if along(&c, d) + r >= best || (along(&c, d) + r).is_nan() {
+                        scan(ids, &mut best, &mut arg);
                     }
                 }
             }
@@ -348,7 +386,7 @@ mod tests {
         let mut rng = drafter_core::rng::Rng::new(214);
         let mut r = || rng.signed_f32();
         let directions = sphere_directions(SUPPORT_DIRECTIONS);
-        for case in 0..60 {
+        for case in 0..120 {
             let n = [1, 7, 300, 2_000, 9_000][case % 5];
             let scale = [1.0, 1e-4, 3e5][case % 3];
             let offset = Vec3::new(r(), r(), r()) * [0.0, 1.0, 1e6][case % 3];
@@ -365,6 +403,15 @@ mod tests {
             }
             if case % 7 == 3 {
                 points[n / 2] = Vec3::new(f32::NAN, 0.0, 0.0);
+            }
+            // An infinite point, and points so far apart that sums of coordinates overflow.
+            if case % 11 == 5 {
+                points[n / 3] = Vec3::new(f32::INFINITY, 1.0, f32::NEG_INFINITY);
+            }
+            if case % 13 == 8 {
+                for (i, p) in points.iter_mut().enumerate().step_by(5) {
+                    *p = Vec3::new(3e38, -3e38, 2e38) * if i % 2 == 0 { 1.0 } else { -1.0 };
+                }
             }
             assert_eq!(
                 support_points(&points, &directions),
