@@ -367,12 +367,9 @@ impl Viewer {
             }
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let device = self.renderer.gpu().device.clone();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("web frame") });
-        self.renderer.encode_frame(&self.options, &mut encoder, Some(&view)).map_err(js_error)?;
-        let queue = &self.renderer.gpu().queue;
-        queue.submit([encoder.finish()]);
-        queue.present(frame);
+        // In two submits: SwiftShader draws the surfaces while the silhouettes are found.
+        self.renderer.submit_frame(&self.options, Some(&view)).map_err(js_error)?;
+        self.renderer.gpu().queue.present(frame);
         Ok(start.elapsed().as_secs_f64() * 1e3)
     }
 

@@ -395,16 +395,25 @@ impl Renderer {
         self.enhance
             .prepare(queue, &EnhanceSetup { height: size.1, far_depth: camera.view_depth(Vec3::ZERO) + radius * 1.5 });
         self.display.prepare(&self.gpu.device, queue, &display::uniforms(options, radius, options.orthographic));
-        if options.lines {
-            let view = world_view(&camera, scene.origin);
-            let silhouettes = scene.lines.lines.silhouettes(view);
-            let uniforms = lines::uniforms(options, &camera, size.1);
-            self.lines.prepare(&self.gpu.device, queue, &mut scene.lines, &uniforms, silhouettes);
-        }
         let info = FrameInfo { camera, target_size: options.target_size(), drawn_size: size };
         self.last_frame = Some(info);
         self.shadow_plan = plan;
         Ok(info)
+    }
+
+    /// The lines pass's share of [`Self::prepare`], apart so that [`Self::submit_frame`] can hand
+    /// the other passes to the GPU first: this frame's silhouettes (found on the CPU) and the
+    /// pass's uniforms.
+    fn prepare_lines(&mut self, options: &RenderOptions, info: &FrameInfo) -> Result<(), RenderError> {
+        if !options.lines {
+            return Ok(());
+        }
+        let scene = self.scene.as_mut().ok_or(RenderError::NoModel)?;
+        let view = world_view(&info.camera, scene.origin);
+        let silhouettes = scene.lines.lines.silhouettes(view);
+        let uniforms = lines::uniforms(options, &info.camera, info.drawn_size.1);
+        self.lines.prepare(&self.gpu.device, &self.gpu.queue, &mut scene.lines, &uniforms, silhouettes);
+        Ok(())
     }
 
     /// Records a whole frame for `options` into `encoder`, the display pass writing `output`
@@ -418,6 +427,44 @@ impl Renderer {
         output: Option<&wgpu::TextureView>,
     ) -> Result<FrameInfo, RenderError> {
         let info = self.prepare(options)?;
+        self.encode_surface_passes(options, encoder, output)?;
+        self.prepare_lines(options, &info)?;
+        self.encode_line_passes(options, encoder, output)?;
+        Ok(info)
+    }
+
+    /// [`Self::encode_frame`] recorded and submitted in two command buffers: the passes before the
+    /// lines first, then this frame's silhouettes are found and the lines (and an interactive
+    /// frame's filter) follow. The GPU draws the surfaces while this thread finds the silhouettes,
+    /// where one command buffer would wait for them: the browser's page, whose silhouettes of a
+    /// first frame are found by brute force on the thread that draws (a GL queue flushes its
+    /// commands at each submit). The same frame as [`Self::encode_frame`]'s.
+    pub fn submit_frame(
+        &mut self,
+        options: &RenderOptions,
+        output: Option<&wgpu::TextureView>,
+    ) -> Result<FrameInfo, RenderError> {
+        let device = self.gpu.device.clone();
+        let encoder = |label| device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        let info = self.prepare(options)?;
+        let mut surfaces = encoder("frame surfaces");
+        self.encode_surface_passes(options, &mut surfaces, output)?;
+        self.gpu.queue.submit([surfaces.finish()]);
+        self.prepare_lines(options, &info)?;
+        let mut lines = encoder("frame lines");
+        self.encode_line_passes(options, &mut lines, output)?;
+        self.gpu.queue.submit([lines.finish()]);
+        Ok(info)
+    }
+
+    /// The G-buffer, shadow, enhance and display passes of a prepared frame.
+    fn encode_surface_passes(
+        &mut self,
+        options: &RenderOptions,
+        encoder: &mut wgpu::CommandEncoder,
+        output: Option<&wgpu::TextureView>,
+    ) -> Result<(), RenderError> {
+        let info = self.last_frame.ok_or(RenderError::NoModel)?;
         if options.interactive && output.is_none() {
             self.ensure_upscaled(info.target_size)?;
         }
@@ -434,6 +481,22 @@ impl Renderer {
         }
         let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };
         self.display.encode(encoder, &frame.display, drawn);
+        Ok(())
+    }
+
+    /// The lines pass (its silhouettes prepared) and an interactive frame's filter, after
+    /// [`Self::encode_surface_passes`].
+    fn encode_line_passes(
+        &self,
+        options: &RenderOptions,
+        encoder: &mut wgpu::CommandEncoder,
+        output: Option<&wgpu::TextureView>,
+    ) -> Result<(), RenderError> {
+        let (Some(scene), Some(frame)) = (self.scene.as_ref(), self.targets.as_ref()) else {
+            return Err(RenderError::NoModel);
+        };
+        let targets = &frame.targets;
+        let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };
         if options.lines {
             self.lines.encode(encoder, &scene.lines, &frame.lines, drawn);
         }
@@ -441,7 +504,7 @@ impl Renderer {
             let output = output.or(self.upscaled.as_ref().map(|t| &t.view)).ok_or(RenderError::NoModel)?;
             self.upscale.encode(encoder, &frame.upscale, output);
         }
-        Ok(info)
+        Ok(())
     }
 
     /// Makes the headless output of interactive frames `size` large.
