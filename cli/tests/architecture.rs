@@ -104,19 +104,38 @@ fn code_map_lists_every_workspace_member_and_only_paths_that_exist() {
     assert!(stray.is_empty(), "code map rows under crates/ that are not workspace members: {stray:?}");
 }
 
-/// The names of the passes `Renderer::encode_frame` encodes (`self.NAME.encode(`), in source order.
+/// The passes as `Renderer::encode_frame` records them: the `.encode(` calls of the renderer's
+/// `encode_*` steps that it calls, in its order. `Renderer::submit_frame` (the page's frames) must
+/// call the same steps in the same order.
 fn encoded_passes() -> Vec<String> {
     let source = read(&format!("{RENDER}/src/renderer.rs"));
-    let start = source.find("pub fn encode_frame(").expect("Renderer::encode_frame in the renderer's renderer.rs");
-    let body = &source[start..];
-    let body = &body[..body.find("\n    }\n").expect("the end of encode_frame")];
+    let body_of = |signature: &str| {
+        let start = source.find(signature).unwrap_or_else(|| panic!("{signature} in the renderer's renderer.rs"));
+        let body = &source[start..];
+        body[..body.find("\n    }\n").unwrap_or_else(|| panic!("the end of {signature}"))].to_string()
+    };
+    // The `self.encode_*(` steps a frame function calls, in order.
+    let steps = |body: &str| -> Vec<String> {
+        body.match_indices("self.encode_")
+            .map(|(i, _)| {
+                let name = &body[i + "self.".len()..];
+                name[..name.find('(').expect("a call")].to_string()
+            })
+            .collect()
+    };
+    let frame = steps(&body_of("pub fn encode_frame("));
+    assert!(!frame.is_empty(), "encode_frame calls no encode_* step");
+    assert_eq!(steps(&body_of("pub fn submit_frame(")), frame, "submit_frame and encode_frame record different steps");
     let mut passes = Vec::new();
-    for (i, _) in body.match_indices(".encode(") {
-        let before = &body[..i];
-        let name_start = before.rfind(|c: char| !(c.is_alphanumeric() || c == '_')).map_or(0, |j| j + 1);
-        let receiver = &before[..name_start];
-        assert!(receiver.ends_with("self."), "encode_frame calls encode on something other than a pass field");
-        passes.push(before[name_start..].to_string());
+    for step in &frame {
+        let body = body_of(&format!("fn {step}("));
+        for (i, _) in body.match_indices(".encode(") {
+            let before = &body[..i];
+            let name_start = before.rfind(|c: char| !(c.is_alphanumeric() || c == '_')).map_or(0, |j| j + 1);
+            let receiver = &before[..name_start];
+            assert!(receiver.ends_with("self."), "{step} calls encode on something other than a pass field");
+            passes.push(before[name_start..].to_string());
+        }
     }
     passes
 }
