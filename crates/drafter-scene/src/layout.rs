@@ -25,8 +25,9 @@ pub struct Vertex {
     pub material: u32,
 }
 
-/// One mesh instance (`gbuffer.wgsl`, `shadow.wgsl`: `Instance`), in the instance table indexed by
-/// `instance_index`.
+/// One mesh instance (`shared.wgsl`: `Instance`): the G-buffer and shadow passes read it as vertex
+/// attributes stepped per instance (`InstanceIn`), the lines pass from the instance table by a
+/// segment's `instance`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct InstanceGpu {

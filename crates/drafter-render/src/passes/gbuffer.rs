@@ -1,9 +1,10 @@
 //! G-buffer pass (Lux et al. 2013, §5 "G-Buffer Generation Pass"; Algorithm 1, lines 1–11).
 //!
 //! # How it works
-//! Every mesh is drawn **once**, instanced over all its placements: the vertex shader reads the
-//! instance's transform from the instance table ([`crate::table`]), maps the vertex's part label through the
-//! instance's slice of `label_to_part` to a scene-wide part id, and the fragment shader fetches that
+//! Every mesh is drawn **once**, instanced over all its placements: the vertex shader takes the
+//! instance's transform from a second vertex buffer stepped per instance ([`instance_layout`]),
+//! maps the vertex's part label through the instance's slice of `label_to_part` (a table,
+//! [`crate::table`]) to a scene-wide part id, and the fragment shader fetches that
 //! part's projector, gradient parameters and style from the part table. Algorithm 1 sets uniforms
 //! per object; doing it through a table instead keeps the frame time independent of the
 //! number of parts.
