@@ -447,14 +447,27 @@ impl Renderer {
         let device = self.gpu.device.clone();
         let encoder = |label| device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         let info = self.prepare(options)?;
-        let mut surfaces = encoder("frame surfaces");
-        self.encode_surface_passes(options, &mut surfaces, output)?;
-        self.gpu.queue.submit([surfaces.finish()]);
+        let mut frame = encoder("frame");
+        self.encode_surface_passes(options, &mut frame, output)?;
+        // Without lines there are no silhouettes to wait for: one submit (each flushes the GL queue).
+        if options.lines {
+            self.gpu.queue.submit([frame.finish()]);
+            frame = encoder("frame lines");
+        }
         self.prepare_lines(options, &info)?;
-        let mut lines = encoder("frame lines");
-        self.encode_line_passes(options, &mut lines, output)?;
-        self.gpu.queue.submit([lines.finish()]);
+        self.encode_line_passes(options, &mut frame, output)?;
+        self.gpu.queue.submit([frame.finish()]);
         Ok(info)
+    }
+
+    /// The view the display and lines passes draw into: an interactive frame's reduced output
+    /// (filtered up into `output` afterwards), else `output` or the renderer's own.
+    fn drawn_view<'a>(
+        targets: &'a Targets,
+        options: &RenderOptions,
+        output: Option<&'a wgpu::TextureView>,
+    ) -> &'a wgpu::TextureView {
+        if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) }
     }
 
     /// The G-buffer, shadow, enhance and display passes of a prepared frame.
@@ -479,8 +492,7 @@ impl Renderer {
         if options.drawn_enhancements().unsharp_mask {
             self.enhance.encode(encoder, targets, &frame.enhance);
         }
-        let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };
-        self.display.encode(encoder, &frame.display, drawn);
+        self.display.encode(encoder, &frame.display, Self::drawn_view(targets, options, output));
         Ok(())
     }
 
@@ -495,9 +507,8 @@ impl Renderer {
         let (Some(scene), Some(frame)) = (self.scene.as_ref(), self.targets.as_ref()) else {
             return Err(RenderError::NoModel);
         };
-        let targets = &frame.targets;
-        let drawn = if options.interactive { &targets.output.view } else { output.unwrap_or(&targets.output.view) };
         if options.lines {
+            let drawn = Self::drawn_view(&frame.targets, options, output);
             self.lines.encode(encoder, &scene.lines, &frame.lines, drawn);
         }
         if options.interactive {
